@@ -1,0 +1,33 @@
+"""railadhesion: wheel-rail adhesion models, contact mechanics and calibration.
+
+Sign convention and units: see ``docs/CONVENTIONS.md``. In short: SI units; creepage
+xi = (V - omega R)/V (braking positive); forces are exerted by the rail on the wheel and
+oppose the creepage (Kalker's convention, as in CONTACT).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__version__ = "0.1.0"
+
+
+def adhesion(fx, fy, normal_force):
+    """Adhesion coefficient |T|/Q = sqrt(Fx^2 + Fy^2)/Q (dimensionless, >= 0).
+
+    Parameters
+    ----------
+    fx, fy : array_like
+        Tangential forces [N].
+    normal_force : array_like
+        Normal force Q [N], > 0.
+
+    Examples
+    --------
+    >>> float(adhesion(3.0, 4.0, 20.0))
+    0.25
+    """
+    from railadhesion._validate import check_positive
+
+    q = check_positive(normal_force, "normal_force")
+    return np.hypot(fx, fy) / q
