@@ -1,0 +1,1 @@
+"""Calibration: fitting model parameters to measured creep curves, WILAC regression builder."""

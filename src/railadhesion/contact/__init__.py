@@ -1,0 +1,1 @@
+"""Contact mechanics: Hertz, Kalker linear theory, FASTSIM."""

@@ -1,0 +1,1 @@
+"""Readers and writers: parameter files (TOML) and measured creep curves (CSV)."""

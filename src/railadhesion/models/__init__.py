@@ -1,0 +1,1 @@
+"""Creep-force models: Polach, WILAC, 2D twin-disc models."""
