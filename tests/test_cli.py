@@ -33,7 +33,9 @@ def test_hertz_rejects_negative_force():
 
 def test_polach_curve_table_and_figure(tmp_path):
     out = tmp_path / "polach.png"
-    result = _run("polach", "--set", "polach2005_wet", "--creep-percent", "0.5,5", "--out", str(out))
+    result = _run(
+        "polach", "--set", "polach2005_wet", "--creep-percent", "0.5,5", "--out", str(out)
+    )
     assert result.exit_code == 0, result.output
     assert out.stat().st_size > 1000
     assert "polach2005_wet" in result.output
