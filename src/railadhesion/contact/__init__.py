@@ -1,1 +1,32 @@
 """Contact mechanics: Hertz, Kalker linear theory, FASTSIM."""
+
+from railadhesion.contact.fastsim import FastsimResult, fastsim
+from railadhesion.contact.hertz import (
+    HertzContact,
+    LineContact,
+    combined_elastic_constants,
+    hertz_3d,
+    hertz_3d_from_curvatures,
+    line_contact,
+    line_contact_from_pressure,
+)
+from railadhesion.contact.kalker import (
+    KalkerCoefficients,
+    kalker_coefficients,
+    linear_creep_forces,
+)
+
+__all__ = [
+    "FastsimResult",
+    "HertzContact",
+    "KalkerCoefficients",
+    "LineContact",
+    "combined_elastic_constants",
+    "fastsim",
+    "hertz_3d",
+    "hertz_3d_from_curvatures",
+    "kalker_coefficients",
+    "line_contact",
+    "line_contact_from_pressure",
+    "linear_creep_forces",
+]

@@ -1,0 +1,372 @@
+"""Kalker's linear theory of rolling contact: creepage coefficients and linear creep forces.
+
+The coefficients C11, C22, C23 (and C33) of Kalker's linear theory for an elliptical Hertzian
+contact are tabulated in Kalker (1990), Appendix E, Table E.3, against the ratio of the
+semi-axes and Poisson's ratio. The table ships as package data
+(``railadhesion/data/kalker_coefficients.csv``) and is read once, at import.
+
+Interpolation follows CONTACT (Vollebregt, ``m_hertz.f90``, subroutine ``linrol``):
+
+* ``g = min(a/b, b/a)``; the coefficients are linear in ``g`` between two table rows of the
+  branch (``a <= b`` or ``a > b``);
+* across Poisson's ratio the reciprocal ``1/C`` is a parabola through ``nu = 0, 0.25, 0.5``:
+  ``1/C(nu) = 8(nu-1/4)(nu-1/2)/C(0) - 16(nu-1/2)nu/C(1/4) + 8nu(nu-1/4)/C(1/2)``.
+
+Below the table (``g < 0.1``) Kalker's asymptotic expressions are used, corrected so that the
+coefficients are continuous at ``g = 0.1`` (see :func:`kalker_coefficients`, Notes).
+
+Sign convention (``docs/CONVENTIONS.md``): forces are exerted by the rail on the wheel and
+oppose the creepages.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from importlib import resources
+from typing import NamedTuple
+
+import numpy as np
+
+from railadhesion._validate import check_finite, check_positive, check_range
+
+__all__ = ["KalkerCoefficients", "kalker_coefficients", "linear_creep_forces"]
+
+#: Smallest tabulated g = min(a/b, b/a); below it the asymptotes apply.
+_G_MIN = 0.1
+
+
+class KalkerCoefficients(NamedTuple):
+    """Kalker's creepage and spin coefficients (dimensionless).
+
+    Each field is a float (scalar inputs) or an array with the broadcast shape of the inputs.
+    """
+
+    c11: np.ndarray | float
+    """Longitudinal creepage coefficient C11."""
+    c22: np.ndarray | float
+    """Lateral creepage coefficient C22."""
+    c23: np.ndarray | float
+    """Lateral-force/spin coupling coefficient C23 (= C32)."""
+    c33: np.ndarray | float
+    """Spin-moment coefficient C33 (lower confidence, see the data file)."""
+
+
+def _load_table() -> tuple[np.ndarray, np.ndarray]:
+    """Read the package CSV into ``(coord, table)``.
+
+    ``coord`` (19,) is a single monotone coordinate: ``t = a/b`` on the ``a <= b`` branch
+    (0.1 ... 1.0) and ``t = 2 - b/a`` on the ``a > b`` branch (1.1 ... 1.9), so that linear
+    interpolation in ``t`` is linear in ``g`` on either branch. ``table`` has shape
+    (4 coefficients, 3 Poisson ratios, 19 rows).
+    """
+    text = (
+        resources.files("railadhesion").joinpath("data/kalker_coefficients.csv").read_text("utf-8")
+    )
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    rows = list(csv.DictReader(io.StringIO("\n".join(lines))))
+    names = [f"C{ij}_nu{n}" for ij in ("11", "22", "23", "33") for n in ("0", "025", "05")]
+    coord, values = [], []
+    for row in rows:
+        g = float(row["g"])
+        if row["side"] == "a_le_b":
+            t = g
+        elif row["side"] == "a_gt_b":
+            t = 2.0 - g
+        else:  # pragma: no cover - data file error
+            raise ValueError(f"unknown side {row['side']!r} in kalker_coefficients.csv")
+        coord.append(t)
+        values.append([float(row[n]) for n in names])
+    coord = np.asarray(coord)
+    order = np.argsort(coord)
+    coord = coord[order]
+    table = np.asarray(values)[order].T.reshape(4, 3, -1)
+    expected = np.round(np.arange(0.1, 1.95, 0.1), 10)
+    if coord.shape != expected.shape or not np.allclose(coord, expected):  # pragma: no cover
+        raise ValueError("kalker_coefficients.csv: rows must be g = 0.1, 0.2, ..., 1.0 per side")
+    return coord, table
+
+
+_COORD, _TABLE = _load_table()
+_NROW = _COORD.size  # 19
+_ROWS = np.ascontiguousarray(np.moveaxis(_TABLE, -1, 0))  # (19 rows, 4 coefficients, 3 nu)
+_ROWS_LIST = _ROWS.tolist()
+# C33 on the a > b branch at its last two rows (b/a = 0.1 and 0.2), per Poisson column; for
+# b/a < 0.1 C33 is extended as a power law through these two rows (after the nu interpolation).
+_C33_GT_ROWS = (_TABLE[3, :, -1].copy(), _TABLE[3, :, -2].copy())
+_C33_GT_ROWS_LIST = (_C33_GT_ROWS[0].tolist(), _C33_GT_ROWS[1].tolist())
+
+
+def _nu_weights(nu: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Lagrange weights of the parabola in 1/C through nu = 0, 0.25, 0.5 (CONTACT linrol)."""
+    w0 = 8.0 * (nu - 0.25) * (nu - 0.5)
+    w1 = -16.0 * (nu - 0.5) * nu
+    w2 = 8.0 * nu * (nu - 0.25)
+    return w0, w1, w2
+
+
+def _asymptotes(g: np.ndarray, nu: np.ndarray, le: np.ndarray) -> np.ndarray:
+    """Kalker's small-g asymptotes of C11, C22, C23, C33; shape (4, *g.shape).
+
+    ``le`` selects the branch a/b = g -> 0 (True) or b/a = g -> 0 (False). C33 is only
+    provided on the a/b -> 0 branch (strip theory, see kalker_coefficients Notes); on the
+    other branch the returned C33 is a placeholder (NaN) that the caller replaces.
+    """
+    pi = np.pi
+    one_m_nu = 1.0 - nu
+    # a/b = g -> 0 (contact wide laterally, short in rolling direction)
+    c11_le = pi**2 / (4.0 * one_m_nu)
+    c22_le = np.full_like(g, pi**2 / 4.0)
+    c23_le = pi * np.sqrt(g) / (3.0 * one_m_nu) * (1.0 + nu * (np.log(16.0 / g) - 5.0))
+    c33_le = pi**2 / (16.0 * one_m_nu * g)
+    # b/a = g -> 0 (contact long in rolling direction), Lambda = ln(16/g^2)
+    lam = np.log(16.0 / g**2)
+    k = 3.0 - np.log(4.0)
+    c11_gt = 2.0 * pi / ((lam - 2.0 * nu) * g) * (1.0 + k / (lam - 2.0 * nu))
+    den = one_m_nu * lam + 2.0 * nu
+    c22_gt = (2.0 * pi / g) * (1.0 + one_m_nu * k / den) / den
+    c23_gt = 2.0 * pi / (3.0 * g**1.5 * (one_m_nu * lam - 2.0 + 4.0 * nu))
+    return np.stack(
+        [
+            np.where(le, c11_le, c11_gt),
+            np.where(le, c22_le, c22_gt),
+            np.where(le, c23_le, c23_gt),
+            np.where(le, c33_le, np.nan),
+        ]
+    )
+
+
+def kalker_coefficients(a_over_b, poisson) -> KalkerCoefficients:
+    """Kalker's linear-theory creepage coefficients C11, C22, C23, C33 of an elliptical contact.
+
+    Parameters
+    ----------
+    a_over_b : array_like
+        Ratio of the contact semi-axes a/b [-], ``a`` along the rolling direction x, ``b``
+        lateral; in (0, inf).
+    poisson : array_like
+        Poisson's ratio nu [-], in [0, 0.5] (combined value of wheel and rail, see
+        :func:`railadhesion.contact.hertz.combined_elastic_constants`).
+
+    Returns
+    -------
+    KalkerCoefficients
+        ``(c11, c22, c23, c33)``, dimensionless; floats for scalar input, else arrays of the
+        broadcast shape of the inputs.
+
+    Notes
+    -----
+    Table values: Kalker (1990), Appendix E, Table E.3, as carried in CONTACT (``linrol``);
+    the C33 column comes from a second public copy and is of lower confidence (see the
+    header of ``data/kalker_coefficients.csv``). Between rows, ``C`` is linear in
+    ``g = min(a/b, b/a)``; across Poisson's ratio ``1/C`` is the parabola through the columns
+    ``nu = 0, 0.25, 0.5`` (as CONTACT). At the table points the table values are returned.
+
+    For ``g < 0.1`` Kalker's asymptotes (Kalker 1990, Table E.3, as in CONTACT ``linrol``)
+    are used:
+
+    * a/b = g -> 0: ``C11 = pi^2/(4(1-nu))``, ``C22 = pi^2/4``,
+      ``C23 = pi sqrt(g)/(3(1-nu)) (1 + nu(ln(16/g) - 5))``;
+    * b/a = g -> 0, ``L = ln(16/g^2)``:
+      ``C11 = 2pi/((L-2nu)g) (1 + (3-ln4)/(L-2nu))``,
+      ``C22 = (2pi/g)(1 + (1-nu)(3-ln4)/((1-nu)L+2nu))/((1-nu)L+2nu)``,
+      ``C23 = 2pi/(3 g^1.5 ((1-nu)L - 2 + 4nu))``.
+
+    CONTACT switches to the asymptotes below g = 0.101, with a jump of up to 6 % against the
+    table row g = 0.1 (largest for C23, a/b = 0.1, nu = 0.5). Here the asymptote is
+    multiplied by ``1 + (r - 1) g/0.1``, where ``r`` is the ratio table/asymptote at g = 0.1
+    for the same branch and nu: the result is continuous at g = 0.1 and tends to the
+    asymptote (relative correction O(g)) as g -> 0.
+
+    C33 has no asymptote in CONTACT. On the a/b -> 0 branch we use the strip-theory limit
+    ``C33 = pi^2/(16(1-nu) g)`` (each lateral strip rolls as a 2D contact with longitudinal
+    creepage -phi*y; the same argument gives Kalker's C11 = pi^2/(4(1-nu))), corrected as
+    above. On the b/a -> 0 branch C33 (interpolated in nu as above) is extended as the power
+    law in g through its values at b/a = 0.2 and 0.1. Both are extrapolations of this
+    library, not published values. Applied to the strongly curved C33 columns, the parabola
+    in 1/C is not monotonic in nu near nu = 0.05 and makes C33 rise slightly (about 1 %)
+    with a/b beyond a/b = 7 for 0.04 <= nu <= 0.16.
+
+    References
+    ----------
+    J. J. Kalker, *Three-dimensional elastic bodies in rolling contact*, Kluwer, 1990,
+    Appendix E, Table E.3.
+    E. A. H. Vollebregt, CONTACT, ``src/m_hertz.f90``, subroutine ``linrol`` (Apache-2.0).
+
+    Examples
+    --------
+    >>> c = kalker_coefficients(0.5, 0.25)
+    >>> round(float(c.c11), 4), round(float(c.c22), 4), round(float(c.c23), 4)
+    (3.62, 3.01, 0.929)
+    >>> [round(float(x), 3) for x in kalker_coefficients(1.6, 0.28)]
+    [4.824, 4.484, 2.188, 0.895]
+    """
+    r = check_positive(a_over_b, "a_over_b")
+    nu = check_range(poisson, "poisson", 0.0, 0.5)
+    if r.ndim == 0 and nu.ndim == 0:
+        return KalkerCoefficients(*_coefficients_scalar(float(r), float(nu)))
+    if r.shape != nu.shape:
+        r, nu = np.broadcast_arrays(r, nu)
+    le = r <= 1.0
+    g = np.where(le, r, 1.0 / r)
+    t = np.where(le, g, 2.0 - g)
+    # position in the table (rows 0.1 apart); snap round-off so table points are exact
+    s = (np.clip(t, _COORD[0], _COORD[-1]) - _COORD[0]) * 10.0
+    s_round = np.round(s)
+    s = np.where(np.abs(s - s_round) < 1e-9, s_round, s)
+    i = np.minimum(s.astype(np.intp), _NROW - 2)
+    f = (s - i)[..., None, None]
+    cg = _ROWS[i] * (1.0 - f) + _ROWS[i + 1] * f  # (*shape, 4 coefficients, 3 nu columns)
+    w0, w1, w2 = _nu_weights(nu[..., None])
+    coef = np.moveaxis(1.0 / (w0 / cg[..., 0] + w1 / cg[..., 1] + w2 / cg[..., 2]), -1, 0)
+
+    small = g < _G_MIN
+    if np.any(small):
+        gs, nus, les = g[small], nu[small], le[small]
+        asym = _asymptotes(gs, nus, les)
+        asym01 = _asymptotes(np.full_like(gs, _G_MIN), nus, les)
+        # where g < 0.1, ``coef`` holds the table value at g = 0.1 (t was clipped above)
+        corrected = asym * (1.0 + (coef[:, small] / asym01 - 1.0) * (gs / _G_MIN))
+        # C33 on the b/a -> 0 branch: nu parabola at b/a = 0.1 and 0.2, then a power law in g
+        v0, v1, v2 = _nu_weights(nus)
+        r01, r02 = _C33_GT_ROWS
+        c33_01 = 1.0 / (v0 / r01[0] + v1 / r01[1] + v2 / r01[2])
+        c33_02 = 1.0 / (v0 / r02[0] + v1 / r02[1] + v2 / r02[2])
+        c33_gt = c33_01 * (gs / _G_MIN) ** (np.log(c33_02 / c33_01) / np.log(2.0))
+        corrected[3] = np.where(les, corrected[3], c33_gt)
+        coef[:, small] = corrected
+    return KalkerCoefficients(coef[0], coef[1], coef[2], coef[3])
+
+
+def _coefficients_scalar(r: float, nu: float) -> tuple[float, float, float, float]:
+    """Same as :func:`kalker_coefficients` for one (already validated) pair, in plain floats."""
+    le = r <= 1.0
+    g = r if le else 1.0 / r
+    w0 = 8.0 * (nu - 0.25) * (nu - 0.5)
+    w1 = -16.0 * (nu - 0.5) * nu
+    w2 = 8.0 * nu * (nu - 0.25)
+    t = g if le else 2.0 - g
+    s = (min(max(t, 0.1), 1.9) - 0.1) * 10.0
+    if abs(s - round(s)) < 1e-9:
+        s = float(round(s))
+    i = min(int(s), _NROW - 2)
+    f = s - i
+    lo, hi = _ROWS_LIST[i], _ROWS_LIST[i + 1]
+    coef = []
+    for k in range(4):
+        c0 = lo[k][0] * (1.0 - f) + hi[k][0] * f
+        c1 = lo[k][1] * (1.0 - f) + hi[k][1] * f
+        c2 = lo[k][2] * (1.0 - f) + hi[k][2] * f
+        coef.append(1.0 / (w0 / c0 + w1 / c1 + w2 / c2))
+    if g >= _G_MIN:
+        return tuple(coef)
+    asym = _asymptotes_scalar(g, nu, le)
+    asym01 = _asymptotes_scalar(_G_MIN, nu, le)
+    h = g / _G_MIN
+    out = [a * (1.0 + (c / a01 - 1.0) * h) for a, a01, c in zip(asym, asym01, coef, strict=True)]
+    if not le:
+        r01, r02 = _C33_GT_ROWS_LIST
+        c33_01 = 1.0 / (w0 / r01[0] + w1 / r01[1] + w2 / r01[2])
+        c33_02 = 1.0 / (w0 / r02[0] + w1 / r02[1] + w2 / r02[2])
+        out[3] = c33_01 * (g / _G_MIN) ** (math.log(c33_02 / c33_01) / math.log(2.0))
+    return tuple(out)
+
+
+def _asymptotes_scalar(g: float, nu: float, le: bool) -> tuple[float, float, float, float]:
+    """Scalar version of :func:`_asymptotes` for one branch (C33 NaN on the b/a branch)."""
+    pi = math.pi
+    if le:
+        return (
+            pi**2 / (4.0 * (1.0 - nu)),
+            pi**2 / 4.0,
+            pi * math.sqrt(g) / (3.0 * (1.0 - nu)) * (1.0 + nu * (math.log(16.0 / g) - 5.0)),
+            pi**2 / (16.0 * (1.0 - nu) * g),
+        )
+    lam = math.log(16.0 / g**2)
+    k = 3.0 - math.log(4.0)
+    den = (1.0 - nu) * lam + 2.0 * nu
+    return (
+        2.0 * pi / ((lam - 2.0 * nu) * g) * (1.0 + k / (lam - 2.0 * nu)),
+        (2.0 * pi / g) * (1.0 + (1.0 - nu) * k / den) / den,
+        2.0 * pi / (3.0 * g**1.5 * ((1.0 - nu) * lam - 2.0 + 4.0 * nu)),
+        math.nan,
+    )
+
+
+def linear_creep_forces(creep_long, creep_lat, spin, a, b, shear_modulus, poisson):
+    """Creep forces and spin moment of Kalker's linear theory (small creepages, full stick).
+
+    Parameters
+    ----------
+    creep_long : array_like
+        Longitudinal creepage xi = (V - omega R)/V [-] (braking positive).
+    creep_lat : array_like
+        Lateral creepage eta [-].
+    spin : array_like
+        Spin creepage phi [rad/m].
+    a : array_like
+        Contact semi-axis in the rolling direction [m], > 0.
+    b : array_like
+        Lateral contact semi-axis [m], > 0.
+    shear_modulus : array_like
+        Combined shear modulus G [Pa], > 0.
+    poisson : array_like
+        Combined Poisson's ratio nu [-], in [0, 0.5].
+
+    Returns
+    -------
+    fx, fy : ndarray or float
+        Longitudinal and lateral forces exerted by the rail on the wheel [N].
+    mz : ndarray or float
+        Spin moment about the contact normal [N m].
+
+    Notes
+    -----
+    With ``c = sqrt(ab)`` and Kalker's signs (the forces oppose the creepages; Kalker 1990,
+    Appendix E; MODELS.md section 2):
+
+    ``Fx = -G c^2 C11 xi``,
+    ``Fy = -G c^2 C22 eta - G c^3 C23 phi``,
+    ``Mz = G c^3 C23 eta - G c^4 C33 phi``.
+
+    The coefficients come from :func:`kalker_coefficients`. The relations hold only while the
+    whole contact sticks; beyond that use FASTSIM or a saturating model (Polach).
+
+    References
+    ----------
+    J. J. Kalker, *Three-dimensional elastic bodies in rolling contact*, Kluwer, 1990,
+    Appendix E.
+
+    Examples
+    --------
+    Braking (xi > 0) on an 8 mm x 4 mm contact, G = 82 GPa: the force on the wheel points
+    backwards.
+
+    >>> fx, fy, mz = linear_creep_forces(1e-4, 0.0, 0.0, 8e-3, 4e-3, 8.2e10, 0.28)
+    >>> round(float(fx), 1)
+    -1365.5
+
+    Positive spin alone pushes the wheel to negative y:
+
+    >>> fx, fy, mz = linear_creep_forces(0.0, 0.0, 0.01, 8e-3, 4e-3, 8.2e10, 0.28)
+    >>> round(float(fy), 1), round(float(mz), 3)
+    (-394.3, -0.671)
+    """
+    xi = check_finite(creep_long, "creep_long")
+    eta = check_finite(creep_lat, "creep_lat")
+    phi = check_finite(spin, "spin")
+    a_ = check_positive(a, "a")
+    b_ = check_positive(b, "b")
+    g_mod = check_positive(shear_modulus, "shear_modulus")
+    coef = kalker_coefficients(a_ / b_, poisson)
+    c = np.sqrt(a_ * b_)
+    gc2 = g_mod * c * c
+    gc3 = gc2 * c
+    fx = -gc2 * coef.c11 * xi
+    fy = -gc2 * coef.c22 * eta - gc3 * coef.c23 * phi
+    mz = gc3 * coef.c23 * eta - gc3 * c * coef.c33 * phi
+    if np.ndim(fx) == 0 and np.ndim(fy) == 0 and np.ndim(mz) == 0:
+        return float(fx), float(fy), float(mz)
+    fx, fy, mz = np.broadcast_arrays(fx, fy, mz)
+    return fx.copy(), fy.copy(), mz.copy()

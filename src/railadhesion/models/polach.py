@@ -1,0 +1,384 @@
+"""Polach's creep-force model (Polach 1999, 2005), in Kalker's sign convention.
+
+Polach's method gives the tangential wheel-rail forces in closed form from the creepages, the
+Hertzian contact ellipse and a friction coefficient. The 2005 extension adds a friction
+coefficient falling with slip velocity and two factors reducing the creep stiffness in the
+areas of adhesion (``k_A``) and slip (``k_S``); with ``k_A = k_S = 1`` and ``A = 1`` (or
+``B = 0``) it is the original 1999 model.
+
+Sign convention (``docs/CONVENTIONS.md``): the forces returned are exerted by the rail on the
+wheel and oppose the creepages, as in Kalker's linear theory and CONTACT. Polach's papers
+count forces positive along the creepages, so both of his components (spin term included) are
+negated here.
+
+References
+----------
+O. Polach, A fast wheel-rail forces calculation computer code, Vehicle System Dynamics 33
+(Suppl.), 1999, 728-739.
+O. Polach, Creep forces in simulations of traction vehicles running on adhesion limit, Wear 258,
+2005, 992-1000.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from railadhesion._validate import (
+    check_finite,
+    check_nonnegative,
+    check_positive,
+    check_range,
+)
+from railadhesion.contact.kalker import kalker_coefficients
+from railadhesion.models.parameters import PolachParameters, polach_parameters
+
+__all__ = ["Polach", "polach_forces"]
+
+_TWO_OVER_PI = 2.0 / math.pi
+_PI_OVER_4 = math.pi / 4.0
+# Gradients above this are clipped: the force terms they feed are then below 1e-50 of mu*Q
+# (k eps / (1 + (k eps)^2) ~ 1/(k eps), (1 + eps_psi^2)^-2 ~ eps_psi^-4), and squaring them
+# cannot overflow.
+_EPS_MAX = 1e50
+_SCALAR_TYPES = (float, int, np.float64)
+
+
+@lru_cache(maxsize=4096)
+def _kalker_scalar(a_over_b: float, poisson: float) -> tuple[float, float, float]:
+    """C11, C22, C23 for scalar inputs, memoised (repeated geometries cost ~0.1 us)."""
+    c = kalker_coefficients(a_over_b, poisson)
+    return float(c.c11), float(c.c22), float(c.c23)
+
+
+def polach_forces(
+    creep_long,
+    creep_lat,
+    spin,
+    normal_force,
+    speed,
+    a,
+    b,
+    *,
+    mu0,
+    k_A=1.0,
+    k_S=1.0,
+    A=1.0,
+    B=0.0,
+    shear_modulus=8.2e10,
+    poisson=0.28,
+):
+    """Tangential creep forces of Polach's model (1999, extended 2005), Kalker's signs.
+
+    Parameters
+    ----------
+    creep_long : array_like
+        Longitudinal creepage xi = (V - omega R)/V [-]; braking > 0, traction < 0. Finite.
+    creep_lat : array_like
+        Lateral creepage eta [-]. Finite.
+    spin : array_like
+        Spin creepage phi [rad/m]. Finite.
+    normal_force : array_like
+        Normal force Q [N], > 0.
+    speed : array_like
+        Rolling speed V [m/s], >= 0. Enters only through the slip velocity w = s_C V of the
+        falling friction law.
+    a : array_like
+        Contact semi-axis **in the rolling direction** x [m], > 0 (whether or not it is the
+        longer one).
+    b : array_like
+        Lateral contact semi-axis [m], > 0.
+    mu0 : array_like
+        Maximum friction coefficient mu0 [-], > 0.
+    k_A : array_like, optional
+        Stiffness reduction factor in the area of adhesion [-], > 0 (Polach: <= 1).
+    k_S : array_like, optional
+        Stiffness reduction factor in the area of slip [-], > 0 (Polach: k_S <= k_A).
+    A : array_like, optional
+        mu_inf/mu0 [-], >= 0. ``A = 1`` gives constant friction.
+    B : array_like, optional
+        Exponential friction decrease rate [s/m], >= 0. ``B = 0`` gives constant friction.
+    shear_modulus : array_like, optional
+        Combined shear modulus G [Pa], > 0.
+    poisson : array_like, optional
+        Combined Poisson's ratio nu [-], in [0, 0.5].
+
+    All arguments broadcast against each other, the five model parameters included (so a
+    model such as WILAC can pass one parameter set per contact).
+
+    Returns
+    -------
+    fx, fy : numpy.float64 or ndarray
+        Longitudinal and lateral forces exerted by the rail on the wheel [N] (they oppose the
+        creepages: ``fx < 0`` in braking). Scalars for scalar input, else arrays of the
+        broadcast shape. Zero creepage gives exactly zero force.
+
+    Raises
+    ------
+    ValueError
+        If an argument is not finite or outside its range; the message names it.
+
+    Notes
+    -----
+    With s_x = xi, s_y = eta, psi = phi, s = sqrt(s_x^2 + s_y^2) (Polach 1999, 2005; the
+    numbering below is that of Polach 2005, section 2, which restates the 1999 model):
+
+    * spin-corrected lateral creepage: s_yC = s_y + psi a if abs(s_y + psi a) > abs(s_y), else
+      s_y; s_C = sqrt(s_x^2 + s_yC^2);
+    * friction falling with the slip velocity w = s_C V:
+      mu = mu0 [(1 - A) exp(-B w) + A];
+    * Kalker's coefficient in the creep direction c_jj = sqrt((C11 s_x/s)^2 + (C22 s_y/s)^2),
+      contact stiffness C = (3/8)(G/a) c_jj and gradient of the tangential stress
+      eps = (2/3) C pi a^2 b s_C / (Q mu) = pi G a b c_jj s_C / (4 Q mu);
+    * force (2005 extension):
+      F = (2 Q mu / pi) [k_A eps / (1 + (k_A eps)^2) + arctan(k_S eps)]
+      (the 1999 model is k_A = k_S = 1; some public codes write ``1 + k_A eps^2``, wrongly);
+    * spin: K_psi = 1 + 6.3 (1 - exp(-a/b)),
+      eps_psi = (8/3) G b sqrt(ab) C23 abs(s_yC) / (K_psi Q mu),
+      delta = (eps_psi^2 - 1)/(eps_psi^2 + 1),
+      K_M = abs(eps_psi) (delta^3/3 - delta^2/2 + 1/6) - (1/3) sqrt((1 - delta^2)^3),
+      F_yS = -(9/16) a Q mu K_M K_psi psi / s_C;
+    * in Polach's signs F_x = F s_x/s_C, F_y = F s_y/s_C + F_yS; returned here:
+      ``fx = -F s_x/s_C``, ``fy = -(F s_y/s_C + F_yS)``.
+
+    C11, C22, C23 come from :func:`railadhesion.contact.kalker.kalker_coefficients` at a/b.
+
+    Implementation detail [derived here]: substituting delta, Polach's K_M simplifies
+    exactly to K_M = -(2/3) eps_psi / (1 + eps_psi^2)^2, hence
+    F_yS = G c^3 C23 psi (abs(s_yC) / s_C) / (1 + eps_psi^2)^2 with c = sqrt(ab). This form is
+    evaluated (no cancellation at large eps_psi, no 0/0). At small pure spin it is exactly
+    Kalker's linear term, so ``fy -> -G c^3 C23 phi``; likewise ``fx -> -G c^2 C11 xi`` at small
+    xi when k_A = k_S = 1. In general the initial slope is (k_A + k_S)/2 times Kalker's.
+
+    **Which semi-axis is a.** In Polach's papers a is the half-axis of the contact ellipse in
+    the longitudinal (rolling) direction and b the lateral one (variable list of the FORTRAN
+    code of Polach 1999: "semiaxis a of the contact ellipse (in longitudinal direction)");
+    this is also our convention (``docs/CONVENTIONS.md``), so ``a`` is passed through as is.
+    Some later papers (e.g. Trummer et al., WILAC) call a the "semi-major" axis; that is only
+    true when the contact is longer in the rolling direction (a/b > 1), which is often not
+    the case on wheel treads (CONTACT's Eurosprinter case has a/b = 0.5). The choice
+    matters: eps is symmetric in a and b, but s_yC, K_psi, eps_psi, F_yS and the Kalker
+    coefficients are not.
+
+    Bounds: with k_S <= k_A the bracket of F is at most pi/2, so |F| <= mu Q <=
+    mu0 Q max(1, A); with k_S > k_A it can exceed mu Q. The total force stays within
+    mu0 Q max(1, A) when the spin does not oppose the lateral creepage (checked by property
+    tests). When it does, on long contacts (a/b > 1), the spin term F_yS, which k_A and k_S
+    do not reduce, can push |(fx, fy)| above mu Q (up to about 1.6 mu Q with k_A = 0.3,
+    k_S = 0.1 at a/b = 5). A tangential force above the friction limit is not physical, so
+    **this implementation caps |(fx, fy)| at mu Q** (mu at the current slip velocity), scaling
+    both components; elsewhere the cap is inactive and the published model is unchanged.
+
+    References
+    ----------
+    O. Polach, A fast wheel-rail forces calculation computer code, Vehicle System Dynamics 33
+    (Suppl.), 1999, 728-739.
+    O. Polach, Creep forces in simulations of traction vehicles running on adhesion limit,
+    Wear 258, 2005, 992-1000.
+
+    Examples
+    --------
+    CONTACT's Eurosprinter case (a = 6.304 mm, b = 12.61 mm, Q = 106.7 kN, V = 10 m/s,
+    G = 82 GPa, nu = 0.28), Coulomb friction 0.33, braking creepage 2 per mille:
+
+    >>> fx, fy = polach_forces(2e-3, 0.0, 0.0, 106.7e3, 10.0, 6.304e-3, 12.61e-3, mu0=0.33)
+    >>> round(float(fx / (0.33 * 106.7e3)), 4), float(fy)
+    (-0.8434, -0.0)
+
+    Arrays and parameter arrays broadcast; the dry and wet sets of Polach (2005) at 5 %
+    traction creepage:
+
+    >>> import numpy as np
+    >>> fx, fy = polach_forces(-0.05, 0.0, 0.0, 106.7e3, 10.0, 6.304e-3, 12.61e-3,
+    ...                        mu0=np.array([0.55, 0.3]), k_A=np.array([1.0, 0.3]),
+    ...                        k_S=np.array([0.4, 0.1]), A=0.4, B=np.array([0.6, 0.2]))
+    >>> np.round(fx / 106.7e3, 4)
+    array([0.4416, 0.2465])
+    """
+    args = (
+        creep_long, creep_lat, spin, normal_force, speed, a, b,
+        mu0, k_A, k_S, A, B, shear_modulus, poisson,
+    )  # fmt: skip
+    scalars = []
+    for v in args:  # fast path for scalars (Python, NumPy or 0-d arrays): no array work
+        if type(v) in _SCALAR_TYPES:
+            scalars.append(v)
+        elif isinstance(v, np.generic | np.ndarray) and v.ndim == 0 and v.dtype.kind in "fiu":
+            scalars.append(float(v))
+        else:
+            return _polach_array(*args)
+    return _polach_scalar(*scalars)
+
+
+def _bad(name: str, rng: str, value) -> ValueError:
+    return ValueError(f"{name} must be in {rng}, got {float(value)!r}")
+
+
+def _polach_scalar(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu):
+    """Scalar path of :func:`polach_forces` with the ``math`` module (a few microseconds)."""
+    isf = math.isfinite
+    for name, val in (("creep_long", sx), ("creep_lat", sy), ("spin", psi)):
+        if not isf(val):
+            raise ValueError(f"{name} must be finite (no NaN or inf), got {float(val)!r}")
+    for name, val in (
+        ("normal_force", q), ("a", a), ("b", b), ("mu0", mu0), ("k_A", k_a), ("k_S", k_s),
+        ("shear_modulus", g),
+    ):  # fmt: skip
+        if not (val > 0 and isf(val)):
+            raise _bad(name, "(0, inf)", val)
+    for name, val in (("speed", v), ("A", big_a), ("B", big_b)):
+        if not (val >= 0 and isf(val)):
+            raise _bad(name, "[0, inf)", val)
+    if not 0.0 <= nu <= 0.5:
+        raise _bad("poisson", "[0.0, 0.5]", nu)
+
+    c11, c22, c23 = _kalker_scalar(a / b, float(nu))
+    syc = sy + psi * a
+    if not abs(syc) > abs(sy):
+        syc = sy
+    sc = math.hypot(sx, syc)
+    if sc == 0.0:  # then psi == 0 too: no creepage, no force
+        return np.float64(0.0), np.float64(0.0)
+    s = math.hypot(sx, sy)
+    cjj = math.hypot(c11 * sx, c22 * sy) / s if s > 0.0 else c22
+    mu = mu0 * ((1.0 - big_a) * math.exp(-big_b * sc * v) + big_a)
+    qmu = q * mu
+    if qmu == 0.0:  # A = 0 and exp(-B w) underflowed: no friction left, no force
+        return np.float64(0.0), np.float64(0.0)
+    eps = min(_PI_OVER_4 * g * a * b * cjj * sc / qmu, _EPS_MAX)
+    x = k_a * eps
+    f_over_sc = _TWO_OVER_PI * qmu * (x / (1.0 + x * x) + math.atan(k_s * eps)) / sc
+    k_psi = 1.0 + 6.3 * (1.0 - math.exp(-a / b))
+    gc3c23 = g * a * b * math.sqrt(a * b) * c23
+    eps_psi = min(8.0 / 3.0 * gc3c23 / a * abs(syc) / (k_psi * qmu), _EPS_MAX)
+    e2 = 1.0 + eps_psi * eps_psi
+    fys = gc3c23 * psi * abs(syc) / sc / (e2 * e2)
+    fx, fy = -f_over_sc * sx, -(f_over_sc * sy + fys)
+    total = math.hypot(fx, fy)
+    if total > qmu:  # Coulomb cap (see Notes): only opposing spin on long contacts gets here
+        fx, fy = fx * (qmu / total), fy * (qmu / total)
+    return np.float64(fx), np.float64(fy)
+
+
+def _polach_array(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu):
+    """Array path of :func:`polach_forces` (validated, broadcast, no Python loops)."""
+    sx = check_finite(sx, "creep_long")
+    sy = check_finite(sy, "creep_lat")
+    psi = check_finite(psi, "spin")
+    q = check_positive(q, "normal_force")
+    v = check_nonnegative(v, "speed")
+    a = check_positive(a, "a")
+    b = check_positive(b, "b")
+    mu0 = check_positive(mu0, "mu0")
+    k_a = check_positive(k_a, "k_A")
+    k_s = check_positive(k_s, "k_S")
+    big_a = check_nonnegative(big_a, "A")
+    big_b = check_nonnegative(big_b, "B")
+    g = check_positive(g, "shear_modulus")
+    nu = check_range(nu, "poisson", 0.0, 0.5)
+
+    coef = kalker_coefficients(a / b, nu)
+    c11, c22, c23 = coef.c11, coef.c22, coef.c23
+
+    syc = sy + psi * a
+    syc = np.where(np.abs(syc) > np.abs(sy), syc, sy)
+    sc = np.hypot(sx, syc)
+    moving = sc > 0.0
+    sc_safe = np.where(moving, sc, 1.0)
+    s = np.hypot(sx, sy)
+    has_s = s > 0.0
+    cjj = np.where(has_s, np.hypot(c11 * sx, c22 * sy) / np.where(has_s, s, 1.0), c22)
+
+    mu = mu0 * ((1.0 - big_a) * np.exp(-big_b * (sc * v)) + big_a)
+    qmu = q * mu
+    # qmu == 0 only if A = 0 and exp(-B w) underflowed: no friction left, no force
+    active = moving & (qmu > 0.0)
+    qmu = np.where(qmu > 0.0, qmu, 1.0)
+    k_psi = 1.0 + 6.3 * (1.0 - np.exp(-a / b))
+    gc3c23 = g * a * b * np.sqrt(a * b) * c23
+    abs_syc = np.abs(syc)
+    with np.errstate(over="ignore"):  # huge gradients become inf, then are clipped
+        eps = np.minimum(_PI_OVER_4 * g * a * b * cjj * sc / qmu, _EPS_MAX)
+        eps_psi = np.minimum((8.0 / 3.0) * gc3c23 / a * abs_syc / (k_psi * qmu), _EPS_MAX)
+    x = k_a * eps
+    f_over_sc = _TWO_OVER_PI * qmu * (x / (1.0 + x * x) + np.arctan(k_s * eps)) / sc_safe
+    e2 = 1.0 + eps_psi * eps_psi
+    fys = gc3c23 * psi * (abs_syc / sc_safe) / (e2 * e2)
+
+    fx = np.where(active, -f_over_sc * sx, 0.0)
+    fy = np.where(active, -(f_over_sc * sy + fys), 0.0)
+    total = np.hypot(fx, fy)
+    scale = np.where(total > qmu, qmu / np.where(total > 0.0, total, 1.0), 1.0)  # Coulomb cap
+    fx, fy = fx * scale, fy * scale
+    if fx.ndim == 0:
+        return np.float64(fx), np.float64(fy)
+    # the five parameters may not reach fx (e.g. spin-only shapes): broadcast both fully
+    shape = np.broadcast_shapes(fx.shape, fy.shape)
+    if fx.shape != shape:
+        fx = np.broadcast_to(fx, shape).copy()
+    if fy.shape != shape:
+        fy = np.broadcast_to(fy, shape).copy()
+    return fx, fy
+
+
+@dataclass(frozen=True)
+class Polach:
+    """Polach's creep-force model with one parameter set (object layer, no physics of its own).
+
+    Parameters
+    ----------
+    params : PolachParameters or str
+        Parameter set, or the name of a built-in set
+        (:data:`railadhesion.models.parameters.POLACH_PARAMETER_SETS`).
+    shear_modulus : float, optional
+        Combined shear modulus G [Pa], > 0.
+    poisson : float, optional
+        Combined Poisson's ratio nu [-], in [0, 0.5].
+
+    Examples
+    --------
+    >>> model = Polach("polach2005_wet")
+    >>> fx, fy = model.forces(-0.02, 0.0, 0.0, 106.7e3, 10.0, 6.304e-3, 12.61e-3)
+    >>> round(float(fx), 1)
+    22666.4
+    >>> round(float(model.adhesion(-0.02, 0.0, 0.0, 106.7e3, 10.0, 6.304e-3, 12.61e-3)), 4)
+    0.2124
+    """
+
+    params: PolachParameters
+    shear_modulus: float = 8.2e10
+    poisson: float = 0.28
+
+    def __post_init__(self) -> None:
+        params = self.params
+        if isinstance(params, str):
+            params = polach_parameters(params)
+        if not isinstance(params, PolachParameters):
+            raise ValueError(
+                f"params must be a PolachParameters or the name of a built-in set, "
+                f"got {type(params).__name__}"
+            )
+        object.__setattr__(self, "params", params)
+        g = float(check_positive(self.shear_modulus, "shear_modulus"))
+        nu = float(check_range(self.poisson, "poisson", 0.0, 0.5))
+        object.__setattr__(self, "shear_modulus", g)
+        object.__setattr__(self, "poisson", nu)
+
+    def forces(self, creep_long, creep_lat, spin, normal_force, speed, a, b):
+        """Forces (fx, fy) [N] exerted by the rail on the wheel; see :func:`polach_forces`."""
+        p = self.params
+        return polach_forces(
+            creep_long, creep_lat, spin, normal_force, speed, a, b,
+            mu0=p.mu0, k_A=p.k_A, k_S=p.k_S, A=p.A, B=p.B,
+            shear_modulus=self.shear_modulus, poisson=self.poisson,
+        )  # fmt: skip
+
+    def adhesion(self, creep_long, creep_lat, spin, normal_force, speed, a, b):
+        """Adhesion coefficient sqrt(fx^2 + fy^2)/Q [-] (:func:`railadhesion.adhesion`)."""
+        from railadhesion import adhesion
+
+        fx, fy = self.forces(creep_long, creep_lat, spin, normal_force, speed, a, b)
+        return adhesion(fx, fy, normal_force)
