@@ -4,7 +4,9 @@ The WILAC model computes each Polach parameter (k_A, k_S, mu0, A, B) of each con
 multiple linear regression on the normalised normal force ``Q' = Q / Q_ref`` and rolling speed
 ``v' = v / v_ref`` (Trummer et al., section 5.2, the equation for k_A there)::
 
-    p = a_0 + a_1 Q' + a_2 v' + a_3 / Q' + a_4 / v' + a_5 exp(Q') + a_6 exp(v') + ... (products up to order 3)
+    p = a_0 + a_1 Q' + a_2 v' + a_3 / Q' + a_4 / v' + a_5 exp(Q') + a_6 exp(v') + ...
+
+(products of the basis factors up to order 3 included).
 
 This module holds the term grammar shared by the model (evaluation) and the calibration
 (forward-selection builder in :mod:`railadhesion.calibration.regression`).
@@ -105,7 +107,9 @@ def design_matrix(terms: Sequence[str], q_norm, v_norm) -> np.ndarray:
     """Matrix with one column per term, rows over the (flattened, broadcast) samples."""
     q, v = np.broadcast_arrays(np.asarray(q_norm, float), np.asarray(v_norm, float))
     q, v = q.ravel(), v.ravel()
-    return np.column_stack([evaluate_term(t, q, v) for t in terms]) if terms else np.empty((q.size, 0))
+    if not terms:
+        return np.empty((q.size, 0))
+    return np.column_stack([evaluate_term(t, q, v) for t in terms])
 
 
 @dataclass(frozen=True)
@@ -140,7 +144,7 @@ class ParameterRegression:
             raise ValueError(f"coefficients must be finite, got {list(coefs)}")
         object.__setattr__(self, "terms", terms)
         object.__setattr__(self, "coefficients", coefs)
-        object.__setattr__(self, "_compiled", tuple((_split(t), c) for t, c in zip(terms, coefs)))
+        object.__setattr__(self, "_compiled", tuple((_split(t), c) for t, c in zip(terms, coefs, strict=True)))
 
     @classmethod
     def constant(cls, value: float) -> ParameterRegression:
