@@ -144,7 +144,8 @@ class ParameterRegression:
             raise ValueError(f"coefficients must be finite, got {list(coefs)}")
         object.__setattr__(self, "terms", terms)
         object.__setattr__(self, "coefficients", coefs)
-        object.__setattr__(self, "_compiled", tuple((_split(t), c) for t, c in zip(terms, coefs, strict=True)))
+        compiled = tuple((_split(t), c) for t, c in zip(terms, coefs, strict=True))
+        object.__setattr__(self, "_compiled", compiled)
 
     @classmethod
     def constant(cls, value: float) -> ParameterRegression:
