@@ -31,3 +31,50 @@ def adhesion(fx, fy, normal_force):
 
     q = check_positive(normal_force, "normal_force")
     return np.hypot(fx, fy) / q
+
+
+# The public API at the top level (imported after ``adhesion``, which the models use).
+from railadhesion.contact import (  # noqa: E402
+    fastsim,
+    hertz_3d,
+    kalker_coefficients,
+    line_contact,
+    linear_creep_forces,
+)
+from railadhesion.models import (  # noqa: E402
+    Polach,
+    PolachParameters,
+    Wilac,
+    WilacParameters,
+    carter,
+    default_wilac_parameters,
+    elastic_foundation,
+    fletcher,
+    fletcher_condition,
+    polach_forces,
+    polach_parameters,
+    wilac_forces,
+    wilac_weights,
+)
+
+__all__ = [
+    "Polach",
+    "PolachParameters",
+    "Wilac",
+    "WilacParameters",
+    "adhesion",
+    "carter",
+    "default_wilac_parameters",
+    "elastic_foundation",
+    "fastsim",
+    "fletcher",
+    "fletcher_condition",
+    "hertz_3d",
+    "kalker_coefficients",
+    "line_contact",
+    "linear_creep_forces",
+    "polach_forces",
+    "polach_parameters",
+    "wilac_forces",
+    "wilac_weights",
+]

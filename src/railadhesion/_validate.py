@@ -57,7 +57,7 @@ def check_nonnegative(value, name: str) -> np.ndarray:
 
 
 def check_range(value, name: str, low: float, high: float, *, closed: str = "both") -> np.ndarray:
-    """Array of ``value`` within ``[low, high]``; ``closed`` is 'both', 'left', 'right' or 'neither'."""
+    """Array of ``value`` within [low, high]; ``closed``: 'both', 'left', 'right', 'neither'."""
     arr = as_float_array(value, name)
     lo_ok = arr >= low if closed in ("both", "left") else arr > low
     hi_ok = arr <= high if closed in ("both", "right") else arr < high

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 app = typer.Typer(
@@ -106,7 +107,7 @@ def hertz(
         ("curvature A [1/m]", h.curvature_A),
         ("curvature B [1/m]", h.curvature_B),
     ]:
-        table.add_row(label, f"{float(value):.4g}")
+        table.add_row(escape(label), f"{float(value):.4g}")
     console.print(table)
 
 
@@ -134,10 +135,11 @@ def polach(
     except ValueError as exc:
         _fail(exc)
     mu = adhesion(fx, fy, normal_force)
-    table = Table(title=f"Polach '{params.name}' at Q = {normal_force:g} N, V = {speed:g} m/s")
-    table.add_column("creep [%]", justify="right")
-    table.add_column("Fx [kN]", justify="right")
-    table.add_column("adhesion |T|/Q", justify="right")
+    title = f"Polach '{params.name}' at Q = {normal_force:g} N, V = {speed:g} m/s"
+    table = Table(title=escape(title))
+    table.add_column(escape("creep [%]"), justify="right")
+    table.add_column(escape("Fx [kN]"), justify="right")
+    table.add_column(escape("adhesion |T|/Q"), justify="right")
     for c, f, m in zip(creep, np.atleast_1d(fx), np.atleast_1d(mu), strict=True):
         table.add_row(f"{c * 100:g}", f"{f / 1e3:.2f}", f"{m:.4f}")
     console.print(table)
@@ -251,9 +253,9 @@ def wilac_table(
     except ValueError as exc:
         _fail(exc)
     table = Table(title=f"WILAC adhesion at Q = {normal_force:g} N, v = {speed:g} m/s")
-    table.add_column("w [µl/s]", justify="right")
+    table.add_column(escape("w [µl/s]"), justify="right")
     for c in creep:
-        table.add_column(f"{c * 100:g} %", justify="right")
+        table.add_column(escape(f"{c * 100:g} %"), justify="right")
     for wi, row in zip(w, mu, strict=True):
         table.add_row(f"{wi:g}", *[f"{x:.3f}" for x in row])
     console.print(table)
@@ -261,10 +263,9 @@ def wilac_table(
 
 def _tram_contact(normal_force: float):
     """Hertz semi-axes of the Pardubice tram rig (seed 000 §4): 0.696 m wheel on 0.905 m roller."""
-    from railadhesion.contact.hertz import hertz_3d
+    from railadhesion.plotting import contact_semi_axes
 
-    h = hertz_3d(normal_force, 0.348, np.inf, 0.660, 0.4525)
-    return h.a, h.b
+    return contact_semi_axes("tram", normal_force)
 
 
 def _load_wilac(path: Path | None):
@@ -282,7 +283,7 @@ def params_list() -> None:
 
     table = Table(title="Polach parameter sets")
     for col in ("name", "k_A", "k_S", "mu0", "A", "B [s/m]", "source"):
-        table.add_column(col)
+        table.add_column(escape(col))
     for name, p in POLACH_PARAMETER_SETS.items():
         table.add_row(
             name, f"{p.k_A:g}", f"{p.k_S:g}", f"{p.mu0:g}", f"{p.A:g}", f"{p.B:g}", p.source

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 # CONTACT's tractcurv example, first series (Eurosprinter, exact Coulomb friction mu = 0.33):
@@ -18,20 +19,25 @@ _CONTACT_XI = np.arange(1, 9) * 0.4e-3
 _CONTACT_FX = np.array([-0.2588, -0.4742, -0.6482, -0.7831, -0.8816, -0.9467, -0.9832, -0.9976])
 
 
-def _table(title: str, columns: list[str]) -> Table:
-    table = Table(title=title, title_justify="left")
-    for col in columns:
-        table.add_column(col, justify="right")
-    return table
+class _Report:
+    """Prints titled tables; every cell is plain text (units in [..] are not rich markup)."""
+
+    def __init__(self, console: Console):
+        self.console = console
+
+    def table(self, title: str, columns: list[str], rows) -> None:
+        table = Table(show_edge=True)
+        for col in columns:
+            table.add_column(escape(col), justify="right")
+        for row in rows:
+            table.add_row(*[escape(str(cell)) for cell in row])
+        self.console.print()
+        self.console.print(escape(title), style="bold", highlight=False)
+        self.console.print(table)
 
 
 def run_demo(out_dir: Path | str = "demo-output", console: Console | None = None) -> list[Path]:
     """Print the demo tables and write the demo figures; return the figure paths."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     from railadhesion import adhesion
     from railadhesion.contact.fastsim import fastsim
     from railadhesion.contact.hertz import hertz_3d
@@ -39,87 +45,106 @@ def run_demo(out_dir: Path | str = "demo-output", console: Console | None = None
     from railadhesion.models.parameters import polach_parameters
     from railadhesion.models.polach import polach_forces
     from railadhesion.models.twod import fletcher_condition
-    from railadhesion.plotting import plot_wilac_curves, plot_wilac_water
+    from railadhesion.models.wilac import Wilac
+    from railadhesion.plotting import (
+        contact_semi_axes,
+        plot_wilac_curves,
+        plot_wilac_speeds,
+        plot_wilac_water,
+    )
 
-    console = console or Console()
+    report = _Report(console or Console())
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    written: list[Path] = []
 
     # 1. Hertz: a locomotive wheel (radius 0.625 m) on a rail head (lateral radius 0.3 m).
     q = 110e3
     h = hertz_3d(q, 0.625, np.inf, 0.3)
-    t = _table("1. Hertz: 110 kN, wheel R = 0.625 m on a rail head of lateral radius 0.3 m",
-               ["a [mm]", "b [mm]", "a/b", "p0 [MPa]", "approach [µm]"])
-    t.add_row(*[f"{v:.4g}" for v in (h.a * 1e3, h.b * 1e3, h.a_over_b, h.max_pressure / 1e6,
-                                      h.approach * 1e6)])
-    console.print(t)
+    report.table(
+        "1. Hertz: Q = 110 kN, wheel R = 0.625 m on a rail head of lateral radius 0.3 m",
+        ["a [mm]", "b [mm]", "a/b", "p0 [MPa]", "approach [µm]"],
+        [[f"{v:.4g}" for v in (h.a * 1e3, h.b * 1e3, h.a_over_b, h.max_pressure / 1e6,
+                               h.approach * 1e6)]],
+    )
 
     # 2. Kalker's coefficients for that contact.
     k = kalker_coefficients(h.a_over_b, 0.28)
-    t = _table(f"2. Kalker's creepage coefficients at a/b = {h.a_over_b:.3f}, nu = 0.28",
-               ["C11", "C22", "C23", "C33"])
-    t.add_row(*[f"{float(v):.4f}" for v in k])
-    console.print(t)
+    report.table(
+        f"2. Kalker's creepage coefficients at a/b = {h.a_over_b:.3f}, nu = 0.28",
+        ["C11", "C22", "C23", "C33"],
+        [[f"{float(v):.4f}" for v in k]],
+    )
 
     # 3. Polach (k_A = k_S = 1, mu = 0.33) against CONTACT's exact Coulomb creep curve.
     a_e, b_e = 6.304e-3, 12.61e-3  # semi-axes printed in tractcurv.ref_out (a/b = 0.5)
     fx, _ = polach_forces(_CONTACT_XI, 0.0, 0.0, 106.7e3, 10.0, a_e, b_e, mu0=0.33)
     ours = fx / (0.33 * 106.7e3)
-    t = _table("3. Polach vs CONTACT (Eurosprinter, exact Coulomb; tractcurv.ref_out)",
-               ["xi [‰]", "CONTACT Fx/(muFn)", "Polach", "deviation [%]"])
-    for xi, ref, val in zip(_CONTACT_XI, _CONTACT_FX, ours, strict=True):
-        t.add_row(f"{xi * 1e3:.1f}", f"{ref:.4f}", f"{val:.4f}", f"{100 * (val - ref) / ref:+.1f}")
-    console.print(t)
+    report.table(
+        "3. Polach vs CONTACT's exact theory (Eurosprinter, Coulomb mu = 0.33; tractcurv.ref_out)",
+        ["xi [‰]", "CONTACT Fx/(mu Fn)", "Polach", "deviation [%]"],
+        [[f"{xi * 1e3:.1f}", f"{ref:.4f}", f"{val:.4f}", f"{100 * (val - ref) / ref:+.1f}"]
+         for xi, ref, val in zip(_CONTACT_XI, _CONTACT_FX, ours, strict=True)],
+    )
 
     # 4. FASTSIM on CONTACT's check case (a = 8 mm, b = 4 mm, Fn = 82 kN, mu = 0.3).
-    t = _table("4. FASTSIM, CONTACT check case (fastsim.ref_out): Fy/(mu Fn)",
-               ["grid", "bound", "ours", "CONTACT"])
+    rows = []
     for n, bound, ref in [(40, "parabolic", -0.6118), (40, "elliptic", -0.6016),
                           (200, "parabolic", -0.6359), (200, "elliptic", -0.5956)]:
         r = fastsim(0.0, -0.000625, 0.625, 82e3, 8e-3, 4e-3, 0.3, shear_modulus=82e9,
                     poisson=0.28, nx=n, ny=n, bound=bound)
-        t.add_row(f"{n}x{n}", bound, f"{float(r.fy) / (0.3 * 82e3):.4f}", f"{ref:.4f}")
-    console.print(t)
+        rows.append([f"{n}x{n}", bound, f"{float(r.fy) / (0.3 * 82e3):.4f}", f"{ref:.4f}"])
+    report.table(
+        "4. FASTSIM on CONTACT's check case (a = 8 mm, b = 4 mm, 82 kN; fastsim.ref_out): "
+        "Fy/(mu Fn)",
+        ["grid", "bound", "ours (strips)", "CONTACT"],
+        rows,
+    )
 
     # 5. Polach's published dry and wet sets on the locomotive contact.
     creep = np.array([0.002, 0.01, 0.03, 0.1, 0.3])
-    t = _table("5. Polach 2005 sets at 110 kN, 10 m/s: adhesion |T|/Q (braking creep)",
-               ["set"] + [f"{c * 100:g} %" for c in creep])
+    rows = []
     for name in ("polach2005_dry", "polach2005_wet"):
         p = polach_parameters(name)
         fx, fy = polach_forces(creep, 0.0, 0.0, q, 10.0, h.a, h.b, **p.as_dict())
-        t.add_row(name, *[f"{v:.3f}" for v in adhesion(fx, fy, q)])
-    console.print(t)
+        rows.append([name, *[f"{v:.3f}" for v in adhesion(fx, fy, q)]])
+    report.table(
+        "5. Polach 2005 parameter sets at 110 kN, 10 m/s: adhesion |T|/Q against creep",
+        ["set"] + [f"{c * 100:g} %" for c in creep],
+        rows,
+    )
 
     # 6. Fletcher's twin-disc conditions (seed 001, Tables 1-2).
     creep2d = np.array([0.001, 0.002, 0.005, 0.01])
-    t = _table("6. Fletcher 2013 twin-disc conditions: adhesion Q/P",
-               ["code", "lubricant"] + [f"{c * 100:g} %" for c in creep2d])
+    rows = []
     for code in ("D3", "W1", "L1", "O1", "CG1"):
         cond = fletcher_condition(code)
-        t.add_row(code, cond.lubricant, *[f"{v:.3f}" for v in np.abs(cond.adhesion(creep2d))])
-    console.print(t)
+        rows.append([code, cond.lubricant, *[f"{v:.3f}" for v in cond.adhesion(creep2d)]])
+    report.table(
+        "6. Fletcher (2013) twin-disc conditions, 47 mm discs at 1000 MPa: adhesion Q/P",
+        ["code", "lubricant"] + [f"{c * 100:g} %" for c in creep2d],
+        rows,
+    )
 
     # 7. WILAC on the tram rig (seed 000): adhesion over water flow and creep.
-    from railadhesion.cli import _tram_contact
-    from railadhesion.models.wilac import Wilac
-
     w = np.array([0.0, 25.0, 35.0, 60.0, 350.0])
     creep_w = np.array([0.01, 0.03, 0.1, 0.3, 0.6, 0.9])
-    a_t, b_t = _tram_contact(4200.0)
+    a_t, b_t = contact_semi_axes("tram", 4200.0)
     mu_w = Wilac().adhesion(creep_w[None, :], 0.0, 0.0, 4200.0, 5.0, a_t, b_t, w[:, None])
-    t = _table("7. WILAC (default set: a reconstruction, see docs/wilac-default.md), "
-               "tram rig 4.2 kN, 5 m/s", ["w [µl/s]"] + [f"{c * 100:g} %" for c in creep_w])
-    for wi, row in zip(w, mu_w, strict=True):
-        t.add_row(f"{wi:g}", *[f"{v:.3f}" for v in row])
-    console.print(t)
+    report.table(
+        "7. WILAC, tram rig 4.2 kN, 5 m/s: adhesion |T|/Q "
+        "(default set = a reconstruction, docs/wilac-default.md)",
+        ["w [µl/s]"] + [f"{c * 100:g} %" for c in creep_w],
+        [[f"{wi:g}", *[f"{v:.3f}" for v in row]] for wi, row in zip(w, mu_w, strict=True)],
+    )
 
+    written = []
     for name, fig in [("wilac_curves.png", plot_wilac_curves()),
-                      ("wilac_water.png", plot_wilac_water())]:
+                      ("wilac_water.png", plot_wilac_water()),
+                      ("wilac_speeds.png", plot_wilac_speeds())]:
         path = out_dir / name
-        fig.savefig(path, dpi=100, bbox_inches="tight")
-        plt.close(fig)
+        fig.savefig(path, dpi=100)
         written.append(path)
-    console.print(f"figures written: {', '.join(str(p) for p in written)}")
+    report.console.print()
+    report.console.print(f"figures written: {', '.join(str(p) for p in written)}",
+                         highlight=False)
     return written
