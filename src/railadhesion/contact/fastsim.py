@@ -2,13 +2,17 @@
 
 FASTSIM (Kalker 1982) replaces the elastic half-space by a set of independent springs: the
 elastic displacement at a point is ``u = L p`` with a flexibility ``L`` [m^3/N] per direction.
-In steady rolling the traction then follows from a march along each lateral strip from the
-leading edge (x = +a(y)) to the trailing edge (x = -a(y)), clipped to the traction bound
-``mu p_n``. The three flexibilities are chosen so that, without saturation, the forces equal
-those of Kalker's linear theory (:func:`railadhesion.contact.kalker.linear_creep_forces`).
+In steady rolling the traction then follows from a march along x from the leading edge to the
+trailing edge, clipped to the traction bound ``mu p_n``. The three flexibilities are chosen so
+that, without saturation, the forces equal those of Kalker's linear theory
+(:func:`railadhesion.contact.kalker.linear_creep_forces`).
+
+Two grid layouts are offered: Kalker's strips (each lateral strip split into elements over
+its own length; the default, converging fast) and CONTACT's rectangular grid (reproduces the
+numbers of Vollebregt's CONTACT program, e.g. its ``fastsim`` example).
 
 This module solves many contacts at once: every input broadcasts to a *contact shape*, the
-contacts and the strips are vectorised, and the only Python loop is the march along x.
+contacts and the grid rows are vectorised, and the only Python loop is the march along x.
 
 Sign convention (``docs/CONVENTIONS.md``): the returned forces are exerted by the rail on the
 wheel and oppose the creepage (Kalker's, as CONTACT); at small creepage
@@ -36,6 +40,11 @@ __all__ = ["FastsimResult", "fastsim"]
 
 _BOUNDS = ("parabolic", "elliptic")
 _FLEXIBILITIES = ("original", "blended")
+_GRIDS = ("strips", "rectangular")
+#: CONTACT evaluates the spin part of the rigid slip a sixth of a step upstream of the element
+#: centre, at x + dq/6 (input FACPHI, default 1/6: CONTACT ``m_sinput.f90``; used in
+#: ``m_sdis.f90``, subroutine ``srztng``).
+_FACPHI = 1.0 / 6.0
 #: CONTACT evaluates the blending weight with spin in rad/mm; 1 rad/m = 1e-3 rad/mm.
 _SPIN_TO_PER_MM = 1e-3
 #: Target number of array elements (contacts x strips) processed together: keeps the march's
@@ -52,8 +61,10 @@ class FastsimResult:
     of the inputs (NumPy scalars for scalar input).
 
     The grid fields are ``None`` unless ``return_tractions=True``; then they have the shape
-    ``(*contact_shape, ny, nx)``: strip index j along y (from y = -b to +b), element index i
-    along x from the leading edge (x = +a(y)) to the trailing edge.
+    ``(*contact_shape, ny, nx)``: row (strip) index j along y (from y = -b to +b), element
+    index i along x from the leading edge (+x) to the trailing edge. On the rectangular grid
+    the elements whose centre lies outside the ellipse carry no traction (``px = py = 0``,
+    ``slip`` False).
     """
 
     fx: np.ndarray
@@ -63,7 +74,7 @@ class FastsimResult:
     mz: np.ndarray
     """Spin moment about the contact normal (z) at the contact centre [N m]."""
     slip_fraction: np.ndarray
-    """Fraction of the contact area (grid cells, area-weighted) in slip [-], in [0, 1]."""
+    """Fraction of the contact area (grid cells in contact, area-weighted) in slip [-]."""
     x: np.ndarray | None = None
     """Cell-centre x coordinates [m] (rolling direction)."""
     y: np.ndarray | None = None
@@ -101,6 +112,31 @@ def _grid_pattern(nx: int, ny: int, bound: str):
     # cell area: (2 a sq_j / nx) * (2 b / ny)
     norm = float((gy * sq).sum() * tx.sum()) * 4.0 / (nx * ny)
     return eta, sq, tx, gy, norm
+
+
+@lru_cache(maxsize=32)
+def _rect_pattern(nx: int, ny: int, scale: float, bound: str):
+    """Dimensionless factors of CONTACT's rectangular grid, shared by all contacts of a call.
+
+    Returns ``(xh, yh, mask, shape, n_in)``:
+
+    * ``xh`` (nx,): element centres x_i / a, from the leading edge (+x) to the trailing edge;
+    * ``yh`` (ny,): row centres y_j / b, from -b to +b;
+    * ``mask`` (nx, ny): 1.0 where the element centre lies inside the ellipse, else 0.0;
+    * ``shape`` (nx, ny): normal pressure at the centres divided by ``Fz / (a b)``
+      (``2/pi u`` or ``3/(2 pi) sqrt(u)``, ``u = 1 - x^2/a^2 - y^2/b^2``; zero outside);
+    * ``n_in``: number of elements in contact.
+
+    Arrays are indexed [column i, row j] so that the march reads one contiguous column.
+    """
+    # odd integer numerators: the centres are exactly symmetric about the contact centre
+    xh = scale * ((nx - 1.0 - 2.0 * np.arange(nx)) / nx)
+    yh = scale * ((2.0 * np.arange(ny) + 1.0 - ny) / ny)
+    u = 1.0 - xh[:, None] ** 2 - yh[None, :] ** 2
+    inside = u > 0.0
+    u = np.where(inside, u, 0.0)
+    shape = (2.0 / np.pi) * u if bound == "parabolic" else (1.5 / np.pi) * np.sqrt(u)
+    return xh, yh, inside.astype(float), shape, int(inside.sum())
 
 
 def _flexibilities(a, b, xi, eta, phi, normal_force, mu, g_mod, nu, blended):
@@ -151,7 +187,9 @@ def fastsim(
     nx: int = 40,
     ny: int = 40,
     bound: str = "parabolic",
-    flexibility: str = "original",
+    flexibility="original",
+    grid: str = "strips",
+    scale: float = 1.1,
     return_tractions: bool = False,
 ) -> FastsimResult:
     """Tangential forces of steady rolling contact by Kalker's FASTSIM algorithm.
@@ -177,17 +215,27 @@ def fastsim(
     poisson : array_like, optional
         Combined Poisson's ratio nu [-], in [0, 0.5]. Default 0.28.
     nx : int, optional
-        Elements per strip along x (>= 1). Default 40.
+        Elements along x (>= 1): per strip (``grid="strips"``) or per grid row
+        (``grid="rectangular"``). Default 40.
     ny : int, optional
-        Number of lateral strips (>= 1). Default 40.
+        Number of strips / grid rows along y (>= 1). Default 40.
     bound : {"parabolic", "elliptic"}, optional
         Traction bound ``mu p_n``: ``"parabolic"`` (Kalker's original,
         ``p_n = 2Fz/(pi a b) (1 - x^2/a^2 - y^2/b^2)``) or ``"elliptic"`` (Hertz,
         ``p_n = 3Fz/(2 pi a b) sqrt(1 - x^2/a^2 - y^2/b^2)``).
-    flexibility : {"original", "blended"}, optional
+    flexibility : {"original", "blended"} or sequence of three array_like, optional
         ``"original"``: Kalker's three flexibilities L1, L2, L3. ``"blended"``: CONTACT's
         blending towards one flexibility as the creepage grows (Vollebregt & Voltr 2023), which
-        makes the force at full sliding oppose the creepage.
+        makes the force at full sliding oppose the creepage. Or explicit ``(L1, L2, L3)``
+        [m^3/N], each > 0 and broadcasting with the contacts (e.g. the ``FLX1..3`` printed by
+        CONTACT, converted from mm^3/N by 1e-9, or Kalker's divided by a slope-reduction
+        factor).
+    grid : {"strips", "rectangular"}, optional
+        Grid layout (see Notes): ``"strips"`` (Kalker's, default) or ``"rectangular"``
+        (CONTACT's, to reproduce its numbers).
+    scale : float, optional
+        ``grid="rectangular"`` only: the grid covers ``[-scale a, scale a] x
+        [-scale b, scale b]`` (CONTACT's SCALE), >= 1. Default 1.1.
     return_tractions : bool, optional
         Also return the grid, tractions and slip flags (see :class:`FastsimResult`).
 
@@ -201,7 +249,8 @@ def fastsim(
     ------
     ValueError
         If an argument is not numeric, not finite or outside its range, or if ``bound``,
-        ``flexibility``, ``nx`` or ``ny`` is invalid.
+        ``flexibility``, ``grid``, ``nx``, ``ny`` or ``scale`` is invalid (including a
+        rectangular grid with no element centre inside the ellipse).
 
     Notes
     -----
@@ -220,31 +269,40 @@ def fastsim(
         w = clip(f_crp/3, 0, 1),  L_i <- (1 - w) L_i + w L_crss.
 
     ``f_crp`` adds spin to creepages, so it depends on the unit of spin: it is evaluated, as
-    CONTACT does, with phi and ch_phi in rad/mm. (In CONTACT's ``fastsim`` example the printed
-    flexibilities imply a weight w of about 0.08 where this formula gives 0.11, so the CONTACT
-    revision that wrote that file computes w slightly differently.)
+    CONTACT's source does, with phi and ch_phi in rad/mm. The output of CONTACT revision 2707
+    in its ``fastsim`` example (FLX1..3 = 0.4937, 0.5152, 0.4090 e-4 mm^3/N) implies a weight
+    w = 0.0799, i.e. ``f_crp`` without the spin terms (this formula gives 0.110); both agree
+    on the forces of that example to 0.35 %.
 
     *Algorithm* (Kalker 1982). Rigid slip ``w = (xi - phi y, eta + phi x)``. Along each
-    strip, from the leading edge, the trial traction is
-    ``p(x - dx) = p(x) - dx (xi/L1 - phi y/L3, eta/L2 + phi xm/L3)`` with ``xm`` the midpoint
-    of the step; where ``|p| > mu p_n`` it is scaled back onto the bound in its own direction
-    (slip). Forces are sums of ``p dA``; ``Mz = sum (x py - y px) dA``.
+    row, from the leading edge, the trial traction is
+    ``p(x - dx) = p(x) - dx (xi/L1 - phi y/L3, eta/L2 + phi xs/L3)``; where
+    ``|p| > mu p_n`` it is scaled back onto the bound in its own direction (slip). Forces are
+    sums of ``p dA``; ``Mz = sum (x py - y px) dA`` about the contact centre.
 
-    *Grid layout* (Kalker 1982): ``ny`` strips of equal width ``2b/ny`` with centres
-    ``y_j``; each strip is split into ``nx`` equal elements spanning its own length
+    *Grid layout* ``"strips"`` (Kalker 1982): ``ny`` strips of equal width ``2b/ny`` with
+    centres ``y_j``; each strip is split into ``nx`` equal elements spanning its own length
     ``2a(y_j)``, ``a(y) = a sqrt(1 - y^2/b^2)``. Tractions, bound and slip are evaluated at
-    the element centres (the first step is half an element from the exact leading edge), and
-    the forces by the midpoint rule. In the stick state this reproduces Kalker's linear forces
-    up to the midpoint-rule error, relative O(1/(2 nx^2) + 1/(2 ny^2)). The discrete
-    normal pressure is scaled so that it sums exactly to Fz, hence ``|F| -> mu Fz`` at full
-    sliding on any grid. The spin moment is the simplified theory's own: in full stick it is
+    the element centres (the first step is half an element from the exact leading edge), the
+    spin term at the midpoint ``xs`` of each step, and the forces by the midpoint rule. In the
+    stick state this reproduces Kalker's linear forces up to the midpoint-rule error,
+    relative O(1/(2 nx^2) + 1/(2 ny^2)). The discrete normal pressure is scaled so that it
+    sums exactly to Fz, hence ``|F| -> mu Fz`` at full sliding on any grid. The spin moment
+    is the simplified theory's own: in full stick it is
     ``Mz = pi a^3 b eta/(4 L2) - 8 a^2 b^3 phi/(15 L3)`` (integrating the stick tractions), not
     Kalker's linear ``G c^3 C23 eta - G c^4 C33 phi``; only Fx and Fy match linear theory.
 
-    CONTACT's FASTSIM works on a rectangular grid instead, starting each strip a whole element
-    upstream of the first element in contact: its results on coarse grids differ from these
-    by a few percent (6 % at 40 x 40 in CONTACT's ``fastsim`` example with the parabolic
-    bound); both layouts converge to the same limit, this one faster.
+    *Grid layout* ``"rectangular"`` (CONTACT, ``m_solvpt.f90``, ``modif_fastsim``):
+    ``nx x ny`` equal elements of size ``dx = 2 scale a/nx``, ``dy = 2 scale b/ny`` over the
+    box ``[-scale a, scale a] x [-scale b, scale b]``; an element is in contact when its
+    centre lies inside the ellipse. Each row is marched from the leading edge (+x) one
+    element per step, starting from zero traction outside the contact, so the first element
+    of a row receives a whole step; the spin term is evaluated at ``xs = x_i + dx/6``
+    (CONTACT's FACPHI = 1/6). The bound is the normal pressure at the element centres,
+    not rescaled, so at full sliding ``|F| = mu sum(p_n dA)``, which differs from ``mu Fz``
+    by the quadrature error (0.08 % for the elliptic bound on 44 x 44). CONTACT's "40 x 40
+    elements in contact" is ``nx = ny = 44`` with ``scale = 1.1``. This layout converges
+    more slowly, about 1/n, than the strips, to the same limit.
 
     References
     ----------
@@ -252,15 +310,22 @@ def fastsim(
     System Dynamics 11 (1982) 1-13.
     E. A. H. Vollebregt, P. Voltr, "Improved accuracy for FASTSIM using one or three
     flexibility values", Vehicle System Dynamics 61(1) (2023).
-    E. A. H. Vollebregt, CONTACT, ``src/m_hertz.f90`` (``simpflex``), Apache-2.0.
+    E. A. H. Vollebregt, CONTACT, ``src/m_hertz.f90`` (``simpflex``), ``src/m_solvpt.f90``
+    (``modif_fastsim``), ``src/m_sdis.f90`` (``srztng``), Apache-2.0.
 
     Examples
     --------
     An 8 mm x 4 mm contact, 82 kN, lateral creepage and spin as in CONTACT's ``fastsim``
-    example (CONTACT's FASTSIM on its rectangular 200 x 200 grid: Fy/(mu Fz) = -0.6359; its
-    grid converges to the same limit, about -0.647, more slowly):
+    example. On CONTACT's grid (220 x 220 elements over 1.1 a x 1.1 b) with CONTACT's printed
+    flexibilities it gives CONTACT's Fy/(mu Fz) = -0.6359; the strip layout converges faster
+    (to about -0.647):
 
-    >>> r = fastsim(0.0, -0.000625, 0.625, 82e3, 8e-3, 4e-3, 0.3)
+    >>> case = (0.0, -0.000625, 0.625, 82e3, 8e-3, 4e-3, 0.3)
+    >>> flx = (0.4937e-13, 0.5152e-13, 0.4090e-13)  # CONTACT's FLX1..3 [mm^3/N] * 1e-9
+    >>> r = fastsim(*case, nx=220, ny=220, grid="rectangular", flexibility=flx)
+    >>> round(float(r.fy / (0.3 * 82e3)), 4)
+    -0.6359
+    >>> r = fastsim(*case)
     >>> round(float(r.fy / (0.3 * 82e3)), 4), round(float(r.slip_fraction), 2)
     (-0.6508, 0.42)
 
@@ -280,17 +345,28 @@ def fastsim(
     g_mod = check_positive(shear_modulus, "shear_modulus")
     nu = check_range(poisson, "poisson", 0.0, 0.5)
     check_choice(bound, "bound", _BOUNDS)
-    check_choice(flexibility, "flexibility", _FLEXIBILITIES)
+    check_choice(grid, "grid", _GRIDS)
+    flx_given = _check_flexibility(flexibility)
     nx = _check_count(nx, "nx")
     ny = _check_count(ny, "ny")
+    if grid == "rectangular":
+        scale = _check_scale(scale)
+        rect = _rect_pattern(nx, ny, scale, bound)
+        if rect[4] == 0:
+            raise ValueError(
+                f"no element centre of the {nx} x {ny} grid (nx x ny) lies inside the contact "
+                f"ellipse with scale={scale!r}: increase nx, ny or decrease scale (>= 1)"
+            )
 
-    args = np.broadcast_arrays(xi, eta, phi, fz, a_, b_, mu_, g_mod, nu)
+    args = np.broadcast_arrays(xi, eta, phi, fz, a_, b_, mu_, g_mod, nu, *flx_given)
     shape = args[0].shape
-    xi, eta, phi, fz, a_, b_, mu_, g_mod, nu = (np.ravel(v) for v in args)
-    l1, l2, l3 = _flexibilities(
-        a_, b_, xi, eta, phi, fz, mu_, g_mod, nu, flexibility == "blended"
-    )
-    eta_j, sq, tx, gy, norm = _grid_pattern(nx, ny, bound)
+    xi, eta, phi, fz, a_, b_, mu_, g_mod, nu, *flx_given = (np.ravel(v) for v in args)
+    if flx_given:
+        l1, l2, l3 = flx_given
+    else:
+        l1, l2, l3 = _flexibilities(
+            a_, b_, xi, eta, phi, fz, mu_, g_mod, nu, flexibility == "blended"
+        )
 
     n = xi.size
     fx = np.empty(n)
@@ -304,14 +380,22 @@ def fastsim(
     else:
         px_all = py_all = slip_all = None
 
+    if grid == "strips":
+        eta_j, sq, tx, gy, norm = _grid_pattern(nx, ny, bound)
     step = max(1, _CHUNK_ELEMENTS // ny)
     for lo in range(0, n, step):
         sl = slice(lo, min(lo + step, n))
-        out = _march(
-            xi[sl], eta[sl], phi[sl], fz[sl], a_[sl], b_[sl], mu_[sl],
-            l1[sl], l2[sl], l3[sl], nx, eta_j, sq, tx, gy, norm,
-            None if px_all is None else (px_all[sl], py_all[sl], slip_all[sl]),
-        )  # fmt: skip
+        store = None if px_all is None else (px_all[sl], py_all[sl], slip_all[sl])
+        if grid == "strips":
+            out = _march(
+                xi[sl], eta[sl], phi[sl], fz[sl], a_[sl], b_[sl], mu_[sl],
+                l1[sl], l2[sl], l3[sl], nx, eta_j, sq, tx, gy, norm, store,
+            )  # fmt: skip
+        else:
+            out = _march_rect(
+                xi[sl], eta[sl], phi[sl], fz[sl], a_[sl], b_[sl], mu_[sl],
+                l1[sl], l2[sl], l3[sl], scale, rect, store,
+            )  # fmt: skip
         fx[sl], fy[sl], mz[sl], slip_fraction[sl] = out
 
     def shaped(v):
@@ -320,19 +404,49 @@ def fastsim(
 
     extra = {}
     if return_tractions:
-        s_centre = (np.arange(nx) + 0.5) / nx  # fraction of the strip length from the leading edge
-        a_strip = a_[:, None] * sq[None, :]  # (n, ny)
-        x = a_strip[:, :, None] * (1.0 - 2.0 * s_centre)[None, None, :]
-        y = np.broadcast_to((b_[:, None] * eta_j[None, :])[:, :, None], x.shape)
+        if grid == "strips":
+            s_centre = (np.arange(nx) + 0.5) / nx  # fraction of the strip length from the lead
+            a_strip = a_[:, None] * sq[None, :]  # (n, ny)
+            x = a_strip[:, :, None] * (1.0 - 2.0 * s_centre)[None, None, :]
+            y = np.broadcast_to((b_[:, None] * eta_j[None, :])[:, :, None], x.shape)
+        else:
+            xh, yh = rect[0], rect[1]
+            x = np.broadcast_to(a_[:, None, None] * xh[None, None, :], (n, ny, nx))
+            y = np.broadcast_to(b_[:, None, None] * yh[None, :, None], (n, ny, nx))
         grid_shape = (*shape, ny, nx)
         extra = {
-            "x": x.reshape(grid_shape),
+            "x": np.array(x).reshape(grid_shape),
             "y": np.array(y).reshape(grid_shape),
             "px": px_all.reshape(grid_shape),
             "py": py_all.reshape(grid_shape),
             "slip": slip_all.reshape(grid_shape),
         }
     return FastsimResult(shaped(fx), shaped(fy), shaped(mz), shaped(slip_fraction), **extra)
+
+
+def _check_flexibility(flexibility) -> list:
+    """``[]`` for a valid model name, else the three validated explicit flexibilities."""
+    if isinstance(flexibility, str):
+        check_choice(flexibility, "flexibility", _FLEXIBILITIES)
+        return []
+    try:
+        values = list(flexibility)
+    except TypeError:
+        values = None
+    if values is None or len(values) != 3:
+        raise ValueError(
+            f"flexibility must be one of {sorted(_FLEXIBILITIES)} or a sequence of three "
+            f"flexibilities (L1, L2, L3) in (0, inf) [m^3/N], got {flexibility!r}"
+        )
+    return [check_positive(v, f"flexibility L{k + 1}") for k, v in enumerate(values)]
+
+
+def _check_scale(value) -> float:
+    """``value`` as a float scalar >= 1, else ValueError naming ``scale``."""
+    arr = check_range(value, "scale", 1.0, np.inf, closed="left")
+    if arr.ndim != 0:
+        raise ValueError(f"scale must be a scalar in [1.0, inf), got shape {arr.shape}")
+    return float(arr)
 
 
 def _check_count(value, name: str) -> int:
@@ -413,4 +527,73 @@ def _march(xi, eta, phi, fz, a, b, mu, l1, l2, l3, nx, eta_j, sq, tx, gy, norm, 
     sum_xpy = a_strip * spy - dx * (nx * spy - qpy + 0.5 * spy)
     mz = ((sum_xpy - y * spx) * da).sum(axis=1)
     slip_fraction = np.minimum((nslip * sq).sum(axis=1) / (nx * sq.sum()), 1.0)
+    return fx, fy, mz, slip_fraction
+
+
+def _march_rect(xi, eta, phi, fz, a, b, mu, l1, l2, l3, scale, rect, store):
+    """FASTSIM on CONTACT's rectangular grid for a chunk of m contacts.
+
+    Returns (fx, fy, mz, slip_fraction), each (m,). Working arrays have shape (m, ny), one
+    entry per grid row; the loop runs over the nx columns from the leading edge (+x).
+    ``store`` is None or a tuple of (m, ny, nx) arrays receiving px, py and the slip flags.
+    """
+    xh, yh, mask, shape, n_in = rect
+    nx, ny = mask.shape
+    col = np.newaxis
+    dx = (2.0 * scale / nx) * a  # (m,)
+    dy = (2.0 * scale / ny) * b
+    y = b[:, col] * yh  # row centres (m, ny)
+    phi_l3 = phi / l3
+    # constant increment of px per element: -dx (xi/L1 - phi y/L3)
+    dpx = -dx[:, col] * ((xi / l1)[:, col] - phi_l3[:, col] * y)
+    # increment of py at column i: -dx (eta/L2 + phi (a xh_i + dx/6)/L3), shape (nx, m, 1)
+    dpy0 = -dx * (eta / l2 + phi_l3 * (_FACPHI * dx))
+    dpy1 = -dx * phi_l3 * a
+    dpy = (dpy0 + xh[:, col] * dpy1)[:, :, col]
+    gfac = (mu * fz / (a * b))[:, col]  # bound at (i, j): gfac * shape[i, j]
+
+    px = np.zeros_like(y)
+    py = np.zeros_like(y)
+    spx = np.zeros_like(y)
+    spy = np.zeros_like(y)
+    sxpy = np.zeros_like(y)  # sum_i xh_i py_i
+    nslip = np.zeros_like(y)
+    r = np.empty_like(y)
+    g = np.empty_like(y)
+    tmp = np.empty_like(y)
+    slip = np.empty(y.shape, dtype=bool)
+    tiny = 1e-30  # [Pa]; keeps g/|p| finite where p = 0
+    for i in range(nx):
+        m_i = mask[i]
+        # step from the previous element; elements outside the contact reset to zero
+        px += dpx
+        px *= m_i
+        py += dpy[i]
+        py *= m_i
+        np.multiply(px, px, out=r)
+        np.multiply(py, py, out=tmp)
+        r += tmp
+        np.sqrt(r, out=r)
+        np.multiply(gfac, shape[i], out=g)
+        np.greater(r, g, out=slip)
+        r += tiny
+        np.divide(g, r, out=tmp)
+        np.minimum(tmp, 1.0, out=tmp)
+        px *= tmp
+        py *= tmp
+        spx += px
+        spy += py
+        np.multiply(py, xh[i], out=tmp)
+        sxpy += tmp
+        nslip += slip
+        if store is not None:
+            store[0][:, :, i] = px
+            store[1][:, :, i] = py
+            store[2][:, :, i] = slip
+
+    da = dx * dy
+    fx = spx.sum(axis=1) * da
+    fy = spy.sum(axis=1) * da
+    mz = (a * sxpy.sum(axis=1) - (y * spx).sum(axis=1)) * da
+    slip_fraction = nslip.sum(axis=1) / n_in
     return fx, fy, mz, slip_fraction
