@@ -72,8 +72,11 @@ def main(argv=None) -> None:
                lambda: polach_forces(xi, eta, phi, q, v, a, b, **dry), n)
     throughput("Polach, vectorised (xi only)",
                lambda: polach_forces(xi, 0.0, 0.0, q, v, a, b, **dry), n)
-    latency("Polach, one scalar call",
+    latency("Polach, one scalar call (same contact shape)",
             lambda: polach_forces(0.01, 0.001, 0.1, 100e3, 20.0, 6e-3, 5e-3, **dry))
+    shapes = iter(np.tile(rng.uniform(3e-3, 8e-3, 4096), 64).tolist())
+    latency("Polach, one scalar call (new a/b every call)",
+            lambda: polach_forces(0.01, 0.001, 0.1, 100e3, 20.0, next(shapes), 5e-3, **dry))
     wilac = Wilac()
     throughput("WILAC, vectorised (array water flow)",
                lambda: wilac.forces(xi, eta, phi, q, v, a, b, w), n)
@@ -81,8 +84,9 @@ def main(argv=None) -> None:
             lambda: wilac.forces(0.01, 0.0, 0.0, 100e3, 20.0, 6e-3, 5e-3, 25.0))
     latency("Kalker coefficients, one scalar call", lambda: kalker_coefficients(0.7, 0.28))
     m = n // 10
-    throughput("Hertz 3D (exact elliptic integrals), vectorised",
-               lambda: hertz_3d(q[:m], 0.46, np.inf, 0.3), m)
+    rail_lateral = rng.uniform(0.2, 0.6, m)
+    throughput("Hertz 3D (exact elliptic integrals), vectorised, varied geometry",
+               lambda: hertz_3d(q[:m], 0.46, np.inf, rail_lateral), m)
     for grid, count in ((20, 2000 if args.quick else 20_000), (40, 500 if args.quick else 5000)):
         throughput(f"FASTSIM {grid}x{grid}, batched",
                    lambda grid=grid, count=count: fastsim(

@@ -1,0 +1,448 @@
+"""Figures of the WILAC model (Trummer et al., seed 000, Figs. 5–9 and 11).
+
+Every function returns a :class:`matplotlib.figure.Figure`. Figures are created with
+:class:`matplotlib.figure.Figure` directly (no :mod:`matplotlib.pyplot` state, no display
+needed; saving a PNG uses the Agg renderer), or drawn into an ``ax``/``fig`` you pass in.
+
+Creep is plotted as the paper plots it: **traction at negative longitudinal creep**
+``c_x = ξ < 0`` (Kalker's convention, ``docs/CONVENTIONS.md``), in per cent, and the adhesion
+``T_x/Q`` (the force of the rail on the wheel, positive in traction) on the other axis.
+
+Contact geometry is given by name (:data:`WILAC_GEOMETRIES`: ``"tram"``, the Pardubice tram
+wheel rig of seed 000 §4, and ``"locomotive"``, the contact used for the locomotive-scale
+checks of the default parameter set) or directly as the semi-axes ``(a, b)`` in metres.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from railadhesion._validate import check_finite, check_nonnegative, check_positive
+
+__all__ = [
+    "WILAC_GEOMETRIES",
+    "contact_semi_axes",
+    "plot_wilac_weights",
+    "plot_wilac_curves",
+    "plot_wilac_water",
+    "plot_wilac_speeds",
+]
+
+#: Named wheel–rail (or wheel–roller) geometries for the WILAC figures, as the radii of
+#: :func:`railadhesion.contact.hertz.hertz_3d` [m] (steel, E = 210 GPa, ν = 0.28).
+#: ``tram``: seed 000 §4 — wheel diameter 0.696 m on a rail roller of diameter 0.905 m,
+#: effective lateral radius of the contact 0.660 m (put on the roller, the wheel taken as
+#: laterally straight). ``locomotive``: our choice for the 110 kN checks (the paper does not
+#: state its locomotive contact): wheel radius 0.625 m (as CONTACT's Eurosprinter example),
+#: laterally straight (conical) tread on a rail head of lateral radius 0.300 m (a/b ≈ 1.6 at
+#: 110 kN). The same numbers are used by ``scripts/build_default_wilac.py``.
+WILAC_GEOMETRIES: dict[str, dict[str, float]] = {
+    "tram": {
+        "wheel_radius": 0.348,
+        "rail_radius": 0.4525,
+        "wheel_lateral_radius": math.inf,
+        "rail_lateral_radius": 0.660,
+    },
+    "locomotive": {
+        "wheel_radius": 0.625,
+        "rail_radius": math.inf,
+        "wheel_lateral_radius": math.inf,
+        "rail_lateral_radius": 0.300,
+    },
+}
+
+_CREEP_LABEL = "longitudinal creep $c_x$ [%] (traction < 0)"
+_ADHESION_LABEL = "adhesion $T_x/Q$ [-]"
+_WATER_LABEL = "water flow rate $w$ [µl/s]"
+
+
+def contact_semi_axes(geometry, normal_force) -> tuple[float, float]:
+    """Semi-axes ``(a, b)`` [m] of a named geometry at a normal force, or ``geometry`` itself.
+
+    Parameters
+    ----------
+    geometry : str or (float, float)
+        A key of :data:`WILAC_GEOMETRIES` (Hertz contact via
+        :func:`railadhesion.contact.hertz.hertz_3d`), or the semi-axes ``(a, b)`` [m] along the
+        rolling direction and laterally.
+    normal_force : float
+        Normal force Q [N], > 0.
+
+    Returns
+    -------
+    (float, float)
+        ``a`` (rolling direction) and ``b`` (lateral) [m].
+
+    Examples
+    --------
+    >>> a, b = contact_semi_axes("tram", 4200.0)
+    >>> round(a * 1e3, 2), round(b * 1e3, 2)
+    (1.41, 3.15)
+    """
+    q = float(check_positive(normal_force, "normal_force"))
+    if isinstance(geometry, str):
+        if geometry not in WILAC_GEOMETRIES:
+            raise ValueError(
+                f"geometry must be one of {sorted(WILAC_GEOMETRIES)} or an (a, b) pair in m, "
+                f"got {geometry!r}"
+            )
+        from railadhesion.contact.hertz import hertz_3d
+
+        g = WILAC_GEOMETRIES[geometry]
+        contact = hertz_3d(
+            q,
+            g["wheel_radius"],
+            g["wheel_lateral_radius"],
+            g["rail_lateral_radius"],
+            g["rail_radius"],
+            young=2.1e11,
+            poisson=0.28,
+        )
+        return float(contact.a), float(contact.b)
+    try:
+        a, b = (float(x) for x in geometry)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(
+            f"geometry must be one of {sorted(WILAC_GEOMETRIES)} or an (a, b) pair in m, "
+            f"got {geometry!r}"
+        ) from exc
+    check_positive(a, "geometry a")
+    check_positive(b, "geometry b")
+    return a, b
+
+
+def _params(params):
+    from railadhesion.models.wilac import WilacParameters, default_wilac_parameters
+
+    if params is None:
+        return default_wilac_parameters()
+    if not isinstance(params, WilacParameters):
+        raise ValueError(f"params must be a WilacParameters or None, got {type(params).__name__}")
+    return params
+
+
+def _axes(ax, figsize=(6.4, 4.4)):
+    if ax is None:
+        fig = Figure(figsize=figsize, layout="constrained")
+        ax = fig.add_subplot()
+    return ax.figure, ax
+
+
+def _traction_creep(creep_max: float, n_points: int) -> np.ndarray:
+    """Magnitudes 0 … creep_max, dense at low creep (where the curves bend)."""
+    creep_max = float(check_positive(creep_max, "creep_max"))
+    if creep_max > 1:
+        raise ValueError(f"creep_max must be in (0, 1], got {creep_max!r}")
+    if int(n_points) < 10:
+        raise ValueError(f"n_points must be in [10, inf), got {n_points!r}")
+    return np.concatenate(([0.0], np.geomspace(1e-4 * creep_max, creep_max, int(n_points) - 1)))
+
+
+def plot_wilac_weights(params=None, *, water_flow_max=100.0, n_points=401, fig=None):
+    """Blending weights f_i(w) and transitions e_i(w) of WILAC (seed 000, Figs. 5 and 6).
+
+    Parameters
+    ----------
+    params : WilacParameters, optional
+        Parameter set whose ``transitions`` are drawn; ``None``: the default set.
+    water_flow_max : float, optional
+        Upper end of the water-flow axis [µl/s], > 0.
+    n_points : int, optional
+        Number of water-flow samples.
+    fig : matplotlib.figure.Figure, optional
+        Figure to draw into (two subplots are added); a new one by default.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Top panel: the four weights f_Dry, f_Damp2, f_Damp1, f_Wet; bottom: e_1, e_2, e_3.
+
+    Notes
+    -----
+    Trummer et al. (seed 000), section 5.3, the equations for f_i and e_i, Table 1; computed
+    with :func:`railadhesion.models.wilac.wilac_weights` and
+    :func:`~railadhesion.models.wilac.wilac_transitions`.
+
+    Examples
+    --------
+    >>> fig = plot_wilac_weights()
+    >>> [len(ax.lines) for ax in fig.axes]
+    [4, 3]
+    """
+    from railadhesion.models.wilac import WILAC_CONDITIONS, wilac_transitions, wilac_weights
+
+    p = _params(params)
+    wmax = float(check_positive(water_flow_max, "water_flow_max"))
+    w = np.linspace(0.0, wmax, int(n_points))
+    f = wilac_weights(w, p.transitions)
+    e = wilac_transitions(w, p.transitions)
+    if fig is None:
+        fig = Figure(figsize=(6.4, 6.0), layout="constrained")
+    ax_f, ax_e = fig.subplots(2, 1, sharex=True)
+    names = {"dry": "Dry", "damp2": "Damp2", "damp1": "Damp1", "wet": "Wet"}
+    for i, cond in enumerate(WILAC_CONDITIONS):
+        ax_f.plot(w, f[i], label=f"$f_{{{names[cond]}}}$")
+    ax_f.set_ylabel("weight $f_i$ [-]")
+    ax_f.set_title("WILAC blending weights (Trummer et al., Fig. 5)")
+    ax_f.legend(loc="center right")
+    labels = ("Dry–Damp2", "Damp2–Damp1", "Damp1–Wet")
+    for i in range(3):
+        m, s = p.transitions[i]
+        ax_e.plot(w, e[i], label=f"$e_{i + 1}$ ({labels[i]}; m = {m:g}, s = {s:g} µl/s)")
+    ax_e.set_xlabel(_WATER_LABEL)
+    ax_e.set_ylabel("transition $e_i$ [-]")
+    ax_e.set_title("Transition functions (Fig. 6)")
+    ax_e.legend(loc="lower right", fontsize="small")
+    for ax in (ax_f, ax_e):
+        ax.set_xlim(0.0, wmax)
+        ax.set_ylim(-0.02, 1.02)
+        ax.grid(True, alpha=0.3)
+    return fig
+
+
+def plot_wilac_curves(
+    water_flows=(0, 25, 35, 60, 350),
+    normal_force=4200.0,
+    speed=5.0,
+    geometry="tram",
+    *,
+    params=None,
+    creep_max=1.0,
+    n_points=200,
+    ax=None,
+):
+    """Adhesion against longitudinal creep for several water flow rates (seed 000, Fig. 7).
+
+    Parameters
+    ----------
+    water_flows : sequence of float, optional
+        Water flow rates w [µl/s], one curve each.
+    normal_force : float, optional
+        Normal force Q [N]; default the tram rig's 4.2 kN.
+    speed : float, optional
+        Rolling speed v [m/s]; default the tram rig's 5 m/s.
+    geometry : str or (float, float), optional
+        Contact geometry: a key of :data:`WILAC_GEOMETRIES` or semi-axes ``(a, b)`` [m].
+    params : WilacParameters, optional
+        Parameter set; ``None``: the default set.
+    creep_max : float, optional
+        Largest creep magnitude [-], in (0, 1].
+    n_points : int, optional
+        Creep samples per curve.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into; a new figure by default.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One line per water flow rate; x: creep c_x [%], traction negative as in the paper;
+        y: T_x/Q [-].
+
+    Notes
+    -----
+    Forces from :func:`railadhesion.models.wilac.wilac_forces` (seed 000, section 5), pure
+    longitudinal creep, no spin.
+
+    Examples
+    --------
+    >>> fig = plot_wilac_curves(water_flows=(0, 350), n_points=20)
+    >>> len(fig.axes[0].lines)
+    2
+    """
+    from railadhesion.models.wilac import wilac_forces
+
+    p = _params(params)
+    q = float(check_positive(normal_force, "normal_force"))
+    v = float(check_nonnegative(speed, "speed"))
+    flows = check_nonnegative(np.atleast_1d(np.asarray(water_flows, dtype=float)), "water_flows")
+    a, b = contact_semi_axes(geometry, q)
+    creep = -_traction_creep(creep_max, n_points)
+    fig, ax = _axes(ax)
+    fx, _ = wilac_forces(creep[None, :], 0.0, 0.0, q, v, a, b, flows[:, None], p)
+    for w, row in zip(flows, np.asarray(fx) / q, strict=True):
+        ax.plot(100 * creep, row, label=f"w = {w:g} µl/s")
+    ax.set_xlabel(_CREEP_LABEL)
+    ax.set_ylabel(_ADHESION_LABEL)
+    ax.set_title(f"WILAC, Q = {q / 1e3:g} kN, v = {v:g} m/s (cf. Trummer et al., Fig. 7)")
+    ax.set_xlim(-100 * float(creep_max), 0.0)
+    ax.set_ylim(bottom=0.0)
+    ax.grid(True, alpha=0.3)
+    ax.legend()
+    return fig
+
+
+def plot_wilac_water(
+    creeps=(0.03, 0.1, 0.3, 0.6),
+    normal_force=4200.0,
+    speed=5.0,
+    geometry="tram",
+    *,
+    params=None,
+    water_flow_max=100.0,
+    marks=(25, 35, 60),
+    n_points=301,
+    ax=None,
+):
+    """Adhesion against water flow rate at fixed traction creeps (seed 000, Fig. 8).
+
+    Parameters
+    ----------
+    creeps : sequence of float, optional
+        Creep magnitudes |c_x| [-]; each is applied as traction, c_x = −|c_x|.
+    normal_force : float, optional
+        Normal force Q [N].
+    speed : float, optional
+        Rolling speed v [m/s].
+    geometry : str or (float, float), optional
+        A key of :data:`WILAC_GEOMETRIES` or semi-axes ``(a, b)`` [m].
+    params : WilacParameters, optional
+        Parameter set; ``None``: the default set.
+    water_flow_max : float, optional
+        Upper end of the water-flow axis [µl/s].
+    marks : sequence of float, optional
+        Water flow rates marked by grey vertical lines (the paper marks the rates where it
+        measured; those above ``water_flow_max`` are skipped).
+    n_points : int, optional
+        Water-flow samples.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One line per creep, plus one vertical line per mark within the axis.
+
+    Examples
+    --------
+    >>> fig = plot_wilac_water(creeps=(0.03, 0.6), marks=(25,), n_points=50)
+    >>> len(fig.axes[0].lines)
+    3
+    """
+    from railadhesion.models.wilac import wilac_forces
+
+    p = _params(params)
+    q = float(check_positive(normal_force, "normal_force"))
+    v = float(check_nonnegative(speed, "speed"))
+    wmax = float(check_positive(water_flow_max, "water_flow_max"))
+    mags = np.abs(check_finite(np.atleast_1d(np.asarray(creeps, dtype=float)), "creeps"))
+    a, b = contact_semi_axes(geometry, q)
+    w = np.linspace(0.0, wmax, int(n_points))
+    fig, ax = _axes(ax)
+    fx, _ = wilac_forces(-mags[:, None], 0.0, 0.0, q, v, a, b, w[None, :], p)
+    for c, row in zip(mags, np.asarray(fx) / q, strict=True):
+        ax.plot(w, row, label=f"$c_x$ = {-100 * c:g} %")
+    for m in marks:
+        if 0 <= m <= wmax:
+            ax.axvline(m, color="0.6", lw=0.8, ls=":", zorder=0)
+    ax.set_xlabel(_WATER_LABEL)
+    ax.set_ylabel(_ADHESION_LABEL)
+    ax.set_title(f"WILAC, Q = {q / 1e3:g} kN, v = {v:g} m/s (cf. Trummer et al., Fig. 8)")
+    ax.set_xlim(0.0, wmax)
+    ax.set_ylim(bottom=0.0)
+    ax.grid(True, alpha=0.3)
+    ax.legend()
+    return fig
+
+
+def plot_wilac_speeds(
+    speeds=(5, 10, 20),
+    water_flow=0.0,
+    normal_force=110e3,
+    geometry="locomotive",
+    *,
+    params=None,
+    compare_polach=True,
+    polach_speed=10.0,
+    creep_max=0.6,
+    n_points=200,
+    ax=None,
+):
+    """Adhesion against creep at several speeds (seed 000, Fig. 9; with Fig. 11's comparison).
+
+    Parameters
+    ----------
+    speeds : sequence of float, optional
+        Rolling speeds v [m/s], one WILAC curve each (solid).
+    water_flow : float, optional
+        Water flow rate w [µl/s]; 0 is the dry condition.
+    normal_force : float, optional
+        Normal force Q [N]; default 110 kN, the locomotive tests of the paper.
+    geometry : str or (float, float), optional
+        A key of :data:`WILAC_GEOMETRIES` or semi-axes ``(a, b)`` [m].
+    params : WilacParameters, optional
+        Parameter set; ``None``: the default set.
+    compare_polach : bool, optional
+        Also draw (dashed) the plain Polach model with parameters fixed at their WILAC values
+        for ``polach_speed``, as the paper's Fig. 11 does.
+    polach_speed : float, optional
+        Speed [m/s] whose WILAC Polach parameters are frozen for the comparison.
+    creep_max : float, optional
+        Largest creep magnitude [-], in (0, 1].
+    n_points : int, optional
+        Creep samples per curve.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        ``len(speeds)`` solid lines, and as many dashed ones if ``compare_polach``.
+
+    Notes
+    -----
+    The frozen-parameter curves use each condition's Polach parameters at
+    ``(normal_force, polach_speed)`` (:meth:`~railadhesion.models.wilac.WilacParameters.
+    polach_parameters`), evaluated with :func:`railadhesion.models.polach.polach_forces` at each
+    speed and blended with the same water-flow weights (seed 000, section 5.4, Fig. 11).
+
+    Examples
+    --------
+    >>> fig = plot_wilac_speeds(speeds=(5, 20), n_points=20)
+    >>> len(fig.axes[0].lines)
+    4
+    """
+    from railadhesion.models.polach import polach_forces
+    from railadhesion.models.wilac import WILAC_CONDITIONS, wilac_forces, wilac_weights
+
+    p = _params(params)
+    q = float(check_positive(normal_force, "normal_force"))
+    w = float(check_nonnegative(water_flow, "water_flow"))
+    vs = check_nonnegative(np.atleast_1d(np.asarray(speeds, dtype=float)), "speeds")
+    a, b = contact_semi_axes(geometry, q)
+    creep = -_traction_creep(creep_max, n_points)
+    fig, ax = _axes(ax)
+    fx, _ = wilac_forces(creep[None, :], 0.0, 0.0, q, vs[:, None], a, b, w, p)
+    colors = [f"C{i}" for i in range(len(vs))]
+    for v, row, col in zip(vs, np.asarray(fx) / q, colors, strict=True):
+        ax.plot(100 * creep, row, color=col, label=f"WILAC, v = {v:g} m/s")
+    if compare_polach:
+        vp = float(check_nonnegative(polach_speed, "polach_speed"))
+        weights = wilac_weights(w, p.transitions)
+        total = np.zeros((vs.size, creep.size))
+        for i, cond in enumerate(WILAC_CONDITIONS):
+            if weights[i] == 0:
+                continue
+            pp = p.polach_parameters(cond, q, vp)
+            fxi, _ = polach_forces(
+                creep[None, :], 0.0, 0.0, q, vs[:, None], a, b,
+                mu0=pp["mu0"], k_A=pp["k_A"], k_S=pp["k_S"], A=pp["A"], B=pp["B"],
+            )
+            total = total + weights[i] * np.asarray(fxi)
+        for v, row, col in zip(vs, total / q, colors, strict=True):
+            ax.plot(
+                100 * creep, row, color=col, ls="--",
+                label=f"Polach, fixed parameters of {vp:g} m/s, v = {v:g} m/s",
+            )
+    ax.set_xlabel(_CREEP_LABEL)
+    ax.set_ylabel(_ADHESION_LABEL)
+    ax.set_title(
+        f"WILAC, Q = {q / 1e3:g} kN, w = {w:g} µl/s (cf. Trummer et al., Figs. 9 and 11)"
+    )
+    ax.set_xlim(-100 * float(creep_max), 0.0)
+    ax.set_ylim(bottom=0.0)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
+    return fig
