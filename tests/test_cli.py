@@ -94,3 +94,60 @@ def test_demo_runs(tmp_path):
     assert result.exit_code == 0, result.output
     assert "CONTACT" in result.output
     assert sorted(p.name for p in tmp_path.glob("*.png"))
+
+
+def _write_synthetic_curve(path, params, q, v, w, a=4e-3, b=3e-3):
+    """A noise-free creep curve from known Polach parameters, in the documented CSV format."""
+    import numpy as np
+
+    from railadhesion.io.creepcurves import CreepCurve, write_creep_curve
+    from railadhesion.models.polach import polach_forces
+
+    creep = -np.geomspace(1e-3, 0.6, 25)
+    fx, _ = polach_forces(creep, 0.0, 0.0, q, v, a, b, **params)
+    curve = CreepCurve(creep, abs(fx) / q, normal_force=q, speed=v, water_flow=w, a=a, b=b,
+                       name=path.stem)
+    write_creep_curve(curve, path)
+
+
+def test_fit_polach_recovers_parameters_and_writes_file(tmp_path):
+    from railadhesion.io.paramfiles import load_polach_parameters
+
+    truth = dict(k_A=0.6, k_S=0.2, mu0=0.35, A=0.5, B=0.4)
+    csv = tmp_path / "curve.csv"
+    _write_synthetic_curve(csv, truth, 50e3, 10.0, 0.0)
+    out = tmp_path / "fitted.toml"
+    result = _run("fit", "polach", str(csv), "--out", str(out))
+    assert result.exit_code == 0, result.output
+    fitted = load_polach_parameters(out)
+    for key, value in truth.items():
+        assert getattr(fitted, key) == pytest.approx(value, rel=1e-3)
+
+
+def test_fit_polach_names_missing_metadata(tmp_path):
+    csv = tmp_path / "bare.csv"
+    csv.write_text("creep,adhesion\n-0.01,0.2\n-0.02,0.25\n-0.05,0.3\n")
+    result = _run("fit", "polach", str(csv))
+    assert result.exit_code == 2
+    assert "normal_force_N" in result.output
+
+
+def test_fit_wilac_builds_a_loadable_file(tmp_path):
+    from railadhesion.io.paramfiles import load_wilac_parameters
+
+    sets = {0.0: dict(k_A=1.0, k_S=0.4, mu0=0.45, A=0.4, B=0.6),
+            25.0: dict(k_A=0.3, k_S=0.1, mu0=0.15, A=0.4, B=0.3),
+            35.0: dict(k_A=0.3, k_S=0.1, mu0=0.2, A=0.8, B=0.2),
+            350.0: dict(k_A=0.2, k_S=0.1, mu0=0.15, A=0.9, B=0.1)}
+    folder = tmp_path / "curves"
+    folder.mkdir()
+    for w, params in sets.items():
+        for q in (3000.0, 6000.0):
+            _write_synthetic_curve(folder / f"w{w:g}_q{q:g}.csv", params, q, 5.0, w)
+    out = tmp_path / "wilac.toml"
+    result = _run("fit", "wilac", str(folder), "--out", str(out), "--speed-range", "2,10")
+    assert result.exit_code == 0, result.output
+    assert "WILAC calibration from 8 creep curves" in result.output
+    params = load_wilac_parameters(out)
+    dry = params.polach_parameters("dry", 4500.0, 5.0)
+    assert float(dry["mu0"]) == pytest.approx(0.45, rel=1e-3)

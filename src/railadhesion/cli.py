@@ -316,6 +316,7 @@ def fit_polach_cmd(
 
     try:
         curve = read_creep_curve(csv)
+        curve.require("normal_force", "speed", "a", "b")
         result = fit_polach(
             curve.creep, curve.adhesion, normal_force=curve.normal_force, speed=curve.speed,
             a=curve.a, b=curve.b, fit=tuple(s.strip() for s in fit.split(",") if s.strip()),
@@ -332,16 +333,29 @@ def fit_polach_cmd(
 def fit_wilac_cmd(
     folder: Path = typer.Argument(..., help="Folder of creep-curve CSVs at several (Q, v, w)."),
     out: Path = typer.Option(Path("wilac.toml"), help="WILAC parameter file to write."),
+    normal_force_range: str | None = typer.Option(
+        None, help="Validity range of Q [N] as 'low,high' (default: span of the data)."
+    ),
+    speed_range: str | None = typer.Option(
+        None, help="Validity range of v [m/s] as 'low,high' (default: span of the data)."
+    ),
+    name: str = typer.Option("", help="Name stored in the parameter file."),
 ) -> None:
     """Calibrate a complete WILAC parameter file from a folder of creep curves."""
-    from railadhesion.calibration.pipeline import calibrate_wilac
-    from railadhesion.io.paramfiles import save_wilac_parameters
+    from railadhesion.calibration.pipeline import calibrate_wilac_to_toml
 
+    kwargs = {"name": name}
+    for key, text in (("normal_force_range", normal_force_range), ("speed_range", speed_range)):
+        if text is not None:
+            values = _floats(text, "--" + key.replace("_", "-"))
+            if values.size != 2:
+                raise typer.BadParameter(f"--{key.replace('_', '-')}: expected 'low,high'")
+            kwargs[key] = (float(values[0]), float(values[1]))
     try:
-        params = calibrate_wilac(folder)
+        calibration = calibrate_wilac_to_toml(folder, out, **kwargs)
     except ValueError as exc:
         _fail(exc)
-    save_wilac_parameters(params, out)
+    console.print(calibration.summary(), highlight=False, markup=False)
     console.print(f"WILAC parameters written to {out}")
 
 

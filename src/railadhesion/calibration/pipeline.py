@@ -46,22 +46,22 @@ __all__ = [
 PAPER_WATER_FLOWS: dict[str, float] = {"dry": 0.0, "damp2": 25.0, "damp1": 35.0, "wet": 350.0}
 
 
-def condition_for_water_flow(water_flow, rule="nearest") -> str:
+def condition_for_water_flow(water_flow, rule="weights") -> str:
     """WILAC condition a creep curve measured at ``water_flow`` calibrates.
 
     Parameters
     ----------
     water_flow : float
         Water flow rate w [µl/s], >= 0.
-    rule : {"nearest", "weights"}, mapping or callable, default "nearest"
-        * ``"nearest"``: the condition whose dataset flow in :data:`PAPER_WATER_FLOWS`
-          (0, 25, 35, 350 µl/s) is nearest to ``w`` (absolute difference; a tie goes to the
-          drier condition). Note that 60 µl/s then maps to ``damp1`` although the paper finds
-          its curve "very similar" to the 350 µl/s one (§6): use ``"weights"`` or an explicit
-          ``condition`` in the CSV header for such curves.
+    rule : {"weights", "nearest"}, mapping or callable, default "weights"
         * ``"weights"``: the condition of largest WILAC blending weight at ``w``
           (:func:`railadhesion.models.wilac.wilac_weights`, paper Table 1 transitions):
-          w < about 15 -> dry, 15-30 -> damp2, 30-50 -> damp1, above -> wet.
+          w < about 15 -> dry, 15-30 -> damp2, 30-50 -> damp1, above -> wet. This agrees with
+          the model that will use the calibrated set, and puts 60 µl/s with the wet curves,
+          as the paper observes (§6: "very similar" to 350 µl/s).
+        * ``"nearest"``: the condition whose dataset flow in :data:`PAPER_WATER_FLOWS`
+          (0, 25, 35, 350 µl/s) is nearest to ``w`` (absolute difference; a tie goes to the
+          drier condition). 60 µl/s then maps to ``damp1``.
         * a mapping ``{condition: reference flow [µl/s]}``: nearest of those flows.
         * a callable ``f(w) -> condition``.
 
@@ -73,9 +73,9 @@ def condition_for_water_flow(water_flow, rule="nearest") -> str:
     Examples
     --------
     >>> condition_for_water_flow(25.0), condition_for_water_flow(60.0)
-    ('damp2', 'damp1')
-    >>> condition_for_water_flow(60.0, "weights")
-    'wet'
+    ('damp2', 'wet')
+    >>> condition_for_water_flow(60.0, "nearest")
+    'damp1'
     """
     from railadhesion.models.wilac import WILAC_CONDITIONS, wilac_weights
 
@@ -221,7 +221,7 @@ def _range(values: np.ndarray, given, name: str, key: str):
 def run_wilac_calibration(
     source,
     *,
-    condition_of_water="nearest",
+    condition_of_water="weights",
     contact: Callable | None = None,
     fit: Sequence[str] = POLACH_NAMES,
     initial=None,
@@ -247,7 +247,7 @@ def run_wilac_calibration(
     ----------
     source : str, path-like or iterable of CreepCurve
         A folder of creep-curve CSV files (``docs/creep-curve-csv.md``) or curves in memory.
-    condition_of_water : str, mapping or callable, default "nearest"
+    condition_of_water : str, mapping or callable, default "weights"
         How a curve's water flow [µl/s] selects its condition; see
         :func:`condition_for_water_flow`. A curve whose CSV header names a ``condition`` uses it.
     contact : callable, optional
