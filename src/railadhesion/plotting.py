@@ -85,10 +85,7 @@ def contact_semi_axes(geometry, normal_force) -> tuple[float, float]:
     q = float(check_positive(normal_force, "normal_force"))
     if isinstance(geometry, str):
         if geometry not in WILAC_GEOMETRIES:
-            raise ValueError(
-                f"geometry must be one of {sorted(WILAC_GEOMETRIES)} or an (a, b) pair in m, "
-                f"got {geometry!r}"
-            )
+            raise _geometry_error(geometry)
         from railadhesion.contact.hertz import hertz_3d
 
         g = WILAC_GEOMETRIES[geometry]
@@ -105,13 +102,17 @@ def contact_semi_axes(geometry, normal_force) -> tuple[float, float]:
     try:
         a, b = (float(x) for x in geometry)
     except (TypeError, ValueError) as exc:
-        raise ValueError(
-            f"geometry must be one of {sorted(WILAC_GEOMETRIES)} or an (a, b) pair in m, "
-            f"got {geometry!r}"
-        ) from exc
+        raise _geometry_error(geometry) from exc
     check_positive(a, "geometry a")
     check_positive(b, "geometry b")
     return a, b
+
+
+def _geometry_error(geometry) -> ValueError:
+    return ValueError(
+        f"geometry must be one of {sorted(WILAC_GEOMETRIES)} or an (a, b) pair in m, "
+        f"got {geometry!r}"
+    )
 
 
 def _params(params):
@@ -129,6 +130,17 @@ def _axes(ax, figsize=(6.4, 4.4)):
         fig = Figure(figsize=figsize, layout="constrained")
         ax = fig.add_subplot()
     return ax.figure, ax
+
+
+def _finish_adhesion_axes(ax, xlabel: str, title: str, xlim, **legend) -> None:
+    """Labels, title, x range, adhesion axis from 0, grid and legend of the adhesion plots."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(_ADHESION_LABEL)
+    ax.set_title(title)
+    ax.set_xlim(*xlim)
+    ax.set_ylim(bottom=0.0)
+    ax.grid(True, alpha=0.3)
+    ax.legend(**legend)
 
 
 def _traction_creep(creep_max: float, n_points: int) -> np.ndarray:
@@ -264,13 +276,12 @@ def plot_wilac_curves(
     fx, _ = wilac_forces(creep[None, :], 0.0, 0.0, q, v, a, b, flows[:, None], p)
     for w, row in zip(flows, np.asarray(fx) / q, strict=True):
         ax.plot(100 * creep, row, label=f"w = {w:g} µl/s")
-    ax.set_xlabel(_CREEP_LABEL)
-    ax.set_ylabel(_ADHESION_LABEL)
-    ax.set_title(f"WILAC, Q = {q / 1e3:g} kN, v = {v:g} m/s (cf. Trummer et al., Fig. 7)")
-    ax.set_xlim(-100 * float(creep_max), 0.0)
-    ax.set_ylim(bottom=0.0)
-    ax.grid(True, alpha=0.3)
-    ax.legend()
+    _finish_adhesion_axes(
+        ax,
+        _CREEP_LABEL,
+        f"WILAC, Q = {q / 1e3:g} kN, v = {v:g} m/s (cf. Trummer et al., Fig. 7)",
+        (-100 * float(creep_max), 0.0),
+    )
     return fig
 
 
@@ -337,13 +348,12 @@ def plot_wilac_water(
     for m in marks:
         if 0 <= m <= wmax:
             ax.axvline(m, color="0.6", lw=0.8, ls=":", zorder=0)
-    ax.set_xlabel(_WATER_LABEL)
-    ax.set_ylabel(_ADHESION_LABEL)
-    ax.set_title(f"WILAC, Q = {q / 1e3:g} kN, v = {v:g} m/s (cf. Trummer et al., Fig. 8)")
-    ax.set_xlim(0.0, wmax)
-    ax.set_ylim(bottom=0.0)
-    ax.grid(True, alpha=0.3)
-    ax.legend()
+    _finish_adhesion_axes(
+        ax,
+        _WATER_LABEL,
+        f"WILAC, Q = {q / 1e3:g} kN, v = {v:g} m/s (cf. Trummer et al., Fig. 8)",
+        (0.0, wmax),
+    )
     return fig
 
 
@@ -436,13 +446,11 @@ def plot_wilac_speeds(
                 100 * creep, row, color=col, ls="--",
                 label=f"Polach, fixed parameters of {vp:g} m/s, v = {v:g} m/s",
             )
-    ax.set_xlabel(_CREEP_LABEL)
-    ax.set_ylabel(_ADHESION_LABEL)
-    ax.set_title(
-        f"WILAC, Q = {q / 1e3:g} kN, w = {w:g} µl/s (cf. Trummer et al., Figs. 9 and 11)"
+    _finish_adhesion_axes(
+        ax,
+        _CREEP_LABEL,
+        f"WILAC, Q = {q / 1e3:g} kN, w = {w:g} µl/s (cf. Trummer et al., Figs. 9 and 11)",
+        (-100 * float(creep_max), 0.0),
+        fontsize="small",
     )
-    ax.set_xlim(-100 * float(creep_max), 0.0)
-    ax.set_ylim(bottom=0.0)
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize="small")
     return fig

@@ -50,6 +50,8 @@ _SPIN_TO_PER_MM = 1e-3
 #: Target number of array elements (contacts x strips) processed together: keeps the march's
 #: working arrays in cache for large batches.
 _CHUNK_ELEMENTS = 16384
+#: [Pa]; keeps g/|p| finite where p = 0 in the march (tractions that small are irrelevant).
+_TINY_TRACTION = 1e-30
 
 
 @dataclass(frozen=True)
@@ -460,6 +462,32 @@ def _check_count(value, name: str) -> int:
     return k
 
 
+def _clip_to_bound(px, py, g, slip, r, tmp):
+    """Scale the tractions (px, py) back onto the bound ``g`` where ``|p| > g``, in place.
+
+    The step shared by both grid layouts: ``slip`` receives the flags ``|p| > g``; the factor
+    is ``min(1, g/|p|)``, so the traction keeps its direction. ``r`` and ``tmp`` are work
+    arrays of the same shape (overwritten).
+    """
+    np.multiply(px, px, out=r)
+    np.multiply(py, py, out=tmp)
+    r += tmp
+    np.sqrt(r, out=r)
+    np.greater(r, g, out=slip)
+    r += _TINY_TRACTION
+    np.divide(g, r, out=tmp)
+    np.minimum(tmp, 1.0, out=tmp)
+    px *= tmp
+    py *= tmp
+
+
+def _store_column(store, i, px, py, slip) -> None:
+    """Copy the tractions and slip flags of column ``i`` into the (m, ny, nx) ``store``."""
+    store[0][:, :, i] = px
+    store[1][:, :, i] = py
+    store[2][:, :, i] = slip
+
+
 def _march(xi, eta, phi, fz, a, b, mu, l1, l2, l3, nx, eta_j, sq, tx, gy, norm, store):
     """FASTSIM march for a chunk of m contacts; returns (fx, fy, mz, slip_fraction), each (m,).
 
@@ -492,32 +520,19 @@ def _march(xi, eta, phi, fz, a, b, mu, l1, l2, l3, nx, eta_j, sq, tx, gy, norm, 
     g = np.empty_like(px)
     tmp = np.empty_like(px)
     slip = np.empty(px.shape, dtype=bool)
-    tiny = 1e-30  # [Pa]; keeps g/|p| finite where p = 0 (tractions that small are irrelevant)
     for i in range(nx):
         if i > 0:
             inc += dpy1
             px += dpx
             py += inc
-        np.multiply(px, px, out=r)
-        np.multiply(py, py, out=tmp)
-        r += tmp
-        np.sqrt(r, out=r)
         np.multiply(gfac, tx[i], out=g)
-        np.greater(r, g, out=slip)
-        # scale back onto the bound where it is exceeded: factor min(1, g/|p|)
-        r += tiny
-        np.divide(g, r, out=tmp)
-        np.minimum(tmp, 1.0, out=tmp)
-        px *= tmp
-        py *= tmp
+        _clip_to_bound(px, py, g, slip, r, tmp)
         spx += px
         spy += py
         qpy += spy
         nslip += slip
         if store is not None:
-            store[0][:, :, i] = px
-            store[1][:, :, i] = py
-            store[2][:, :, i] = slip
+            _store_column(store, i, px, py, slip)
 
     dy = (2.0 / eta_j.size) * b  # (m,)
     da = dx * dy[:, col]  # cell area per strip (m, ny)
@@ -562,7 +577,6 @@ def _march_rect(xi, eta, phi, fz, a, b, mu, l1, l2, l3, scale, rect, store):
     g = np.empty_like(y)
     tmp = np.empty_like(y)
     slip = np.empty(y.shape, dtype=bool)
-    tiny = 1e-30  # [Pa]; keeps g/|p| finite where p = 0
     for i in range(nx):
         m_i = mask[i]
         # step from the previous element; elements outside the contact reset to zero
@@ -570,26 +584,15 @@ def _march_rect(xi, eta, phi, fz, a, b, mu, l1, l2, l3, scale, rect, store):
         px *= m_i
         py += dpy[i]
         py *= m_i
-        np.multiply(px, px, out=r)
-        np.multiply(py, py, out=tmp)
-        r += tmp
-        np.sqrt(r, out=r)
         np.multiply(gfac, shape[i], out=g)
-        np.greater(r, g, out=slip)
-        r += tiny
-        np.divide(g, r, out=tmp)
-        np.minimum(tmp, 1.0, out=tmp)
-        px *= tmp
-        py *= tmp
+        _clip_to_bound(px, py, g, slip, r, tmp)
         spx += px
         spy += py
         np.multiply(py, xh[i], out=tmp)
         sxpy += tmp
         nslip += slip
         if store is not None:
-            store[0][:, :, i] = px
-            store[1][:, :, i] = py
-            store[2][:, :, i] = slip
+            _store_column(store, i, px, py, slip)
 
     da = dx * dy
     fx = spx.sum(axis=1) * da

@@ -419,7 +419,13 @@ def hertz_3d(
     Notes
     -----
     A = (1/R_wx + 1/R_rx)/2, B = (1/R_wy + 1/R_ry)/2, then
-    :func:`hertz_3d_from_curvatures` (exact Hertz solution; Johnson 1985, section 4.2).
+    :func:`hertz_3d_from_curvatures` (exact Hertz solution; Johnson 1985, section 4.2,
+    eqs. 4.36-4.39, written as in CONTACT ``hzcalc3d``).
+
+    References
+    ----------
+    K. L. Johnson, *Contact Mechanics*, Cambridge University Press, 1985, chapter 4.
+    E. A. H. Vollebregt, CONTACT, ``src/m_hertz.f90``, subroutine ``hzcalc3d``.
 
     Examples
     --------

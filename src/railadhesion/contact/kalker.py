@@ -106,6 +106,14 @@ def _nu_weights(nu: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return w0, w1, w2
 
 
+def _nu_blend(w, c0, c1, c2):
+    """C at nu from the columns C(0), C(1/4), C(1/2) and the weights ``w`` of :func:`_nu_weights`.
+
+    The parabola in 1/C (CONTACT linrol): ``1/C = w0/C(0) + w1/C(1/4) + w2/C(1/2)``.
+    """
+    return 1.0 / (w[0] / c0 + w[1] / c1 + w[2] / c2)
+
+
 def _asymptotes(g: np.ndarray, nu: np.ndarray, le: np.ndarray) -> np.ndarray:
     """Kalker's small-g asymptotes of C11, C22, C23, C33; shape (4, *g.shape).
 
@@ -218,8 +226,8 @@ def kalker_coefficients(a_over_b, poisson) -> KalkerCoefficients:
     i = np.minimum(s.astype(np.intp), _NROW - 2)
     f = (s - i)[..., None, None]
     cg = _ROWS[i] * (1.0 - f) + _ROWS[i + 1] * f  # (*shape, 4 coefficients, 3 nu columns)
-    w0, w1, w2 = _nu_weights(nu[..., None])
-    coef = np.moveaxis(1.0 / (w0 / cg[..., 0] + w1 / cg[..., 1] + w2 / cg[..., 2]), -1, 0)
+    w = _nu_weights(nu[..., None])
+    coef = np.moveaxis(_nu_blend(w, cg[..., 0], cg[..., 1], cg[..., 2]), -1, 0)
 
     small = g < _G_MIN
     if np.any(small):
@@ -229,10 +237,10 @@ def kalker_coefficients(a_over_b, poisson) -> KalkerCoefficients:
         # where g < 0.1, ``coef`` holds the table value at g = 0.1 (t was clipped above)
         corrected = asym * (1.0 + (coef[:, small] / asym01 - 1.0) * (gs / _G_MIN))
         # C33 on the b/a -> 0 branch: nu parabola at b/a = 0.1 and 0.2, then a power law in g
-        v0, v1, v2 = _nu_weights(nus)
+        w_small = _nu_weights(nus)
         r01, r02 = _C33_GT_ROWS
-        c33_01 = 1.0 / (v0 / r01[0] + v1 / r01[1] + v2 / r01[2])
-        c33_02 = 1.0 / (v0 / r02[0] + v1 / r02[1] + v2 / r02[2])
+        c33_01 = _nu_blend(w_small, *r01)
+        c33_02 = _nu_blend(w_small, *r02)
         c33_gt = c33_01 * (gs / _G_MIN) ** (np.log(c33_02 / c33_01) / np.log(2.0))
         corrected[3] = np.where(les, corrected[3], c33_gt)
         coef[:, small] = corrected
@@ -243,9 +251,7 @@ def _coefficients_scalar(r: float, nu: float) -> tuple[float, float, float, floa
     """Same as :func:`kalker_coefficients` for one (already validated) pair, in plain floats."""
     le = r <= 1.0
     g = r if le else 1.0 / r
-    w0 = 8.0 * (nu - 0.25) * (nu - 0.5)
-    w1 = -16.0 * (nu - 0.5) * nu
-    w2 = 8.0 * nu * (nu - 0.25)
+    w = _nu_weights(nu)
     t = g if le else 2.0 - g
     s = (min(max(t, 0.1), 1.9) - 0.1) * 10.0
     if abs(s - round(s)) < 1e-9:
@@ -258,7 +264,7 @@ def _coefficients_scalar(r: float, nu: float) -> tuple[float, float, float, floa
         c0 = lo[k][0] * (1.0 - f) + hi[k][0] * f
         c1 = lo[k][1] * (1.0 - f) + hi[k][1] * f
         c2 = lo[k][2] * (1.0 - f) + hi[k][2] * f
-        coef.append(1.0 / (w0 / c0 + w1 / c1 + w2 / c2))
+        coef.append(_nu_blend(w, c0, c1, c2))
     if g >= _G_MIN:
         return tuple(coef)
     asym = _asymptotes_scalar(g, nu, le)
@@ -267,8 +273,8 @@ def _coefficients_scalar(r: float, nu: float) -> tuple[float, float, float, floa
     out = [a * (1.0 + (c / a01 - 1.0) * h) for a, a01, c in zip(asym, asym01, coef, strict=True)]
     if not le:
         r01, r02 = _C33_GT_ROWS_LIST
-        c33_01 = 1.0 / (w0 / r01[0] + w1 / r01[1] + w2 / r01[2])
-        c33_02 = 1.0 / (w0 / r02[0] + w1 / r02[1] + w2 / r02[2])
+        c33_01 = _nu_blend(w, *r01)
+        c33_02 = _nu_blend(w, *r02)
         out[3] = c33_01 * (g / _G_MIN) ** (math.log(c33_02 / c33_01) / math.log(2.0))
     return tuple(out)
 

@@ -124,7 +124,7 @@ def polach_forces(
     Notes
     -----
     With s_x = xi, s_y = eta, psi = phi, s = sqrt(s_x^2 + s_y^2) (Polach 1999, 2005; the
-    numbering below is that of Polach 2005, section 2, which restates the 1999 model):
+    formulas below are those of Polach 2005, section 2, which restates the 1999 model):
 
     * spin-corrected lateral creepage: s_yC = s_y + psi a if abs(s_y + psi a) > abs(s_y), else
       s_y; s_C = sqrt(s_x^2 + s_yC^2);
@@ -202,37 +202,63 @@ def polach_forces(
         creep_long, creep_lat, spin, normal_force, speed, a, b,
         mu0, k_A, k_S, A, B, shear_modulus, poisson,
     )  # fmt: skip
+    scalars = _scalars(args)
+    if scalars is None:
+        return _polach_array(*args)
+    return _polach_scalar(*scalars)
+
+
+def _scalars(values) -> list | None:
+    """``values`` for the scalar fast path, or ``None`` if any of them is not a real scalar.
+
+    Python and NumPy scalars and 0-d arrays qualify (no array work is then needed); ``float``,
+    ``int`` and ``numpy.float64`` are passed through, other NumPy scalars and 0-d arrays become
+    floats.
+    """
     scalars = []
-    for v in args:  # fast path for scalars (Python, NumPy or 0-d arrays): no array work
+    for v in values:
         if type(v) in _SCALAR_TYPES:
             scalars.append(v)
         elif isinstance(v, np.generic | np.ndarray) and v.ndim == 0 and v.dtype.kind in "fiu":
             scalars.append(float(v))
         else:
-            return _polach_array(*args)
-    return _polach_scalar(*scalars)
+            return None
+    return scalars
 
 
 def _bad(name: str, rng: str, value) -> ValueError:
     return ValueError(f"{name} must be in {rng}, got {float(value)!r}")
 
 
-def _polach_scalar(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu):
-    """Scalar path of :func:`polach_forces` with the ``math`` module (a few microseconds)."""
+def _polach_scalar(
+    sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu, check_contact=True
+):
+    """Scalar path of :func:`polach_forces` with the ``math`` module (a few microseconds).
+
+    ``check_contact=False`` checks only the five model parameters: for a caller (WILAC) that
+    evaluates several parameter sets on one contact whose other inputs an earlier call with
+    ``check_contact=True`` has already validated.
+    """
     isf = math.isfinite
-    for name, val in (("creep_long", sx), ("creep_lat", sy), ("spin", psi)):
-        if not isf(val):
-            raise ValueError(f"{name} must be finite (no NaN or inf), got {float(val)!r}")
-    for name, val in (
-        ("normal_force", q), ("a", a), ("b", b), ("mu0", mu0), ("k_A", k_a), ("k_S", k_s),
-        ("shear_modulus", g),
-    ):  # fmt: skip
+    if check_contact:
+        for name, val in (("creep_long", sx), ("creep_lat", sy), ("spin", psi)):
+            if not isf(val):
+                raise ValueError(f"{name} must be finite (no NaN or inf), got {float(val)!r}")
+        positive = (
+            ("normal_force", q), ("a", a), ("b", b), ("mu0", mu0), ("k_A", k_a), ("k_S", k_s),
+            ("shear_modulus", g),
+        )  # fmt: skip
+        nonnegative = (("speed", v), ("A", big_a), ("B", big_b))
+    else:
+        positive = (("mu0", mu0), ("k_A", k_a), ("k_S", k_s))
+        nonnegative = (("A", big_a), ("B", big_b))
+    for name, val in positive:
         if not (val > 0 and isf(val)):
             raise _bad(name, "(0, inf)", val)
-    for name, val in (("speed", v), ("A", big_a), ("B", big_b)):
+    for name, val in nonnegative:
         if not (val >= 0 and isf(val)):
             raise _bad(name, "[0, inf)", val)
-    if not 0.0 <= nu <= 0.5:
+    if check_contact and not 0.0 <= nu <= 0.5:
         raise _bad("poisson", "[0.0, 0.5]", nu)
 
     c11, c22, c23 = _kalker_scalar(a / b, float(nu))

@@ -34,7 +34,7 @@ from scipy.special import erf
 
 from railadhesion._validate import check_choice, check_nonnegative, check_positive
 from railadhesion.models.parameters import PARAMETER_RANGES
-from railadhesion.models.polach import polach_forces
+from railadhesion.models.polach import _polach_scalar, _scalars, polach_forces
 from railadhesion.models.regression import ParameterRegression
 
 __all__ = [
@@ -230,8 +230,15 @@ def wilac_weights(water_flow, transitions=PAPER_TRANSITIONS) -> np.ndarray:
 
     Notes
     -----
-    Trummer et al. (seed 000), section 5.3: f_Dry = 1 − e_1, f_Damp2 = e_1 − e_2,
-    f_Damp1 = e_2 − e_3, f_Wet = e_3, with e_i from :func:`wilac_transitions`.
+    Trummer et al. (seed 000), section 5.3, the equations for f_i: f_Dry = 1 − e_1,
+    f_Damp2 = e_1 − e_2, f_Damp1 = e_2 − e_3, f_Wet = e_3, with e_i from
+    :func:`wilac_transitions`.
+
+    References
+    ----------
+    G. Trummer, L.E. Buckley-Johnstone, P. Voltr, A. Meierhofer, R. Lewis, K. Six.
+    Wheel-rail creep force model for predicting water induced low adhesion phenomena.
+    Tribology International 109 (2017) 409–415.
 
     Examples
     --------
@@ -497,9 +504,10 @@ class WilacParameters:
 
         Notes
         -----
-        Seed 000, section 5.2: each parameter is a linear regression on Q' = Q/Q_ref and
-        v' = v/v_ref. Inputs are clamped into the calibrated ranges first (parameters are held
-        at the boundary values), outputs clipped to the physical ranges.
+        Trummer et al. (seed 000), section 5.2, the regression equation given there for k_A:
+        each parameter is a linear regression on Q' = Q/Q_ref and v' = v/v_ref. Inputs are
+        clamped into the calibrated ranges first (parameters are held at the boundary values),
+        outputs clipped to the physical ranges.
 
         Examples
         --------
@@ -559,9 +567,9 @@ def _compile_condition(cond: WilacCondition) -> tuple:
     return tuple(plan)
 
 
-def _scalar_condition(plan: tuple, qn: float, vn: float) -> list[float]:
-    """Scalar twin of :func:`_evaluate_condition` with Python floats (about a microsecond)."""
-    fac = (
+def _scalar_factors(qn: float, vn: float) -> tuple:
+    """Scalar twin of :func:`_factor_arrays` (computed once per call, shared by the conditions)."""
+    return (
         qn,
         vn,
         1.0 / qn,
@@ -569,6 +577,10 @@ def _scalar_condition(plan: tuple, qn: float, vn: float) -> list[float]:
         math.exp(qn) if qn < 700.0 else math.inf,
         math.exp(vn) if vn < 700.0 else math.inf,
     )
+
+
+def _scalar_condition(plan: tuple, fac: tuple) -> list[float]:
+    """Scalar twin of :func:`_array_condition` with Python floats: k_A, k_S, mu0, A, B."""
     out = []
     for terms, lo, hi in plan:
         total = 0.0
@@ -655,14 +667,23 @@ def wilac_forces(
 
     Notes
     -----
-    Seed 000, sections 5.1–5.3: for each condition i the Polach forces T_i with that
-    condition's parameters (:meth:`WilacParameters.polach_parameters`), blended
-    T = f_Dry T_Dry + f_Damp2 T_Damp2 + f_Damp1 T_Damp1 + f_Wet T_Wet with the weights of
+    Trummer et al. (seed 000), sections 5.1–5.3: for each condition i the Polach forces T_i
+    with that condition's parameters (:meth:`WilacParameters.polach_parameters`), blended by
+    the weighted sum of section 5.3,
+    T = f_Dry T_Dry + f_Damp2 T_Damp2 + f_Damp1 T_Damp1 + f_Wet T_Wet, with the weights of
     :func:`wilac_weights`. Conditions whose weight is exactly zero for every element are not
     evaluated; the others go through a single call of
     :func:`railadhesion.models.polach.polach_forces` (stacked on an extra axis). Scalar
     arguments take a fast path (about 10–50 µs a call, depending on how many conditions have
     non-zero weight).
+
+    References
+    ----------
+    G. Trummer, L.E. Buckley-Johnstone, P. Voltr, A. Meierhofer, R. Lewis, K. Six.
+    Wheel-rail creep force model for predicting water induced low adhesion phenomena.
+    Tribology International 109 (2017) 409–415.
+    O. Polach, Creep forces in simulations of traction vehicles running on adhesion limit,
+    Wear 258, 2005, 992-1000 (the Polach model, :func:`railadhesion.models.polach.polach_forces`).
 
     Examples
     --------
@@ -732,15 +753,28 @@ def _wilac_scalar(sx, sy, psi, q, v, a, b, w, params, g, nu):
     vlo, vhi = params.speed_range
     qn = min(max(q, qlo), qhi) / params.normal_force_ref
     vn = min(max(v, vlo), vhi) / params.speed_ref
+    fac = _scalar_factors(qn, vn)
+    # Scalar creepages and geometry: Polach's scalar path directly, the contact validated once
+    # (with the first condition; the result is the same as polach_forces for each condition).
+    contact = _scalars((sx, sy, psi, a, b, g, nu))
+    contact_checked = False
     fx = fy = 0.0
     for cond, f in zip(WILAC_CONDITIONS, weights, strict=True):
         if f == 0.0:
             continue
-        k_a, k_s, mu0, big_a, big_b = _scalar_condition(params._scalar_plan[cond], qn, vn)
-        fxi, fyi = polach_forces(
-            sx, sy, psi, q, v, a, b, mu0=mu0, k_A=k_a, k_S=k_s, A=big_a, B=big_b,
-            shear_modulus=g, poisson=nu,
-        )  # fmt: skip
+        k_a, k_s, mu0, big_a, big_b = _scalar_condition(params._scalar_plan[cond], fac)
+        if contact is None:
+            fxi, fyi = polach_forces(
+                sx, sy, psi, q, v, a, b, mu0=mu0, k_A=k_a, k_S=k_s, A=big_a, B=big_b,
+                shear_modulus=g, poisson=nu,
+            )  # fmt: skip
+        else:
+            c_sx, c_sy, c_psi, c_a, c_b, c_g, c_nu = contact
+            fxi, fyi = _polach_scalar(
+                c_sx, c_sy, c_psi, q, v, c_a, c_b, mu0, k_a, k_s, big_a, big_b, c_g, c_nu,
+                check_contact=not contact_checked,
+            )  # fmt: skip
+            contact_checked = True
         fx = fx + f * fxi
         fy = fy + f * fyi
     return fx, fy
