@@ -1,0 +1,14 @@
+"""Test configuration.
+
+Hypothesis explores new random examples on every local run (to find bugs); under CI (the CI
+environment variable is set by `.ci/run`'s runner) it is derandomised so that a landing
+never depends on luck. Run `CI=true python3 -m pytest` to reproduce CI exactly.
+"""
+
+import os
+
+from hypothesis import settings
+
+settings.register_profile("ci", derandomize=True, database=None, print_blob=True)
+if os.environ.get("CI"):
+    settings.load_profile("ci")
