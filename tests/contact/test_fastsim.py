@@ -576,3 +576,29 @@ def test_bad_input(kwargs, name):
     args.update(kwargs)
     with pytest.raises(ValueError, match=name):
         fastsim(**args)
+
+
+# ---------------------------------------------------------------------------- audit: inputs
+
+
+@pytest.mark.parametrize(
+    "name", ["creep_long", "creep_lat", "spin", "normal_force", "a", "b", "mu",
+             "shear_modulus", "poisson"],
+)  # fmt: skip
+def test_nan_in_every_argument_raises_naming_it(name):
+    args = dict(creep_long=1e-3, creep_lat=0.0, spin=0.0, normal_force=80e3, a=6e-3, b=4e-3,
+                mu=0.3)  # fmt: skip
+    args[name] = np.array([0.3, np.nan])
+    with pytest.raises(ValueError) as info:
+        fastsim(**args)
+    # anchored: test_bad_input's match="a" / match="b" accepts almost any message
+    assert str(info.value).startswith(f"{name} must be")
+
+
+def test_absurd_axis_ratio_raises_naming_a_and_b():
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a/b = 1e600 used to warn "overflow in divide"
+        with pytest.raises(ValueError, match=r"^a, b: the axis ratio a/b must be in"):
+            fastsim(1e-3, 0.0, 0.0, 8e4, 1e300, 1e-300, 0.3)

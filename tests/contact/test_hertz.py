@@ -353,3 +353,47 @@ def test_hertz_from_curvatures_bad_input(args, name):
 def test_line_contact_bad_input(func, args, name):
     with pytest.raises(ValueError, match=name):
         func(*args)
+
+
+# ------------------------------------------------------------- audit: extreme curvature ratio
+
+
+@pytest.mark.parametrize("ratio", [1e31, 1e34, 1e40, 1e300])
+def test_curvature_ratio_beyond_solver_bracket_raises(ratio):
+    """The axis-ratio solve brackets k = b/a >= e^-40, i.e. curvature ratios up to ~1.4e33.
+    Beyond, it used to return k = e^-40 silently (same ellipse for 1e34 and 1e300)."""
+    for args in ((1e5, 1.0, ratio), (1e5, [ratio], 1.0)):
+        with pytest.raises(ValueError, match=r"^curvature_A, curvature_B: the curvature ratio"):
+            hertz_3d_from_curvatures(*args)
+
+
+@pytest.mark.parametrize("ratio", [1e10, 1e20, 1e30])
+def test_very_slender_ellipse_solves_the_hertz_equation(ratio):
+    # exact relation B/A = (E/k^2 - K)/(K - E); for k -> 0, K = ln(4/k), E = 1 (to O(k^2 ln k))
+    for h in (hertz_3d_from_curvatures(1e5, 1.0, ratio),
+              hertz_3d_from_curvatures(1e5, np.array([1.0]), ratio)):  # fmt: skip
+        k = float(np.min(h.b) / np.max(h.a))
+        lnk = math.log(4 / k)
+        assert (1 / k**2 - lnk) / (lnk - 1) == pytest.approx(ratio, rel=1e-6)
+
+
+@pytest.mark.parametrize(
+    "kwargs, name",
+    [
+        ({"young": np.nan}, "young"),
+        ({"poisson": np.nan}, "poisson"),
+        ({"young_rail": np.nan}, "young_rail"),
+        ({"poisson_rail": np.nan}, "poisson_rail"),
+        ({"rail_radius": np.nan}, "rail_radius"),
+        ({"rail_lateral_radius": np.nan}, "rail_lateral_radius"),
+        ({"normal_force": np.nan}, "normal_force"),
+        ({"wheel_radius": np.nan}, "wheel_radius"),
+    ],
+)
+def test_hertz_3d_nan_in_every_argument(kwargs, name):
+    args = dict(normal_force=1e5, wheel_radius=0.46, wheel_lateral_radius=np.inf,
+                rail_lateral_radius=0.3)  # fmt: skip
+    args.update(kwargs)
+    with pytest.raises(ValueError) as info:
+        hertz_3d(**args)
+    assert str(info.value).startswith(f"{name} must be")

@@ -330,3 +330,55 @@ def test_linear_forces_bad_input(kwargs, name):
     args.update(kwargs)
     with pytest.raises(ValueError, match=name):
         linear_creep_forces(**args)
+
+
+# ------------------------------------------------------------------ audit: extreme axis ratios
+
+
+@pytest.mark.parametrize("aob", [1e-160, 1e-200, 1e-320, 1e155, 1e200, 1e300])
+def test_axis_ratio_beyond_representable_range_raises(aob):
+    """Beyond a/b in [1e-150, 1e150] the asymptotes over/underflow: formerly the scalar path
+    raised ZeroDivisionError (b/a < 1e-154) or returned inf (a/b = 1e-320), and the array
+    path emitted RuntimeWarnings even on the valid branch (both branches are evaluated)."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for value in (aob, np.array([0.5, aob])):
+            with pytest.raises(ValueError, match=r"^a_over_b must be in \[1e-150, 1e\+150\]"):
+                kalker_coefficients(value, 0.28)
+
+
+@pytest.mark.parametrize("aob", [1e-150, 1e-100, 1e100, 1e150])
+def test_axis_ratio_at_the_range_limits_is_finite_without_warnings(aob):
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for nu in (0.0, 0.28, 0.5):
+            scalar = np.array(kalker_coefficients(aob, nu))
+            array = np.array(kalker_coefficients(np.array([aob, 1.0 / aob, 0.5]), nu))
+            assert np.all(np.isfinite(array)) and np.all(array > 0)
+            np.testing.assert_allclose(scalar, array[:, 0], rtol=1e-12)
+
+
+def test_linear_forces_absurd_semi_axes_name_a_and_b():
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a/b = 1e600 used to warn "overflow in divide"
+        with pytest.raises(ValueError, match=r"^a, b: the axis ratio a/b must be in"):
+            linear_creep_forces(1e-3, 0.0, 0.0, 1e300, 1e-300, 8e10, 0.28)
+
+
+@pytest.mark.parametrize(
+    "name", ["creep_long", "creep_lat", "spin", "a", "b", "shear_modulus", "poisson"]
+)
+def test_linear_forces_nan_in_every_argument(name):
+    args = dict(creep_long=1e-3, creep_lat=0.0, spin=0.0, a=6e-3, b=4e-3, shear_modulus=8e10,
+                poisson=0.28)  # fmt: skip
+    args[name] = np.array([1.0, np.nan]) if name != "poisson" else np.nan
+    with pytest.raises(ValueError) as info:
+        linear_creep_forces(**args)
+    # anchored: match="a" or match="b" (test_linear_forces_bad_input) accepts any message
+    assert str(info.value).startswith(f"{name} must be")

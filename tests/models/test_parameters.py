@@ -126,3 +126,24 @@ def test_text_fields_must_be_strings():
 def test_any_value_in_range_is_accepted(values):
     p = PolachParameters(**dict(zip(PARAMETER_RANGES, values, strict=True)))
     assert all(math.isfinite(v) for v in p.as_dict().values())
+
+
+@pytest.mark.parametrize("value", ["0.5", b"0.5", [0.5], (0.5,)])
+def test_non_scalar_or_text_values_are_rejected(value):
+    """float() accepts numeric strings and 1-element sequences/arrays: they used to pass."""
+    import numpy as np
+
+    for bad in (value, np.array(value) if not isinstance(value, str | bytes) else value):
+        kw = dict(GOOD)
+        kw["k_A"] = bad
+        with pytest.raises(ValueError, match=r"^k_A must be a real number in \(0, 1\]"):
+            PolachParameters(**kw)
+
+
+def test_numpy_bool_rejected_and_numpy_scalars_accepted():
+    import numpy as np
+
+    with pytest.raises(ValueError, match="mu0"):
+        PolachParameters(**{**GOOD, "mu0": np.True_})
+    p = PolachParameters(**{**GOOD, "mu0": np.float32(0.25), "B": np.array(0.3)})
+    assert p.mu0 == 0.25 and isinstance(p.mu0, float) and isinstance(p.B, float)

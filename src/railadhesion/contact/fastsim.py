@@ -34,7 +34,7 @@ from railadhesion._validate import (
     check_positive,
     check_range,
 )
-from railadhesion.contact.kalker import kalker_coefficients
+from railadhesion.contact.kalker import axis_ratio, kalker_coefficients
 
 __all__ = ["FastsimResult", "fastsim"]
 
@@ -143,11 +143,12 @@ def _rect_pattern(nx: int, ny: int, scale: float, bound: str):
 
 def _flexibilities(a, b, xi, eta, phi, normal_force, mu, g_mod, nu, blended):
     """Kalker's three flexibilities L1, L2, L3 [m^3/N], optionally blended (CONTACT 2023)."""
-    coef = kalker_coefficients(a / b, nu)
+    a_over_b = axis_ratio(a, b)
+    coef = kalker_coefficients(a_over_b, nu)
     c11, c22, c23 = coef.c11, coef.c22, coef.c23
     l1 = 8.0 * a / (3.0 * g_mod * c11)
     l2 = 8.0 * a / (3.0 * g_mod * c22)
-    l3 = np.pi * a * np.sqrt(a / b) / (4.0 * g_mod * c23)
+    l3 = np.pi * a * np.sqrt(a_over_b) / (4.0 * g_mod * c23)
     if not blended:
         return l1, l2, l3
     # Vollebregt & Voltr (2023): blend the three flexibilities towards one combined value as the

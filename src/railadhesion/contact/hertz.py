@@ -33,6 +33,9 @@ __all__ = [
 # curvature ratio up to ~1e35.
 _LNK_MIN = -40.0
 _MAX_ITER = 80
+#: Largest accepted curvature ratio max(A, B)/min(A, B): F(e^_LNK_MIN) is about 1.4e33; beyond
+#: the bracket the solve would silently return k = e^-40 (a wrong ellipse).
+_RATIO_MAX = 1e30
 
 
 def _scalar_or_array(x):
@@ -267,7 +270,7 @@ def hertz_3d_from_curvatures(
         Gap coefficient A along the rolling direction x [1/m], > 0: the undeformed gap is
         h = A x^2 + B y^2, A = (1/R_wx + 1/R_rx)/2.
     curvature_B : array_like
-        Gap coefficient B along y [1/m], > 0.
+        Gap coefficient B along y [1/m], > 0; max(A, B)/min(A, B) <= 1e30.
     young, poisson : array_like
         Young's modulus [Pa] and Poisson's ratio [-] of the wheel (and of the rail unless
         ``young_rail``/``poisson_rail`` are given).
@@ -313,6 +316,14 @@ def hertz_3d_from_curvatures(
 def _hertz_core(q, ca, cb, young, poisson, young_rail, poisson_rail) -> HertzContact:
     """Solve the validated problem; ``q``, ``ca``, ``cb`` are float arrays, A, B > 0."""
     e_star = combined_elastic_constants(young, poisson, young_rail, poisson_rail)[0]
+    with np.errstate(over="ignore"):
+        ratio_ok = np.all((ca <= _RATIO_MAX * cb) & (cb <= _RATIO_MAX * ca))
+    if not ratio_ok:
+        raise ValueError(
+            f"curvature_A, curvature_B: the curvature ratio max(A, B)/min(A, B) must be in "
+            f"[1, {_RATIO_MAX:g}], got A = {np.ravel(ca)[:3].tolist()}, "
+            f"B = {np.ravel(cb)[:3].tolist()} 1/m"
+        )
     if q.ndim == 0 and ca.ndim == 0 and cb.ndim == 0 and np.ndim(e_star) == 0:
         return _hertz_scalar(float(q), float(ca), float(cb), float(e_star))
     q, ca, cb, e_star = np.broadcast_arrays(q, ca, cb, e_star)

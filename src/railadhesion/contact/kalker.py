@@ -35,6 +35,10 @@ __all__ = ["KalkerCoefficients", "kalker_coefficients", "linear_creep_forces"]
 
 #: Smallest tabulated g = min(a/b, b/a); below it the asymptotes apply.
 _G_MIN = 0.1
+#: Accepted range of a/b. Beyond it the asymptotes over- or underflow (g**2, g**1.5, 1/g):
+#: no contact ellipse is that slender, and a clear error beats inf, NaN or a RuntimeWarning.
+_AOB_MIN = 1e-150
+_AOB_MAX = 1e150
 
 
 class KalkerCoefficients(NamedTuple):
@@ -152,7 +156,7 @@ def kalker_coefficients(a_over_b, poisson) -> KalkerCoefficients:
     ----------
     a_over_b : array_like
         Ratio of the contact semi-axes a/b [-], ``a`` along the rolling direction x, ``b``
-        lateral; in (0, inf).
+        lateral; in [1e-150, 1e150] (beyond, the asymptotic formulas over- or underflow).
     poisson : array_like
         Poisson's ratio nu [-], in [0, 0.5] (combined value of wheel and rail, see
         :func:`railadhesion.contact.hertz.combined_elastic_constants`).
@@ -210,7 +214,7 @@ def kalker_coefficients(a_over_b, poisson) -> KalkerCoefficients:
     >>> [round(float(x), 3) for x in kalker_coefficients(1.6, 0.28)]
     [4.824, 4.484, 2.188, 0.895]
     """
-    r = check_positive(a_over_b, "a_over_b")
+    r = check_range(a_over_b, "a_over_b", _AOB_MIN, _AOB_MAX)
     nu = check_range(poisson, "poisson", 0.0, 0.5)
     if r.ndim == 0 and nu.ndim == 0:
         return KalkerCoefficients(*_coefficients_scalar(float(r), float(nu)))
@@ -300,6 +304,19 @@ def _asymptotes_scalar(g: float, nu: float, le: bool) -> tuple[float, float, flo
     )
 
 
+def axis_ratio(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a/b of validated semi-axes, or ValueError naming a and b if it is out of the range of
+    :func:`kalker_coefficients` (no overflow warning for absurd pairs such as 1e300/1e-300)."""
+    with np.errstate(over="ignore", under="ignore"):
+        r = np.true_divide(a, b)
+    if not np.all((r >= _AOB_MIN) & (r <= _AOB_MAX)):
+        raise ValueError(
+            f"a, b: the axis ratio a/b must be in [{_AOB_MIN:g}, {_AOB_MAX:g}], got "
+            f"{np.ravel(r)[:3].tolist()}"
+        )
+    return r
+
+
 def linear_creep_forces(creep_long, creep_lat, spin, a, b, shear_modulus, poisson):
     """Creep forces and spin moment of Kalker's linear theory (small creepages, full stick).
 
@@ -365,7 +382,7 @@ def linear_creep_forces(creep_long, creep_lat, spin, a, b, shear_modulus, poisso
     a_ = check_positive(a, "a")
     b_ = check_positive(b, "b")
     g_mod = check_positive(shear_modulus, "shear_modulus")
-    coef = kalker_coefficients(a_ / b_, poisson)
+    coef = kalker_coefficients(axis_ratio(a_, b_), poisson)
     c = np.sqrt(a_ * b_)
     gc2 = g_mod * c * c
     gc3 = gc2 * c

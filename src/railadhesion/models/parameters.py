@@ -31,6 +31,8 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 __all__ = [
     "PARAMETER_RANGES",
     "POLACH_PARAMETER_SETS",
@@ -104,7 +106,8 @@ class PolachParameters:
         for field, (low, high, low_closed, high_closed) in PARAMETER_RANGES.items():
             raw = getattr(self, field)
             rng = _range_text(low, high, low_closed, high_closed)
-            if isinstance(raw, bool):
+            # float() would also take bools, numeric strings ("0.5") and 1-element arrays
+            if isinstance(raw, bool | np.bool_ | str | bytes) or np.ndim(raw) != 0:
                 raise ValueError(f"{field} must be a real number in {rng}, got {raw!r}")
             try:
                 value = float(raw)

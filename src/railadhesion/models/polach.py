@@ -33,16 +33,17 @@ from railadhesion._validate import (
     check_positive,
     check_range,
 )
-from railadhesion.contact.kalker import kalker_coefficients
+from railadhesion.contact.kalker import _AOB_MAX, _AOB_MIN, axis_ratio, kalker_coefficients
 from railadhesion.models.parameters import PolachParameters, polach_parameters
 
 __all__ = ["Polach", "polach_forces"]
 
 _TWO_OVER_PI = 2.0 / math.pi
 _PI_OVER_4 = math.pi / 4.0
-# Gradients above this are clipped: the force terms they feed are then below 1e-50 of mu*Q
-# (k eps / (1 + (k eps)^2) ~ 1/(k eps), (1 + eps_psi^2)^-2 ~ eps_psi^-4), and squaring them
-# cannot overflow.
+# The gradient eps is clipped here: the term k eps / (1 + (k eps)^2) ~ 1/(k eps) it feeds is
+# then below 1e-50 of mu*Q, and squaring it cannot overflow. The spin gradient eps_psi is not
+# clipped: F_yS ~ |s_yC| / (1 + eps_psi^2)^2 with eps_psi proportional to |s_yC|, so a clipped
+# eps_psi would let F_yS grow without bound at huge creepages; (1 + eps_psi^2) = inf gives 0.
 _EPS_MAX = 1e50
 _SCALAR_TYPES = (float, int, np.float64)
 
@@ -261,7 +262,10 @@ def _polach_scalar(
     if check_contact and not 0.0 <= nu <= 0.5:
         raise _bad("poisson", "[0.0, 0.5]", nu)
 
-    c11, c22, c23 = _kalker_scalar(a / b, float(nu))
+    a_over_b = a / b
+    if not _AOB_MIN <= a_over_b <= _AOB_MAX:  # kalker_coefficients' range; message names a, b
+        axis_ratio(np.float64(a), np.float64(b))
+    c11, c22, c23 = _kalker_scalar(a_over_b, float(nu))
     syc = sy + psi * a
     if not abs(syc) > abs(sy):
         syc = sy
@@ -277,11 +281,13 @@ def _polach_scalar(
     eps = min(_PI_OVER_4 * g * a * b * cjj * sc / qmu, _EPS_MAX)
     x = k_a * eps
     f_over_sc = _TWO_OVER_PI * qmu * (x / (1.0 + x * x) + math.atan(k_s * eps)) / sc
-    k_psi = 1.0 + 6.3 * (1.0 - math.exp(-a / b))
+    k_psi = 1.0 + 6.3 * (1.0 - math.exp(-a_over_b))
     gc3c23 = g * a * b * math.sqrt(a * b) * c23
-    eps_psi = min(8.0 / 3.0 * gc3c23 / a * abs(syc) / (k_psi * qmu), _EPS_MAX)
-    e2 = 1.0 + eps_psi * eps_psi
-    fys = gc3c23 * psi * abs(syc) / sc / (e2 * e2)
+    eps_psi = 8.0 / 3.0 * gc3c23 / a * abs(syc) / (k_psi * qmu)
+    e2 = 1.0 + eps_psi * eps_psi  # may be inf (float overflow): then F_yS = 0
+    # |psi|/s_C <= 2/a and |s_yC|/e2 is bounded: this order cannot overflow (a product
+    # psi*|s_yC| first would, for huge creepages, and give inf*0 = NaN after the cap)
+    fys = gc3c23 * (psi / sc) * (abs(syc) / e2) / e2
     fx, fy = -f_over_sc * sx, -(f_over_sc * sy + fys)
     total = math.hypot(fx, fy)
     if total > qmu:  # Coulomb cap (see Notes): only opposing spin on long contacts gets here
@@ -306,7 +312,8 @@ def _polach_array(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu):
     g = check_positive(g, "shear_modulus")
     nu = check_range(nu, "poisson", 0.0, 0.5)
 
-    coef = kalker_coefficients(a / b, nu)
+    a_over_b = axis_ratio(a, b)
+    coef = kalker_coefficients(a_over_b, nu)
     c11, c22, c23 = coef.c11, coef.c22, coef.c23
 
     syc = sy + psi * a
@@ -323,21 +330,23 @@ def _polach_array(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu):
     # qmu == 0 only if A = 0 and exp(-B w) underflowed: no friction left, no force
     active = moving & (qmu > 0.0)
     qmu = np.where(qmu > 0.0, qmu, 1.0)
-    k_psi = 1.0 + 6.3 * (1.0 - np.exp(-a / b))
+    k_psi = 1.0 + 6.3 * (1.0 - np.exp(-a_over_b))
     gc3c23 = g * a * b * np.sqrt(a * b) * c23
     abs_syc = np.abs(syc)
-    with np.errstate(over="ignore"):  # huge gradients become inf, then are clipped
+    with np.errstate(over="ignore"):  # huge gradients become inf (eps is then clipped)
         eps = np.minimum(_PI_OVER_4 * g * a * b * cjj * sc / qmu, _EPS_MAX)
-        eps_psi = np.minimum((8.0 / 3.0) * gc3c23 / a * abs_syc / (k_psi * qmu), _EPS_MAX)
+        eps_psi = (8.0 / 3.0) * gc3c23 / a * abs_syc / (k_psi * qmu)
+        e2 = 1.0 + eps_psi * eps_psi  # inf gives F_yS = 0
     x = k_a * eps
     f_over_sc = _TWO_OVER_PI * qmu * (x / (1.0 + x * x) + np.arctan(k_s * eps)) / sc_safe
-    e2 = 1.0 + eps_psi * eps_psi
-    fys = gc3c23 * psi * (abs_syc / sc_safe) / (e2 * e2)
+    fys = gc3c23 * (psi / sc_safe) * (abs_syc / e2) / e2  # same order as the scalar path
 
     fx = np.where(active, -f_over_sc * sx, 0.0)
     fy = np.where(active, -(f_over_sc * sy + fys), 0.0)
     total = np.hypot(fx, fy)
-    scale = np.where(total > qmu, qmu / np.where(total > 0.0, total, 1.0), 1.0)  # Coulomb cap
+    over = total > qmu
+    # Coulomb cap; divide only where it applies (qmu/total of a tiny force would overflow)
+    scale = np.where(over, qmu / np.where(over, total, 1.0), 1.0)
     fx, fy = fx * scale, fy * scale
     if fx.ndim == 0:
         return np.float64(fx), np.float64(fy)
