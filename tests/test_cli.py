@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
@@ -151,3 +152,100 @@ def test_fit_wilac_builds_a_loadable_file(tmp_path):
     params = load_wilac_parameters(out)
     dry = params.polach_parameters("dry", 4500.0, 5.0)
     assert float(dry["mu0"]) == pytest.approx(0.45, rel=1e-3)
+
+
+# ---- audit: user errors exit with code 2 and a message, never a traceback
+
+
+def _assert_user_error(result, *fragments):
+    assert result.exit_code == 2, (result.exit_code, result.output, result.exception)
+    assert "Traceback" not in result.output
+    assert not isinstance(result.exception, Exception) or isinstance(
+        result.exception, SystemExit
+    ), repr(result.exception)
+    text = " ".join(result.output.split())  # Rich wraps long lines
+    for fragment in fragments:
+        assert fragment in text, (fragment, result.output)
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["wilac", "curves"],
+        ["wilac", "weights"],
+        ["wilac", "water"],
+        ["wilac", "speeds"],
+        ["wilac", "table"],
+    ],
+)
+def test_wilac_commands_with_a_missing_params_file(tmp_path, args):
+    missing = tmp_path / "missing.toml"
+    extra = [] if args[1] == "table" else ["--out", str(tmp_path / "x.png")]
+    result = _run(*args, "--params", str(missing), *extra)
+    _assert_user_error(result, "--params: cannot read", "missing.toml")
+
+
+@pytest.mark.parametrize("name", ["no_such_dir/x.png", "x.unknownformat"])
+def test_figure_that_cannot_be_written(tmp_path, name):
+    blocker = tmp_path / "no_such_dir"
+    blocker.write_text("a file where a folder is needed")
+    result = _run("wilac", "weights", "--out", str(tmp_path / name))
+    _assert_user_error(result, "cannot write the figure to")
+
+
+def test_error_messages_keep_their_brackets(tmp_path):
+    # Rich took "[low, high]" for markup and dropped it from the printed message
+    bad = tmp_path / "bad.toml"
+    bad.write_text(
+        (Path(__file__).parent / "io" / "data" / "wilac_example.toml")
+        .read_text(encoding="utf-8")
+        .replace("speed_range_m_s = [1.0, 40.0]", "speed_range_m_s = [1.0, 40.0, 50.0]"),
+        encoding="utf-8",
+    )
+    result = _run("params", "check", str(bad))
+    _assert_user_error(result, "validity.speed_range_m_s: expected [low, high] (2 numbers)")
+
+
+def test_fit_polach_on_a_degenerate_curve_names_the_file(tmp_path):
+    csv = tmp_path / "flat.csv"
+    csv.write_text(
+        "# normal_force_N = 4200\n# speed_m_s = 5\n# a_m = 0.004\n# b_m = 0.003\n"
+        "creep,adhesion\n" + "".join(f"{-0.01 * (i + 1)},0.1\n" for i in range(8))
+    )
+    result = _run("fit", "polach", str(csv))
+    _assert_user_error(result, "flat.csv: adhesion is the same (0.1) at all 8 points")
+
+
+def test_fit_polach_unreadable_csv(tmp_path):
+    csv = tmp_path / "utf16.csv"
+    csv.write_text("creep,adhesion\n-0.01,0.2\n", encoding="utf-16")
+    _assert_user_error(_run("fit", "polach", str(csv)), "utf16.csv: not a UTF-8 text file")
+    _assert_user_error(_run("fit", "polach", str(tmp_path / "nope.csv")), "cannot read")
+
+
+def test_fit_output_that_cannot_be_written(tmp_path):
+    truth = dict(k_A=0.6, k_S=0.2, mu0=0.35, A=0.5, B=0.4)
+    csv = tmp_path / "curve.csv"
+    _write_synthetic_curve(csv, truth, 50e3, 10.0, 0.0)
+    out = tmp_path / "missing_dir" / "fitted.toml"
+    result = _run("fit", "polach", str(csv), "--fit", "mu0", "--out", str(out))
+    _assert_user_error(result, "cannot write the parameter file")
+
+
+def test_demo_with_an_unusable_output_folder(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    result = _run("demo", "--out", str(blocker / "sub"))
+    _assert_user_error(result, "cannot write the demo figures")
+
+
+@pytest.mark.parametrize(
+    "command",
+    [[], ["demo"], ["hertz"], ["polach"], ["wilac"], ["wilac", "curves"], ["wilac", "weights"],
+     ["wilac", "water"], ["wilac", "speeds"], ["wilac", "table"], ["params"], ["params", "list"],
+     ["params", "check"], ["fit"], ["fit", "polach"], ["fit", "wilac"]],
+)  # fmt: skip
+def test_help_of_every_command(command):
+    result = _run(*command, "--help")
+    assert result.exit_code == 0, result.output
+    assert "Usage" in result.output

@@ -49,16 +49,21 @@ def _floats(text: str, name: str) -> np.ndarray:
 
 
 def _fail(exc: Exception) -> None:
-    console.print(f"[red]error:[/red] {exc}")
+    # escape(): messages hold brackets ("[low, high]", "[0, inf)") that Rich would otherwise
+    # take for markup and drop from the output.
+    console.print(f"[red]error:[/red] {escape(str(exc))}")
     raise typer.Exit(code=2)
 
 
 def _save(fig, out: Path | None) -> None:
     if out is None:
         return
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110, bbox_inches="tight")
-    console.print(f"figure written to {out}")
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        fig.savefig(out, dpi=110, bbox_inches="tight")
+    except (OSError, ValueError) as exc:  # unwritable folder, unknown image format
+        _fail(f"cannot write the figure to {out}: {exc}")
+    console.print(f"figure written to {escape(str(out))}")
 
 
 @app.command()
@@ -68,7 +73,10 @@ def demo(
     """Run the demo: Hertz, Kalker, Polach, FASTSIM, Fletcher and WILAC on realistic cases."""
     from railadhesion.demo import run_demo
 
-    run_demo(out_dir=out, console=console)
+    try:
+        run_demo(out_dir=out, console=console)
+    except OSError as exc:  # e.g. the output folder cannot be created
+        _fail(f"cannot write the demo figures to {out}: {exc}")
 
 
 @app.command()
@@ -273,7 +281,10 @@ def _load_wilac(path: Path | None):
         return None
     from railadhesion.io.paramfiles import load_wilac_parameters
 
-    return load_wilac_parameters(path)
+    try:
+        return load_wilac_parameters(path)
+    except OSError as exc:  # missing file, a folder, no permission: a user error, no traceback
+        raise ValueError(f"--params: cannot read {path}: {exc.strerror or exc}") from exc
 
 
 @params_app.command("list")
@@ -300,7 +311,10 @@ def params_check(path: Path = typer.Argument(..., help="A parameter file (TOML).
         params = load_parameter_file(path)
     except (ValueError, OSError) as exc:
         _fail(exc)
-    console.print(f"[green]ok[/green]: {path} holds {type(params).__name__} '{params.name}'")
+    console.print(
+        f"[green]ok[/green]: {escape(str(path))} holds {type(params).__name__} "
+        f"{escape(repr(params.name))}"
+    )
 
 
 @fit_app.command("polach")
@@ -317,16 +331,22 @@ def fit_polach_cmd(
     try:
         curve = read_creep_curve(csv)
         curve.require("normal_force", "speed", "a", "b")
+    except ValueError as exc:  # the message names the file
+        _fail(exc)
+    try:
         result = fit_polach(
             curve.creep, curve.adhesion, normal_force=curve.normal_force, speed=curve.speed,
             a=curve.a, b=curve.b, fit=tuple(s.strip() for s in fit.split(",") if s.strip()),
         )
     except ValueError as exc:
-        _fail(exc)
-    console.print(str(result))
+        _fail(f"{csv}: {exc}")
+    console.print(str(result), highlight=False, markup=False)
     if out is not None:
-        save_polach_parameters(result.as_polach_parameters(), out)
-        console.print(f"parameters written to {out}")
+        try:
+            save_polach_parameters(result.as_polach_parameters(), out)
+        except (OSError, ValueError) as exc:
+            _fail(f"cannot write the parameter file {out}: {exc}")
+        console.print(f"parameters written to {escape(str(out))}")
 
 
 @fit_app.command("wilac")
@@ -355,8 +375,10 @@ def fit_wilac_cmd(
         calibration = calibrate_wilac_to_toml(folder, out, **kwargs)
     except ValueError as exc:
         _fail(exc)
+    except OSError as exc:  # the output file cannot be written
+        _fail(f"cannot write the parameter file {out}: {exc}")
     console.print(calibration.summary(), highlight=False, markup=False)
-    console.print(f"WILAC parameters written to {out}")
+    console.print(f"WILAC parameters written to {escape(str(out))}")
 
 
 if __name__ == "__main__":  # pragma: no cover

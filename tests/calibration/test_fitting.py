@@ -237,3 +237,71 @@ def test_fletcher_bad_input():
         fit_fletcher(xi, y, fit=("k_A",), mu=0.2, **kw)
     with pytest.raises(ValueError, match="half_width must be in"):
         fit_fletcher(xi, y, mu=0.2, half_width=0.0, radius=FLETCHER_R)
+
+
+# ---- degenerate data, bounds outside the model's domain, bad fixed/initial values (audit)
+
+
+@pytest.mark.parametrize("fit_fn", ["polach", "fletcher"])
+def test_degenerate_curves_are_value_errors(fit_fn):
+    """No creepage or a flat adhesion cannot determine a curve: a clear ValueError, not a
+    'converged' fit with R^2 = -5e31 (as before)."""
+    def run(creep, y):
+        if fit_fn == "polach":
+            return _fit(creep, y)
+        return fit_fletcher(creep, y, half_width=FLETCHER_A, radius=FLETCHER_R, mu=0.2)
+
+    with pytest.raises(ValueError, match=r"creep is 0 at all 10 points"):
+        run(np.zeros(10), np.full(10, 0.2))
+    with pytest.raises(ValueError, match=r"adhesion is the same \(0\.2\) at all"):
+        run(CREEP, np.full(CREEP.size, 0.2))
+    with pytest.raises(ValueError, match=r"adhesion is the same \(0\) at all"):
+        run(CREEP, np.zeros(CREEP.size))
+
+
+@pytest.mark.parametrize(
+    ("bounds", "pattern"),
+    [
+        ({"A": (-1.0, 1.0)}, r"bounds\['A'\]: low must be >= 0 \(A must be in \[0, inf\)"),
+        ({"k_S": (-1.0, 1.0)}, r"bounds\['k_S'\]: low must be >= 0"),
+        ({"B": (-np.inf, 10.0)}, r"bounds\['B'\]: low must be >= 0"),
+    ],
+)
+def test_polach_bounds_outside_the_model_domain_are_rejected(bounds, pattern):
+    # before: the optimiser stepped to A < 0 and the fit died with "A must be in [0, inf)"
+    y = 0.5 * _adhesion(CREEP, k_A=0.6, k_S=0.2, mu0=0.4, A=0.0, B=5.0)
+    with pytest.raises(ValueError, match=pattern):
+        _fit(CREEP, y, bounds=bounds)
+
+
+def test_polach_zero_lower_bound_of_a_positive_parameter_is_usable():
+    y = _adhesion(CREEP, k_A=0.6, k_S=0.2, mu0=0.4, A=0.4, B=0.5)
+    res = _fit(CREEP, y, bounds={"k_A": (0.0, 1.0), "mu0": (0.0, 2.0)})
+    assert res.params["k_A"] == pytest.approx(0.6, rel=1e-3)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "pattern"),
+    [
+        (dict(fit=("k_A",), initial={"mu0": 0.4, "A": "x"}), r"initial\['A'\] must be a number"),
+        (dict(fit=("k_A",), initial={"mu0": float("nan")}), r"initial\['mu0'\] must be finite"),
+        (dict(initial={"mu0": float("nan")}), r"initial\['mu0'\] must be finite"),
+        (dict(fit=("k_A",), initial={"mu0": -1.0}), r"initial\['mu0'\] must be in \(0, inf\)"),
+        (dict(fit=("k_A",), initial={"mu0": 0.4, "B": -1.0}), r"initial\['B'\] must be in \[0"),
+    ],
+)
+def test_polach_bad_initial_values_are_named(kwargs, pattern):
+    with pytest.raises(ValueError, match=pattern):
+        _fit(CREEP, _adhesion(CREEP, mu0=0.3), **kwargs)
+
+
+def test_fletcher_fixed_k_s_zero_is_a_value_error():
+    # before: ZeroDivisionError in the starting guess
+    xi = np.linspace(1e-4, 0.01, 20)
+    y = _fletcher_adhesion(xi, 0.2, 0.5)
+    with pytest.raises(ValueError, match=r"initial\['k_s'\] must be in \(0, inf\)"):
+        fit_fletcher(xi, y, half_width=FLETCHER_A, radius=FLETCHER_R, fit=("mu",),
+                     initial={"k_s": 0.0, "k_a": 0.5})
+    with pytest.raises(ValueError, match=r"bounds\['k_a'\]: low must be >= 0"):
+        fit_fletcher(xi, y, half_width=FLETCHER_A, radius=FLETCHER_R, mu=0.2,
+                     bounds={"k_a": (-1.0, 5.0)})

@@ -214,3 +214,25 @@ def test_run_returns_fits_per_curve():
     mu0 = result.parameters.conditions["dry"].mu0.coefficients[0]
     fitted = [cf.fit.params["mu0"] for cf in result.curve_fits if cf.condition == "dry"]
     assert mu0 == pytest.approx(np.mean(fitted))
+
+
+def test_a_curve_that_cannot_be_fitted_is_named():
+    """A failing per-curve fit names the curve (before: only the fit's message, e.g.
+    'creep is 0 at all ...', with no hint which of many files it came from)."""
+    curves = _curves()
+    flat = CreepCurve(CREEP, np.full(CREEP.size, 0.2), normal_force=3000.0, speed=3.0,
+                      water_flow=25.0, a=4e-3, b=3e-3, name="flat_run7")  # fmt: skip
+    with pytest.raises(ValueError, match=r"flat_run7 \(damp2\): Polach fit: adhesion is the"):
+        calibrate_wilac(curves + [flat])
+
+
+def test_contact_function_returning_bad_semi_axes_is_named():
+    curves = [
+        CreepCurve(c.creep, c.adhesion, normal_force=c.normal_force, speed=c.speed,
+                   water_flow=c.water_flow, name=c.name)
+        for c in _curves()
+    ]  # fmt: skip
+    with pytest.raises(ValueError, match=r"contact\(normal_force\) returned semi-axes"):
+        calibrate_wilac(curves, contact=lambda q: (0.0, 3e-3))
+    with pytest.raises(ValueError, match=r"contact\(normal_force\) must return the semi-axes"):
+        calibrate_wilac(curves, contact=lambda q: 4e-3)

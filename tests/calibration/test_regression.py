@@ -163,3 +163,17 @@ def test_affine_invariance(seed, scale, offset):
     expected[0] += offset
     np.testing.assert_allclose(moved.coefficients, expected, rtol=1e-6, atol=1e-8 * (1 + scale))
     assert moved.r_squared == pytest.approx(base.r_squared, abs=1e-9)
+
+
+def test_unnormalised_regressors_do_not_warn():
+    """exp(Q') of an unnormalised Q' overflows; the column is skipped without a warning
+    (before: RuntimeWarning 'overflow encountered in exp', an error under the test config)."""
+    import warnings
+
+    q = np.array([1e3, 2e3, 3e3, 4e3, 5e3])
+    v = np.array([0.5, 0.6, 0.7, 0.8, 0.9])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fit = build_regression(q, v, 0.1 + 0.2 * v)
+    assert all("exp(Q)" not in t for t in fit.terms)
+    assert fit(q, v) == pytest.approx(0.1 + 0.2 * v, abs=1e-9)

@@ -171,3 +171,72 @@ def test_write_read_roundtrip(tmp_path_factory, data, q, v, percent):
     np.testing.assert_array_equal(back.adhesion, curve.adhesion)
     assert back.metadata == curve.metadata
     assert back.name == "rt"
+
+
+# ---- audit: rows of separators only, encodings, separators, line numbers
+
+
+def test_rows_of_separators_only_are_reported_not_dropped(tmp_path):
+    # spreadsheets write empty rows as ",,": before, they vanished without a trace
+    path = _write(tmp_path, "creep,adhesion\n-0.01,0.2\n,\n-0.02,0.3\n , \n-0.03,0.31\n")
+    with pytest.warns(CreepCurveWarning, match=r"2 of 5 data rows excluded \(line 3: row is"):
+        curve = read_creep_curve(path)
+    assert curve.creep.tolist() == [-0.01, -0.02, -0.03]
+    assert [(e.line, e.reason) for e in curve.excluded] == [
+        (3, "row is empty (separators only)"),
+        (5, "row is empty (separators only)"),
+    ]
+
+
+def test_rows_of_separators_only_keep_the_order_of_excluded_rows(tmp_path):
+    path = _write(tmp_path, "creep,adhesion\n-0.01,x\n,\n-0.02,0.3\n")
+    with pytest.warns(CreepCurveWarning):
+        curve = read_creep_curve(path)
+    assert [e.line for e in curve.excluded] == [2, 3]
+
+
+def test_blank_lines_are_still_skipped_silently(tmp_path):
+    path = _write(tmp_path, "creep,adhesion\n\n-0.01,0.2\n   \n-0.02,0.3\n\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        curve = read_creep_curve(path)
+    assert curve.excluded == () and len(curve) == 2
+
+
+def test_not_utf8_names_the_file(tmp_path):
+    path = tmp_path / "utf16.csv"
+    path.write_text("creep,adhesion\n-0.01,0.2\n", encoding="utf-16")
+    with pytest.raises(ValueError, match=r"utf16\.csv: not a UTF-8 text file"):
+        read_creep_curve(path)
+
+
+@pytest.mark.parametrize(
+    ("text", "pattern"),
+    [
+        ("creep;adhesion\n-0.01;0.2\n", r"line 1: header 'creep;adhesion' is separated by semi"),
+        ("creep\tadhesion\n-0.01\t0.2\n", r"line 1: .* is separated by tabs"),
+        ("creep,adhesion,\n-0.01,0.2,\n", r"line 1: column 3 of the header has no name"),
+    ],
+)
+def test_wrong_separators_are_explained(tmp_path, text, pattern):
+    with pytest.raises(ValueError, match=pattern):
+        read_creep_curve(_write(tmp_path, text))
+
+
+def test_windows_line_endings_and_bom(tmp_path):
+    path = tmp_path / "win.csv"
+    path.write_bytes(b"\xef\xbb\xbf# speed_m_s = 5\r\nCreep , ADHESION\r\n-0.01,0.2\r\n-0.02,9\r\n")
+    with pytest.warns(CreepCurveWarning):
+        curve = read_creep_curve(path)
+    assert curve.speed == 5.0 and curve.creep.tolist() == [-0.01]
+    assert [e.line for e in curve.excluded] == [4]
+
+
+def test_line_numbers_count_only_newlines(tmp_path):
+    # a form feed inside a cell is not a line break: before, str.splitlines split there and
+    # the file was refused ("line 3: expected 2 fields") / later lines were misnumbered
+    path = _write(tmp_path, "creep,adhesion\n-0.01,0.2\n-0.02\x0c,0.3\n-0.03,5\n")
+    with pytest.warns(CreepCurveWarning):
+        curve = read_creep_curve(path)
+    assert curve.creep.tolist() == [-0.01, -0.02]
+    assert [e.line for e in curve.excluded] == [4]

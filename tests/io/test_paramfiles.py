@@ -385,3 +385,30 @@ def test_missing_file_raises_file_not_found(tmp_path):
 def test_constants():
     assert FORMAT_VERSION == 1
     assert (WILAC_FORMAT, POLACH_FORMAT) == ("railadhesion-wilac", "railadhesion-polach")
+
+
+@pytest.mark.parametrize("r_squared", [math.nan, math.inf, 1.5])
+def test_regression_r_squared_that_a_file_cannot_hold_is_rejected(r_squared):
+    """Before, ParameterRegression took any r_squared, and save_wilac_parameters wrote a file
+    that load_wilac_parameters then refused (r_squared must be finite and <= 1)."""
+    with pytest.raises(ValueError, match="r_squared must be finite and <= 1"):
+        ParameterRegression(("1",), (0.5,), r_squared=r_squared)
+    with pytest.raises(ValueError, match=r"k_A: r_squared must be finite"):
+        ParameterRegression.from_dict(
+            {"terms": ["1"], "coefficients": [0.5], "r_squared": r_squared}, where="k_A"
+        )
+
+
+def test_save_load_round_trip_with_r_squared_and_odd_text(tmp_path):
+    cond = WilacCondition(
+        k_A=ParameterRegression(("1", "Q", "1/v*exp(Q)"), (0.4, 1e-3, -2e-4), r_squared=-0.25),
+        k_S=ParameterRegression(("1",), (0.1,), r_squared=1.0),
+        mu0=0.3, A=0.4, B=0.2,
+    )  # fmt: skip
+    params = WilacParameters(
+        {c: cond for c in WILAC_CONDITIONS}, 1.2345678901234567e5, 40.1, (1e-3, 1.5e5),
+        (0.1, 40.0), transitions=((10.1, 2.0), (30.0, 3.0), (50.5, 7.0)),
+        name='we"ird\n[name]', provenance={"notes": 'ä ß \\ "', "reconstruction": True},
+    )  # fmt: skip
+    path = save_wilac_parameters(params, tmp_path / "odd.toml")
+    assert load_wilac_parameters(path) == params

@@ -42,8 +42,14 @@ POLACH_DEFAULT_BOUNDS: dict[str, tuple[float, float]] = {
 #: Values of Polach parameters that are neither fitted nor given in ``initial``
 #: (the defaults of :func:`railadhesion.models.polach.polach_forces`; ``mu0`` has none).
 _POLACH_FIXED_DEFAULTS = {"k_A": 1.0, "k_S": 1.0, "A": 1.0, "B": 0.0}
+#: Domain of each Polach parameter in the model: True if it must be > 0, False if >= 0.
+_POLACH_POSITIVE = {"k_A": True, "k_S": True, "mu0": True, "A": False, "B": False}
 
 FLETCHER_NAMES = ("k_a", "k_s", "mu")
+#: Fletcher's k_a, k_s and mu must all be > 0 in a fit (the model divides by k_s mu).
+_FLETCHER_POSITIVE = {"k_a": True, "k_s": True, "mu": True}
+#: Lower bound used in place of a given 0 for a parameter that must be > 0.
+_POSITIVE_FLOOR = 1e-12
 #: Default bounds of the Fletcher fit (k_a may exceed 1 with noisy dry data; k_s up to 2 so
 #: that a ``mu`` given slightly below the measured saturation does not pin the fit).
 FLETCHER_DEFAULT_BOUNDS: dict[str, tuple[float, float]] = {
@@ -195,7 +201,9 @@ def _as_mapping(value, allowed: Sequence[str], what: str) -> dict[str, float]:
     return dict(value)
 
 
-def _bounds(bounds, defaults: dict, allowed: Sequence[str]) -> dict[str, tuple[float, float]]:
+def _bounds(
+    bounds, defaults: dict, allowed: Sequence[str], positive: Mapping[str, bool]
+) -> dict[str, tuple[float, float]]:
     out = dict(defaults)
     for name, pair in _as_mapping(bounds, allowed, "bounds").items():
         try:
@@ -204,8 +212,49 @@ def _bounds(bounds, defaults: dict, allowed: Sequence[str]) -> dict[str, tuple[f
             raise ValueError(f"bounds[{name!r}] must be a pair (low, high), got {pair!r}") from exc
         if not lo < hi or np.isnan(lo) or np.isnan(hi):
             raise ValueError(f"bounds[{name!r}] must satisfy low < high, got ({lo}, {hi})")
+        # The model rejects values outside its domain: a bound reaching there would make the
+        # optimiser step into it and the fit stop with an error about the model's argument.
+        if lo < 0:
+            rng = "(0, inf)" if positive[name] else "[0, inf)"
+            raise ValueError(
+                f"bounds[{name!r}]: low must be >= 0 ({name} must be in {rng} in the model), "
+                f"got ({lo}, {hi})"
+            )
+        if positive[name] and lo == 0:
+            lo = _POSITIVE_FLOOR
         out[name] = (lo, hi)
     return out
+
+
+def _parameter_value(value, name: str, what: str, positive: bool | None) -> float:
+    """``value`` of parameter ``name`` as a finite float; ``positive``: True for > 0, False for
+    >= 0, None for any finite number (a starting value, clipped into the bounds later)."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what}[{name!r}] must be a number, got {value!r}") from None
+    if not np.isfinite(x):
+        raise ValueError(f"{what}[{name!r}] must be finite, got {x!r}")
+    if positive is True and not x > 0:
+        raise ValueError(f"{what}[{name!r}] must be in (0, inf) ({name} is fixed), got {x!r}")
+    if positive is False and not x >= 0:
+        raise ValueError(f"{what}[{name!r}] must be in [0, inf) ({name} is fixed), got {x!r}")
+    return x
+
+
+def _check_shape_information(s: np.ndarray, y: np.ndarray) -> None:
+    """Reject data that cannot determine a creep curve: no creepage, or a flat adhesion."""
+    if not np.any(s != 0):
+        raise ValueError(
+            f"creep is 0 at all {s.size} points: a creep curve needs points at non-zero "
+            "creepage (the model's force is 0 there whatever its parameters)"
+        )
+    if float(np.ptp(y)) <= 1e-12 * float(np.max(y)):
+        raise ValueError(
+            f"adhesion is the same ({float(y[0]):g}) at all {y.size} points: a flat curve does "
+            "not determine the model's parameters (no initial slope, no peak); check the "
+            "adhesion column"
+        )
 
 
 def _data(creep, adhesion) -> tuple[np.ndarray, np.ndarray]:
@@ -354,7 +403,8 @@ def fit_polach(
         given. Fitted parameters not given start from a guess derived from the data (below).
     bounds : mapping of str to (low, high), optional
         Bounds overriding :data:`POLACH_DEFAULT_BOUNDS` (k_A, k_S in [1e-3, 1], mu0 in
-        [1e-3, 1.5], A in [0, 1], B in [0, 100] s/m).
+        [1e-3, 1.5], A in [0, 1], B in [0, 100] s/m). Lower bounds must be >= 0 (the model's
+        domain); a lower bound 0 of k_A, k_S or mu0 is used as 1e-12.
     creep_lat : array_like, default 0
         Lateral creepage eta [-] of the points.
     spin : array_like, default 0
@@ -369,6 +419,12 @@ def fit_polach(
     FitResult
         ``params`` (all five), ``stderr`` of the fitted ones, residuals, R², RMSE;
         :meth:`FitResult.as_polach_parameters` gives a validated parameter set.
+
+    Raises
+    ------
+    ValueError
+        Bad arguments (named), no more points than fitted parameters, creep 0 at every
+        point, or the same adhesion at every point (a flat curve determines no parameter).
 
     Notes
     -----
@@ -414,6 +470,7 @@ def fit_polach(
         raise ValueError(
             f"creep must hold more points than fitted parameters ({len(fitted)}), got {s.size}"
         )
+    _check_shape_information(s, y)
     q = check_positive(normal_force, "normal_force")
     v = check_nonnegative(speed, "speed")
     aa = check_positive(a, "a")
@@ -435,13 +492,17 @@ def fit_polach(
     q, v, aa, bb, eta, phi = (x.ravel() if x.size > 1 else x.reshape(()) for x in
                               (q, v, aa, bb, eta, phi))  # fmt: skip
     init = _as_mapping(initial, POLACH_NAMES, "initial")
-    bnd = _bounds(bounds, POLACH_DEFAULT_BOUNDS, POLACH_NAMES)
+    init = {
+        n: _parameter_value(x, n, "initial", None if n in fitted else _POLACH_POSITIVE[n])
+        for n, x in init.items()
+    }
+    bnd = _bounds(bounds, POLACH_DEFAULT_BOUNDS, POLACH_NAMES, _POLACH_POSITIVE)
     fixed = {}
     for name in POLACH_NAMES:
         if name in fitted:
             continue
         if name in init:
-            fixed[name] = float(init[name])
+            fixed[name] = init[name]
         elif name in _POLACH_FIXED_DEFAULTS:
             fixed[name] = _POLACH_FIXED_DEFAULTS[name]
         else:
@@ -581,15 +642,20 @@ def fit_fletcher(
         raise ValueError(
             f"creep must hold more points than fitted parameters ({len(fitted)}), got {s.size}"
         )
+    _check_shape_information(s, y)
     a = float(check_positive(half_width, "half_width"))
     r = float(check_positive(radius, "radius"))
     init = _as_mapping(initial, FLETCHER_NAMES, "initial")
+    init = {
+        n: _parameter_value(x, n, "initial", None if n in fitted else _FLETCHER_POSITIVE[n])
+        for n, x in init.items()
+    }
     if mu is not None:
         mu = float(check_positive(mu, "mu"))
         init.setdefault("mu", mu)
     elif "mu" not in fitted and "mu" not in init:
         raise ValueError("mu must be given (in (0, inf)) when it is not fitted")
-    bnd = _bounds(bounds, FLETCHER_DEFAULT_BOUNDS, FLETCHER_NAMES)
+    bnd = _bounds(bounds, FLETCHER_DEFAULT_BOUNDS, FLETCHER_NAMES, _FLETCHER_POSITIVE)
     fixed = {n: float(init.get(n, 1.0)) for n in FLETCHER_NAMES if n not in fitted}
 
     def model(c, params):

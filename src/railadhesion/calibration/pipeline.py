@@ -357,7 +357,18 @@ def run_wilac_calibration(
         if curve.a is not None and curve.b is not None:
             a, b = curve.a, curve.b
         elif contact is not None:
-            a, b = (float(x) for x in contact(curve.normal_force))
+            where = curve.source or curve.name or "creep curve"
+            try:
+                a, b = (float(x) for x in contact(curve.normal_force))
+            except (TypeError, ValueError) as exc:
+                raise ValueError(
+                    f"{where}: contact(normal_force) must return the semi-axes (a, b) [m]: {exc}"
+                ) from exc
+            if not (a > 0 and b > 0 and np.isfinite(a) and np.isfinite(b)):
+                raise ValueError(
+                    f"{where}: contact(normal_force) returned semi-axes ({a!r}, {b!r}); both "
+                    "must be in (0, inf) m"
+                )
         else:
             curve.require("a", "b")
         rows.append((curve, cond, a, b))
@@ -381,11 +392,16 @@ def run_wilac_calibration(
     curve_fits = []
     for curve, cond, a, b in rows:
         init = initial.get(cond) if per_condition_initial else initial
-        res = fit_polach(
-            curve.creep, curve.adhesion, normal_force=curve.normal_force, speed=curve.speed,
-            a=a, b=b, fit=fit, initial=init, bounds=bounds, shear_modulus=shear_modulus,
-            poisson=poisson,
-        )  # fmt: skip
+        try:
+            res = fit_polach(
+                curve.creep, curve.adhesion, normal_force=curve.normal_force, speed=curve.speed,
+                a=a, b=b, fit=fit, initial=init, bounds=bounds, shear_modulus=shear_modulus,
+                poisson=poisson,
+            )  # fmt: skip
+        except ValueError as exc:  # name the curve: the fit's message does not know it
+            raise ValueError(
+                f"{curve.source or curve.name or 'creep curve'} ({cond}): Polach fit: {exc}"
+            ) from exc
         curve_fits.append(
             CurveFit(curve, cond, res, curve.normal_force / q_ref, curve.speed / v_ref, a, b)
         )

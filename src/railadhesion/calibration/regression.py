@@ -299,7 +299,10 @@ def build_regression(
     elif ss_tot <= tol**2 * n:
         reason = "RMS deviation of y from its mean <= atol"
     else:
-        pool_cols = design_matrix(pool, q, v) if pool else np.empty((n, 0))
+        # exp of a large Q' or v' (e.g. values not normalised) overflows: such columns are
+        # marked unusable below, without a floating-point warning.
+        with np.errstate(over="ignore", invalid="ignore"):
+            pool_cols = design_matrix(pool, q, v) if pool else np.empty((n, 0))
         usable = np.all(np.isfinite(pool_cols), axis=0)
         best_by_size = {0: 0.0}
         reason = "no candidate left"

@@ -287,6 +287,11 @@ def read_creep_curve(path) -> CreepCurve:
         text = path.read_text(encoding="utf-8-sig")
     except OSError as exc:
         raise ValueError(f"cannot read creep-curve file {where}: {exc}") from exc
+    except UnicodeDecodeError as exc:
+        raise ValueError(
+            f"{where}: not a UTF-8 text file (byte {exc.start}: {exc.reason}); save the CSV "
+            "as UTF-8"
+        ) from None
 
     meta: dict[str, tuple[float, int]] = {}
     text_meta: dict[str, str] = {}
@@ -294,16 +299,31 @@ def read_creep_curve(path) -> CreepCurve:
     header: list[str] | None = None
     header_line = 0
     rows: list[tuple[int, list[str]]] = []
-    for lineno, line in enumerate(text.splitlines(), start=1):
+    blank_rows: list[tuple[int, str]] = []
+    # Split on "\n" only (read_text has already turned "\r\n" and "\r" into "\n"):
+    # str.splitlines would also split at form feeds and other separators, shifting the line
+    # numbers reported below.
+    for lineno, line in enumerate(text.split("\n"), start=1):
         if line.lstrip().startswith("#"):
             _header_entry(line, lineno, where, meta, text_meta, info)
             continue
         fields = next(csv.reader([line])) if line.strip() else []
         if all(not f.strip() for f in fields):
+            if header is not None and line.strip():
+                # separators only (",,"; spreadsheets write these): a data row without data,
+                # reported below rather than dropped silently
+                blank_rows.append((lineno, line))
             continue  # blank line
         if header is None:
             header = [_CANONICAL.get(f.strip().lower(), f.strip()) for f in fields]
             header_line = lineno
+            if len(header) == 1:
+                for sep, label in ((";", "semicolons"), ("\t", "tabs")):
+                    if sep in header[0]:
+                        raise ValueError(
+                            f"{where}, line {lineno}: header {line.strip()!r} is separated by "
+                            f"{label}; the separator must be a comma (docs/creep-curve-csv.md)"
+                        )
             _check_header(header, where, lineno)
             continue
         if len(fields) != len(header):
@@ -318,7 +338,8 @@ def read_creep_curve(path) -> CreepCurve:
             "'adhesion'"
         )
     if not rows:
-        raise ValueError(f"{where}: no data rows after the header (line {header_line})")
+        empty = f" ({len(blank_rows)} rows hold separators only)" if blank_rows else ""
+        raise ValueError(f"{where}: no data rows after the header (line {header_line}){empty}")
 
     col = {name: i for i, name in enumerate(header)}
     creep_name = "creep" if "creep" in col else "creep_percent"
@@ -362,6 +383,8 @@ def read_creep_curve(path) -> CreepCurve:
 
     creep_vals, adh_vals, excluded = [], [], []
     limit_c = MAX_ABS_CREEP / factor
+    for ln, line in blank_rows:
+        excluded.append(ExcludedRow(ln, "row is empty (separators only)", line))
     for ln, f in rows:
         raw_c, raw_a = f[col[creep_name]].strip(), f[col["adhesion"]].strip()
         c, a = _parse_float(raw_c), _parse_float(raw_a)
@@ -390,16 +413,20 @@ def read_creep_curve(path) -> CreepCurve:
         adh_vals.append(a)
 
     if excluded:
+        excluded.sort(key=lambda e: e.line)
         shown = "; ".join(str(e) for e in excluded[:5])
         more = f"; ... ({len(excluded) - 5} more)" if len(excluded) > 5 else ""
+        n_rows = len(rows) + len(blank_rows)
         warnings.warn(
-            f"{where}: {len(excluded)} of {len(rows)} data rows excluded ({shown}{more}); "
+            f"{where}: {len(excluded)} of {n_rows} data rows excluded ({shown}{more}); "
             "see CreepCurve.excluded",
             CreepCurveWarning,
             stacklevel=2,
         )
     if not creep_vals:
-        raise ValueError(f"{where}: no valid data row (all {len(rows)} rows excluded)")
+        raise ValueError(
+            f"{where}: no valid data row (all {len(rows) + len(blank_rows)} rows excluded)"
+        )
 
     kwargs = {METADATA_KEYS[k][0]: v[0] for k, v in meta.items()}
     return CreepCurve(
@@ -420,6 +447,12 @@ def _check_header(header: list[str], where: str, lineno: int) -> None:
         if name in seen:
             raise ValueError(f"{where}, line {lineno}: column '{name}' appears twice")
         seen.add(name)
+        if not name:
+            raise ValueError(
+                f"{where}, line {lineno}: column {len(seen)} of the header has no name (a "
+                "trailing or doubled comma?); allowed columns: "
+                f"{', '.join(_ALLOWED_COLUMNS)}"
+            )
         if name not in _ALLOWED_COLUMNS:
             raise ValueError(
                 f"{where}, line {lineno}: unknown column '{name}'; allowed columns: "

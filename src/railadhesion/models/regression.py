@@ -142,6 +142,18 @@ class ParameterRegression:
             raise ValueError(f"terms must be unique, got {list(terms)}")
         if not all(np.isfinite(coefs)):
             raise ValueError(f"coefficients must be finite, got {list(coefs)}")
+        if self.r_squared is not None:
+            # what a parameter file can hold (docs/parameter-files.md: R² <= 1, finite), so
+            # that every regression saved can be loaded again
+            try:
+                r2 = float(self.r_squared)
+            except (TypeError, ValueError):
+                raise ValueError(
+                    f"r_squared must be a number <= 1 or None, got {self.r_squared!r}"
+                ) from None
+            if not (np.isfinite(r2) and r2 <= 1.0):
+                raise ValueError(f"r_squared must be finite and <= 1 (or None), got {r2!r}")
+            object.__setattr__(self, "r_squared", r2)
         object.__setattr__(self, "terms", terms)
         object.__setattr__(self, "coefficients", coefs)
         compiled = tuple((_split(t), c) for t, c in zip(terms, coefs, strict=True))
