@@ -52,6 +52,11 @@ _SPIN_TO_PER_MM = 1e-3
 _CHUNK_ELEMENTS = 16384
 #: [Pa]; keeps g/|p| finite where p = 0 in the march (tractions that small are irrelevant).
 _TINY_TRACTION = 1e-30
+#: Largest creepage magnitude max(|xi|, |eta|, |phi| a) marched as given. Larger creepages
+#: are scaled down to it, all three by the same factor (direction kept): the contact is then in
+#: full slip for any physical contact, where the result does not depend on the magnitude, and
+#: the march stays clear of overflow (|xi| ~ 1e150 gave 0 or NaN instead of mu Fz).
+_CREEP_MAX = 1e50
 
 
 @dataclass(frozen=True)
@@ -364,6 +369,7 @@ def fastsim(
     args = np.broadcast_arrays(xi, eta, phi, fz, a_, b_, mu_, g_mod, nu, *flx_given)
     shape = args[0].shape
     xi, eta, phi, fz, a_, b_, mu_, g_mod, nu, *flx_given = (np.ravel(v) for v in args)
+    xi, eta, phi = _limit_creepage(xi, eta, phi, a_)
     if flx_given:
         l1, l2, l3 = flx_given
     else:
@@ -425,6 +431,17 @@ def fastsim(
             "slip": slip_all.reshape(grid_shape),
         }
     return FastsimResult(shaped(fx), shaped(fy), shaped(mz), shaped(slip_fraction), **extra)
+
+
+def _limit_creepage(xi, eta, phi, a):
+    """Creepages scaled down to magnitude :data:`_CREEP_MAX` where they exceed it (see there)."""
+    with np.errstate(over="ignore"):
+        size = np.maximum(np.maximum(np.abs(xi), np.abs(eta)), np.abs(phi) * a)
+    over = size > _CREEP_MAX
+    if not over.any():
+        return xi, eta, phi
+    scale = np.where(over, _CREEP_MAX / np.where(over, size, 1.0), 1.0)
+    return xi * scale, eta * scale, phi * scale
 
 
 def _check_flexibility(flexibility) -> list:

@@ -718,7 +718,7 @@ def wilac_forces(
     # input is aligned on the trailing axes of the full broadcast shape.
     ndim = max(
         weights.ndim - 1, qn.ndim, vn.ndim,
-        *(np.ndim(x) for x in (creep_long, creep_lat, spin, a, b)),
+        *(np.ndim(x) for x in (creep_long, creep_lat, spin, a, b, shear_modulus, poisson)),
     )  # fmt: skip
     pshape = np.broadcast_shapes(qn.shape, vn.shape)
     fac = _factor_arrays(qn, vn)
