@@ -28,6 +28,7 @@ from functools import lru_cache
 import numpy as np
 
 from railadhesion._validate import (
+    as_float_array,
     check_finite,
     check_nonnegative,
     check_positive,
@@ -222,20 +223,30 @@ def polach_forces(
     scalars = _scalars(args)
     if scalars is None:
         return _polach_array(*args)
-    return _polach_scalar(*scalars)
+    sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu = scalars
+    fx, fy, bad = _kernels().polach_checked(
+        sx, sy, psi, q, v, a, b, g, nu, 0.0, 0.0, 0.0, k_a, k_s, mu0, big_a, big_b
+    )
+    if bad >= 0:
+        _polach_scalar(*scalars)  # the reference scalar path raises the error naming it
+        raise AssertionError("polach kernel flagged an input the reference accepts")
+    return np.float64(fx), np.float64(fy)
 
 
 def _scalars(values) -> list | None:
     """``values`` for the scalar fast path, or ``None`` if any of them is not a real scalar.
 
-    Python and NumPy scalars and 0-d arrays qualify (no array work is then needed); ``float``,
-    ``int`` and ``numpy.float64`` are passed through, other NumPy scalars and 0-d arrays become
-    floats.
+    Python and NumPy scalars and 0-d arrays qualify (no array work is then needed); ``float``
+    and ``numpy.float64`` are passed through, ints, other NumPy scalars and 0-d arrays become
+    floats (so that the compiled kernels see one signature).
     """
     scalars = []
     for v in values:
-        if type(v) in _SCALAR_TYPES:
+        t = type(v)
+        if t is float or t is np.float64:
             scalars.append(v)
+        elif t is int:
+            scalars.append(float(v))
         elif isinstance(v, np.generic | np.ndarray) and v.ndim == 0 and v.dtype.kind in "fiu":
             scalars.append(float(v))
         else:
@@ -315,8 +326,41 @@ def _polach_scalar(
     return np.float64(fx), np.float64(fy)
 
 
-def _polach_array(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu):
-    """Array path of :func:`polach_forces` (validated, broadcast, no Python loops)."""
+_ARG_NAMES = (
+    "creep_long", "creep_lat", "spin", "normal_force", "speed", "a", "b",
+    "mu0", "k_A", "k_S", "A", "B", "shear_modulus", "poisson",
+)  # fmt: skip
+
+
+def _kernels():
+    """The compiled kernels (:mod:`railadhesion.models.kernels`), imported on first use so
+    that ``import railadhesion`` does not import numba."""
+    from railadhesion.models import kernels
+
+    return kernels
+
+
+def _polach_array(*args):
+    """Array path of :func:`polach_forces`: the compiled kernel, validated in the same pass.
+
+    Gives the numbers of :func:`_polach_reference` (to rounding). If any argument is out of
+    range, the reference runs to raise the error naming it.
+    """
+    arrays = [as_float_array(x, name) for x, name in zip(args, _ARG_NAMES, strict=True)]
+    k = _kernels()
+    shape, n, flat = k.flatten_args(arrays)
+    fx, fy, ok = k.polach_many(flat, n)
+    if not ok:
+        _polach_reference(*arrays)  # raises the ValueError naming the argument
+        raise AssertionError("polach kernel flagged an input the reference accepts")
+    if not shape:
+        return np.float64(fx[0]), np.float64(fy[0])
+    return fx.reshape(shape), fy.reshape(shape)
+
+
+def _polach_reference(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu):
+    """NumPy reference of the array path of :func:`polach_forces` (validated, broadcast, no
+    Python loops): the readable implementation the compiled kernel is tested against."""
     sx = check_finite(sx, "creep_long")
     sy = check_finite(sy, "creep_lat")
     psi = check_finite(psi, "spin")
