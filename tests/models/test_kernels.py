@@ -227,3 +227,39 @@ def test_import_does_not_import_numba():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)  # fmt: skip
     assert out.stdout.strip() == "False"
+
+
+# --- the fixed-contact object ---------------------------------------------------------------
+
+
+@given(sx=creep, sy=creep, psi=spin, v=st.floats(0.0, 60.0), q=st.floats(1e2, 1e6),
+       ratio=st.sampled_from([0.05, 0.5, 1.0, 5.0]), k_a=k_st, k_s=k_st,
+       big_a=st.floats(0.0, 2.0), big_b=st.one_of(st.just(0.0), st.floats(0, 50)))  # fmt: skip
+@SETTINGS
+def test_polach_contact_equals_polach_forces(sx, sy, psi, v, q, ratio, k_a, k_s, big_a, big_b):
+    from railadhesion.models.polach import PolachContact
+
+    a = 6e-3
+    kw = dict(mu0=0.4, k_A=k_a, k_S=k_s, A=big_a, B=big_b)
+    contact = PolachContact(1e5, 10.0, a, a / ratio, **kw)
+    ref = polach_forces(sx, sy, psi, q, v, a, a / ratio, **kw)
+    got = contact.forces(sx, sy, psi, speed=v, normal_force=q)
+    assert type(got[0]) is float
+    _close(got, ref, 0.4 * q * 2)
+
+
+def test_polach_contact_validates():
+    from railadhesion.models.polach import Polach, PolachContact
+
+    with pytest.raises(ValueError, match="^k_A must be in"):
+        PolachContact(1e5, 10.0, 6e-3, 5e-3, mu0=0.3, k_A=2.0)
+    with pytest.raises(ValueError, match="one contact"):
+        PolachContact(np.array([1e5, 2e5]), 10.0, 6e-3, 5e-3, mu0=0.3)
+    contact = Polach("polach2005_wet").contact(1e5, 10.0, 6e-3, 5e-3)
+    for args, kwargs, name in (((math.nan,), {}, "creep_long"), ((0.0, math.inf), {}, "creep_lat"),
+                               ((0.0, 0.0, -math.inf), {}, "spin"),
+                               ((0.01,), {"speed": -1.0}, "speed"),
+                               ((0.01,), {"normal_force": 0.0}, "normal_force")):  # fmt: skip
+        with pytest.raises(ValueError, match=f"^{name} must be"):
+            contact.forces(*args, **kwargs)
+    assert "PolachContact(normal_force=100000.0" in repr(contact)
