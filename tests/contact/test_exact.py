@@ -121,7 +121,8 @@ def test_contact_tractcurv_exact_coulomb_series():
     r = exact_rolling(xi, 0.0, 0.0, 106.7e3, 6.304e-3, 12.61e-3, 0.33, nx=48, ny=44, scale=1.1)
     ours = r.fx / (0.33 * 106.7e3)
     np.testing.assert_allclose(ours, contact, rtol=0.005)
-    assert np.all(r.fy == 0.0) or np.all(np.abs(r.fy) < 1e-9 * 106.7e3)
+    # no lateral force from longitudinal creepage (up to the iteration tolerance)
+    assert np.all(np.abs(r.fy) < 1e-6 * 106.7e3)
 
 
 def test_contact_carter2d_example():
@@ -213,9 +214,9 @@ def test_symmetries_and_batch_equals_single():
     single = exact_rolling(xi[2], eta[2], phi[2], 6e4, 5e-3, 6e-3, 0.3, **args)
     assert float(single.fy) == pytest.approx(r.fy[2], rel=1e-9)
     assert np.ndim(single.fx) == 0
-    # eta alone (no spin): mirror symmetry in y gives Fx = 0... and xi alone gives Fy = Mz = 0
+    # xi alone: mirror symmetry in y gives Fy = Mz = 0 (up to the iteration tolerance)
     r2 = exact_rolling(0.001, 0.0, 0.0, 6e4, 5e-3, 6e-3, 0.3, **args)
-    assert abs(float(r2.fy)) < 1e-9 * 6e4 and abs(float(r2.mz)) < 1e-9 * 6e4
+    assert abs(float(r2.fy)) < 1e-6 * 6e4 and abs(float(r2.mz)) < 1e-6 * 6e4 * 5e-3
 
 
 def test_broadcasting_shape():

@@ -189,12 +189,14 @@ def _gs_diagonal(ratio, nu):
     The true diagonal of the rolling operator, (A(0) - A(e_x))/dx, is as large as the
     coupling to the trailing neighbour, -(A(0) - A(e_x))/dx, and plain Gauss-Seidel diverges.
     The self-displacement A(0)/dx instead (the element's effect on its upstream neighbour is
-    lagged), enlarged for elements long in x (dy < dx), gives a convergent iteration
-    (spectral radius 0.75-0.92 in the stick state for grids up to 30 x 30 and
-    0.2 <= dy/dx <= 5, measured). Any positive diagonal leaves the solution unchanged.
+    lagged), enlarged by ``1 + (dx/dy - 1)/4`` for elements long in x (dy < dx), gives a
+    convergent iteration: spectral radius 0.76-0.91 in the stick state, sweeping from the
+    trailing edge, for 0.2 <= dy/dx <= 5 on grids up to 30 x 30 (measured on the dense
+    iteration matrix). Any positive diagonal leaves the solution unchanged; the solver
+    enlarges it further if the iteration diverges.
     """
     a0x, _, a0y = _influence_point(0.0, 0.0, 0.5, 0.5 * ratio, nu)
-    fac = 1.0 if ratio >= 1.0 else 1.6
+    fac = 1.0 if ratio >= 1.0 else 1.0 + 0.25 * (1.0 / ratio - 1.0)
     return fac * a0x / math.pi, fac * a0y / math.pi
 
 
@@ -233,18 +235,23 @@ def _local_slip(ssx, ssy, kx, ky, g):
     return g * ex, g * ey
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, fastmath=True)
 def _apply_update(sx, sy, lo, hi, kxx, kxy, kyy, iy, ix, mx, my, dpx, dpy):
     """s_J += K(J - I) dp for every element J of the contact rows."""
     for jy in range(my):
-        if hi[jy] <= lo[jy]:
+        n = hi[jy] - lo[jy]
+        if n <= 0:
             continue
         ky = jy - iy + my - 1
-        kx0 = ix - (mx - 1)  # column index of di = jx - ix is jx - ix + mx - 1 = jx - kx0
-        for jx in range(lo[jy], hi[jy]):
-            k = jx - kx0
-            sx[jy, jx] += kxx[ky, k] * dpx + kxy[ky, k] * dpy
-            sy[jy, jx] += kxy[ky, k] * dpx + kyy[ky, k] * dpy
+        k0 = lo[jy] - ix + mx - 1  # kernel column of element (jy, lo[jy])
+        rxx = kxx[ky, k0 : k0 + n]
+        rxy = kxy[ky, k0 : k0 + n]
+        ryy = kyy[ky, k0 : k0 + n]
+        ox = sx[jy, lo[jy] : hi[jy]]
+        oy = sy[jy, lo[jy] : hi[jy]]
+        for t in range(n):
+            ox[t] += rxx[t] * dpx + rxy[t] * dpy
+            oy[t] += rxy[t] * dpx + ryy[t] * dpy
 
 
 @numba.njit(cache=True)
@@ -300,6 +307,7 @@ def _gauss_seidel(g, wx, wy, kxx, kxy, kyy, dgx, dgy, tol, max_iter, px, py, sx,
     err = 0.0
     pref = gmax
     sweeps = 0
+    err_min = np.inf
     for _ in range(max_iter):
         sweeps += 1
         err = 0.0
@@ -332,6 +340,18 @@ def _gauss_seidel(g, wx, wy, kxx, kxy, kyy, dgx, dgy, tol, max_iter, px, py, sx,
         pref = max(pmax, 1e-12 * gmax)
         if err <= tol * pref:
             break
+        # divergence guard: relative change 1e3 x its minimum -> larger diagonal, restart
+        rel = err / pref
+        err_min = min(err_min, rel)
+        if rel > 1e3 * err_min or not math.isfinite(rel):
+            k0x *= 1.3
+            k0y *= 1.3
+            err_min = np.inf
+            for iy in range(my):
+                for ix in range(mx):
+                    px[iy, ix] = 0.0
+                    py[iy, ix] = 0.0
+            _full_slip_field(px, py, wx, wy, lo, hi, kxx, kxy, kyy, mx, my, sx, sy)
     # exact slip for the output (removes round-off accumulated by the updates)
     _full_slip_field(px, py, wx, wy, lo, hi, kxx, kxy, kyy, mx, my, sx, sy)
     for iy in range(my):
@@ -510,7 +530,7 @@ def exact_rolling(
     ny: int = 30,
     scale: float = 1.0,
     spin_offset: float = SPIN_OFFSET_CONTACT,
-    tol: float = 1e-7,
+    tol: float = 1e-6,
     max_iter: int = 5000,
     return_fields: bool = False,
 ) -> ExactResult:
@@ -662,7 +682,7 @@ def solve_tangential(
     shear_modulus=8.2e10,
     poisson=0.28,
     spin_offset: float = SPIN_OFFSET_CONTACT,
-    tol: float = 1e-7,
+    tol: float = 1e-6,
     max_iter: int = 5000,
 ) -> ExactResult:
     """Steady-rolling tangential problem on a given grid and normal pressure (one case).
