@@ -1,5 +1,11 @@
-"""Contact mechanics: Hertz, Kalker linear theory, FASTSIM."""
+"""Contact mechanics: Hertz, Kalker linear theory, FASTSIM, Kalker's exact rolling theory."""
 
+from railadhesion.contact.exact import (
+    ExactResult,
+    exact_rolling,
+    solve_tangential,
+    tangential_influence,
+)
 from railadhesion.contact.fastsim import FastsimResult, fastsim
 from railadhesion.contact.hertz import (
     HertzContact,
@@ -17,11 +23,13 @@ from railadhesion.contact.kalker import (
 )
 
 __all__ = [
+    "ExactResult",
     "FastsimResult",
     "HertzContact",
     "KalkerCoefficients",
     "LineContact",
     "combined_elastic_constants",
+    "exact_rolling",
     "fastsim",
     "hertz_3d",
     "hertz_3d_from_curvatures",
@@ -29,4 +37,6 @@ __all__ = [
     "line_contact",
     "line_contact_from_pressure",
     "linear_creep_forces",
+    "solve_tangential",
+    "tangential_influence",
 ]

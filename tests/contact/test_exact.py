@@ -1,0 +1,251 @@
+"""Tests of the exact steady-rolling solver (railadhesion.contact.exact).
+
+Reference numbers are quoted from the outputs Vollebregt's CONTACT wrote for its example
+inputs (eve70a/CONTACT, ``examples/*.ref_out``, revision 2707), from Kalker's linear theory
+(package table) and from limits of Coulomb friction. Grids are kept coarse here; the
+fine-grid checks are in ``scripts/validate_exact_solver.py`` (docs/validation/exact_solver.md).
+"""
+
+import math
+
+import numpy as np
+import pytest
+from scipy import integrate
+
+from railadhesion.contact import kalker_coefficients
+from railadhesion.contact.exact import exact_rolling, solve_tangential, tangential_influence
+
+G = 82e9
+NU = 0.28
+
+
+# --------------------------------------------------------------------------- influence
+
+
+def _cerruti_quadrature(x, y, dx, dy, nu):
+    """Displacement difference of two bodies under a unit tangential load on the rectangle,
+    by numerical quadrature of Cerruti's point-load solution (Johnson 1985, eq. 2.19, z = 0).
+    The rectangle is split at the field point so that the 1/r singularity sits at a corner."""
+    f = 1.0 / (math.pi * G)  # two identical bodies: 2 * 1/(2 pi G)
+
+    def kern(kind):
+        def k(sy, sx):
+            rx, ry = x - sx, y - sy
+            r = math.hypot(rx, ry)
+            if kind == "xx":
+                return f * ((1 - nu) / r + nu * rx * rx / r**3)
+            if kind == "yy":
+                return f * ((1 - nu) / r + nu * ry * ry / r**3)
+            return f * nu * rx * ry / r**3
+
+        return k
+
+    xs = sorted({-dx / 2, dx / 2, min(max(x, -dx / 2), dx / 2)})
+    ys = sorted({-dy / 2, dy / 2, min(max(y, -dy / 2), dy / 2)})
+    out = []
+    for kind in ("xx", "xy", "yy"):
+        total = 0.0
+        for x0, x1 in zip(xs[:-1], xs[1:], strict=True):
+            for y0, y1 in zip(ys[:-1], ys[1:], strict=True):
+                total += integrate.dblquad(kern(kind), x0, x1, y0, y1, epsabs=1e-22, epsrel=1e-10)[
+                    0
+                ]
+        out.append(total)
+    return out
+
+
+@pytest.mark.parametrize(
+    "x, y, dx, dy",
+    [
+        (0.0, 0.0, 1e-3, 1e-3),  # self influence, square
+        (0.0, 0.0, 2e-3, 0.5e-3),  # self influence, long element
+        (1e-3, 0.0, 1e-3, 1e-3),  # neighbour along x
+        (0.0, 1e-3, 1e-3, 0.5e-3),  # neighbour along y
+        (1.5e-3, -2.5e-3, 1e-3, 0.7e-3),  # diagonal: axy != 0
+        (-3e-3, 2e-3, 0.4e-3, 1.3e-3),
+    ],
+)
+def test_influence_matches_quadrature_of_cerruti(x, y, dx, dy):
+    closed = tangential_influence(x, y, dx, dy, poisson=NU, shear_modulus=G)
+    quad = _cerruti_quadrature(x, y, dx, dy, NU)
+    scale = abs(quad[0])
+    for c, q in zip(closed, quad, strict=True):
+        assert abs(float(c) - q) <= 1e-7 * scale
+
+
+def test_influence_self_square_closed_form():
+    # integral of 1/r over a square of side h about its centre: 4 h ln(1 + sqrt 2)
+    h = 1e-3
+    axx, axy, ayy = tangential_influence(0.0, 0.0, h, h, poisson=0.0, shear_modulus=G)
+    assert float(axx) == pytest.approx(4 * h * math.log(1 + math.sqrt(2)) / (math.pi * G), 1e-12)
+    assert float(axy) == 0.0
+    assert float(ayy) == pytest.approx(float(axx), 1e-12)
+
+
+def test_influence_symmetries():
+    x, y = 2.3e-3, -1.1e-3
+    a = tangential_influence(x, y, 1e-3, 0.6e-3)
+    b = tangential_influence(-x, y, 1e-3, 0.6e-3)
+    c = tangential_influence(y, x, 0.6e-3, 1e-3)  # swap the axes
+    assert a[0] == pytest.approx(b[0]) and a[2] == pytest.approx(b[2])
+    assert a[1] == pytest.approx(-b[1])  # axy odd in x
+    assert a[0] == pytest.approx(c[2]) and a[2] == pytest.approx(c[0])
+
+
+# --------------------------------------------------------------------------- CONTACT
+
+
+def test_contact_fastsim_example_halfspace_case():
+    # CONTACT examples/fastsim.ref_out, case 1 (exact half-space solution): a = 8 mm,
+    # b = 4 mm, Fn = 82 kN, eta = -0.000625, phi = 0.000625 rad/mm, mu = 0.3, G = 82 GPa,
+    # nu = 0.28, 44 x 44 elements over 1.1a x 1.1b: FY/FSTAT/FN = -0.6074, MZ = -4.821e4 N mm,
+    # 356 adhesion and 920 slip elements (of 1276 in contact).
+    r = exact_rolling(
+        0.0, -0.000625, 0.625, 82e3, 8e-3, 4e-3, 0.3, nx=44, ny=44, scale=1.1, return_fields=True
+    )
+    assert float(r.fy) / (0.3 * 82e3) == pytest.approx(-0.6074, rel=0.005)
+    assert float(r.mz) == pytest.approx(-48.21, rel=0.01)
+    assert abs(float(r.fx)) < 1e-6 * 82e3  # symmetric about y = 0: no longitudinal force
+    n_stick = int((r.state == 1).sum())
+    n_slip = int((r.state == 2).sum())
+    assert abs(n_stick - 356) <= 15 and abs(n_slip - 920) <= 15
+    assert int(r.iterations) < 1000
+
+
+def test_contact_tractcurv_exact_coulomb_series():
+    # CONTACT examples/tractcurv.ref_out, first series (original CONTACT, Coulomb friction):
+    # Eurosprinter case, a = 6.304 mm, b = 12.61 mm (a/b = 0.5), Fn = 106.7 kN, mu = 0.33,
+    # 48 x 44 elements over 1.1a x 1.1b. FX/FSTAT/FN at CKSI = 1e-5, 0.4, 1.2, 2.0, 3.2 permille:
+    xi = np.array([0.00001, 0.0004, 0.0012, 0.0020, 0.0032])
+    contact = np.array([-7.015e-3, -0.2588, -0.6482, -0.8816, -0.9976])
+    r = exact_rolling(xi, 0.0, 0.0, 106.7e3, 6.304e-3, 12.61e-3, 0.33, nx=48, ny=44, scale=1.1)
+    ours = r.fx / (0.33 * 106.7e3)
+    np.testing.assert_allclose(ours, contact, rtol=0.005)
+    # no lateral force from longitudinal creepage (up to the iteration tolerance)
+    assert np.all(np.abs(r.fy) < 1e-6 * 106.7e3)
+
+
+def test_contact_carter2d_example():
+    # CONTACT examples/carter2d.ref_out: R = 500 mm on a plane, 55 elements of 0.04 mm along x
+    # (first centre at x = -1.05 mm) and one row 200 mm wide (CONTACT's 2D approximation),
+    # Fn = 35780 N, CKSI = -0.024 %, mu = 0.3, G = 82 GPa, nu = 0.28. CONTACT: FX/FSTAT/FN =
+    # 0.6480, 30 adhesion and 20 slip elements, PMAX = 113.9 N/mm^2. Carter's analytic 2D value
+    # for this creepage (adhesion a'/a = 0.6): 0.64.
+    p_len = 35780 / 0.2  # N/m
+    e_star = G / (1 - NU)  # identical bodies: E/(2(1-nu^2)) = G/(1-nu)
+    a = math.sqrt(4 * p_len * 0.5 / (math.pi * e_star))
+    p0 = 2 * p_len / (math.pi * a)
+    assert p0 == pytest.approx(113.9e6, rel=1e-3)
+    x = -1.05e-3 + 0.04e-3 * np.arange(55)
+    pn = (p0 * np.sqrt(np.clip(1 - (x / a) ** 2, 0, None)))[None, :]
+    r = solve_tangential(pn, 0.04e-3, 0.2, -0.00024, 0.0, 0.0, 0.3, x0=-1.05e-3, y0=0.0)
+    assert float(r.fx) / (0.3 * 35780) == pytest.approx(0.6480, rel=0.005)
+    assert int((r.state == 1).sum()) == 30 and int((r.state == 2).sum()) == 20
+    # the adhesion zone is at the leading edge (+x), the slip zone at the trailing edge
+    stick_x = r.x[r.state[0] == 1]
+    slip_x = r.x[r.state[0] == 2]
+    assert stick_x.min() > slip_x.max()
+
+
+# --------------------------------------------------------------------------- limits
+
+
+def test_linear_theory_at_vanishing_creepage():
+    # Kalker's coefficients (package table); 24 x 24 grid: discretisation error < 3.5 %
+    # (1 % is reached at 60 x 60: docs/validation/exact_solver.md)
+    a, b = 4e-3, 5e-3
+    c = math.sqrt(a * b)
+    k = kalker_coefficients(a / b, NU)
+    r = exact_rolling([1e-6, 0, 0], [0, 1e-6, 0], [0, 0, 1e-4], 1e5, a, b, 1e3, nx=24, ny=24)
+    assert -r.fx[0] / (G * c * c * 1e-6) == pytest.approx(k.c11, rel=0.035)
+    assert -r.fy[1] / (G * c * c * 1e-6) == pytest.approx(k.c22, rel=0.035)
+    assert -r.fy[2] / (G * c**3 * 1e-4) == pytest.approx(k.c23, rel=0.035)
+    # reciprocity of linear theory: the moment from lateral creepage is C23 too (C32 = C23)
+    assert r.mz[1] / (G * c**3 * 1e-6) == pytest.approx(k.c23, rel=0.05)
+    assert np.all(r.slip_fraction == 0.0)
+
+
+@pytest.mark.parametrize("xi, eta, phi", [(0.05, 0.02, 0.0), (-0.03, 0.04, 0.5), (0.0, -0.1, 0.0)])
+def test_full_sliding_force_is_mu_q_opposite_to_creepage(xi, eta, phi):
+    fz, mu = 5e4, 0.25
+    r = exact_rolling(xi, eta, phi, fz, 5e-3, 4e-3, mu, nx=16, ny=16)
+    f = math.hypot(float(r.fx), float(r.fy))
+    assert float(r.slip_fraction) == 1.0
+    assert f == pytest.approx(mu * fz, rel=1e-3)
+    assert f <= mu * fz * (1 + 1e-12)
+    # opposite to the rigid slip (spin adds a small moment, and the elastic slip shifts
+    # the local direction slightly, well below 1 degree at these creepages)
+    cosang = -(float(r.fx) * xi + float(r.fy) * eta) / (f * math.hypot(xi, eta))
+    assert cosang > math.cos(math.radians(1.0))
+
+
+def test_coulomb_bound_and_stick_slip_conditions():
+    r = exact_rolling(
+        0.0008, -0.0005, 0.8, 8e4, 6e-3, 5e-3, 0.3, nx=20, ny=20, return_fields=True, tol=1e-9
+    )
+    pt = np.hypot(r.px, r.py)
+    bound = 0.3 * r.pn
+    assert np.all(pt <= bound * (1 + 1e-9) + 1e-6)
+    slip = r.state == 2
+    stick = r.state == 1
+    assert slip.any() and stick.any()
+    np.testing.assert_allclose(pt[slip], bound[slip], rtol=1e-9)
+    # in slip the traction opposes the slip
+    s = np.hypot(r.sx, r.sy)
+    cos = -(r.px * r.sx + r.py * r.sy)[slip] / (pt[slip] * s[slip])
+    assert np.all(cos > 1 - 1e-6)
+    assert np.all(r.sx[stick] == 0.0) and np.all(r.sy[stick] == 0.0)
+    assert np.all(r.px[r.state == 0] == 0.0)
+    # total force is the sum of the traction field
+    da = (r.x[1] - r.x[0]) * (r.y[1] - r.y[0])
+    assert float(r.fx) == pytest.approx(r.px.sum() * da, rel=1e-12)
+
+
+def test_symmetries_and_batch_equals_single():
+    args = dict(nx=14, ny=14)
+    xi = np.array([0.001, -0.001, 0.0005])
+    eta = np.array([0.0005, -0.0005, -0.001])
+    phi = np.array([0.3, -0.3, 0.6])
+    r = exact_rolling(xi, eta, phi, 6e4, 5e-3, 6e-3, 0.3, **args)
+    # (xi, eta, phi) -> -(xi, eta, phi) reverses every force and the moment
+    assert r.fx[1] == pytest.approx(-r.fx[0], rel=1e-6)
+    assert r.fy[1] == pytest.approx(-r.fy[0], rel=1e-6)
+    assert r.mz[1] == pytest.approx(-r.mz[0], rel=1e-6)
+    single = exact_rolling(xi[2], eta[2], phi[2], 6e4, 5e-3, 6e-3, 0.3, **args)
+    assert float(single.fy) == pytest.approx(r.fy[2], rel=1e-9)
+    assert np.ndim(single.fx) == 0
+    # xi alone: mirror symmetry in y gives Fy = Mz = 0 (up to the iteration tolerance)
+    r2 = exact_rolling(0.001, 0.0, 0.0, 6e4, 5e-3, 6e-3, 0.3, **args)
+    assert abs(float(r2.fy)) < 1e-6 * 6e4 and abs(float(r2.mz)) < 1e-6 * 6e4 * 5e-3
+
+
+def test_broadcasting_shape():
+    r = exact_rolling(np.array([[0.001], [0.002]]), [0.0, 0.001, 0.002], 0.0, 6e4, 5e-3, 6e-3,
+                      0.3, nx=8, ny=8)  # fmt: skip
+    assert r.fx.shape == (2, 3) and r.iterations.shape == (2, 3)
+
+
+def test_zero_friction_and_zero_load():
+    r = exact_rolling(0.001, 0.001, 0.1, [6e4, 0.0], 5e-3, 6e-3, [0.0, 0.3], nx=8, ny=8)
+    np.testing.assert_array_equal(r.fx, [0.0, 0.0])
+    np.testing.assert_array_equal(r.fy, [0.0, 0.0])
+
+
+@pytest.mark.parametrize(
+    "kw, msg",
+    [
+        (dict(mu=-0.1), "mu"),
+        (dict(a=0.0), "a"),
+        (dict(creep_long=np.nan), "creep_long"),
+        (dict(nx=0), "nx"),
+        (dict(scale=0.5), "scale"),
+        (dict(poisson=0.7), "poisson"),
+    ],
+)
+def test_bad_input_names_the_argument(kw, msg):
+    args = dict(creep_long=0.001, creep_lat=0.0, spin=0.0, normal_force=5e4, a=5e-3, b=5e-3, mu=0.3)
+    opts = {}
+    for k, v in kw.items():
+        (args if k in args else opts)[k] = v
+    with pytest.raises(ValueError, match=msg):
+        exact_rolling(**args, **opts)
