@@ -1,0 +1,27 @@
+"""Use the models from other tools: FMI 2.0 co-simulation FMUs and creep-force tables.
+
+* :func:`build_creep_force_fmu`: a WILAC or Polach creep-force law as an FMU (pythonfmu);
+* :func:`creep_force_table`: a model evaluated on a grid, written as NetCDF
+  (:func:`write_table_netcdf`) and as a plain CSV (:func:`write_table_csv`), with the error
+  of multilinear interpolation in the table measured at the cell midpoints.
+
+See the README section "Using the models from other tools" and ``docs/creep-force-tables.md``.
+"""
+
+from railadhesion.export.fmu import (
+    FMU_MODELS,
+    FmuVariable,
+    build_creep_force_fmu,
+    build_fmu,
+    creep_force_variables,
+    resolve_parameters,
+)
+
+__all__ = [
+    "FMU_MODELS",
+    "FmuVariable",
+    "build_creep_force_fmu",
+    "build_fmu",
+    "creep_force_variables",
+    "resolve_parameters",
+]
