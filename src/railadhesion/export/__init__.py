@@ -16,12 +16,28 @@ from railadhesion.export.fmu import (
     creep_force_variables,
     resolve_parameters,
 )
+from railadhesion.export.tables import (
+    DEFAULT_GRID,
+    InterpolationError,
+    creep_force_table,
+    interpolation_error,
+    read_table_csv,
+    write_table_csv,
+    write_table_netcdf,
+)
 
 __all__ = [
+    "DEFAULT_GRID",
     "FMU_MODELS",
     "FmuVariable",
+    "InterpolationError",
     "build_creep_force_fmu",
     "build_fmu",
+    "creep_force_table",
     "creep_force_variables",
+    "interpolation_error",
+    "read_table_csv",
     "resolve_parameters",
+    "write_table_csv",
+    "write_table_netcdf",
 ]
