@@ -8,8 +8,12 @@ place as the tests (PYTHONPATH=src).
 from __future__ import annotations
 
 import hashlib
+import os
 import shutil
+import subprocess
+import sys
 import zipfile
+from pathlib import Path
 from xml.etree import ElementTree as ET
 
 import numpy as np
@@ -324,3 +328,53 @@ def test_fmu_variable_validates_its_fields():
         FmuVariable("x", "input", "m", "d")
     with pytest.raises(ValueError, match="causality"):
         FmuVariable("x", "local", "m", "d", 0.0)
+
+
+# --------------------------------------------------------------------------------------------
+# A host without Python
+
+
+def _libpython():
+    import sysconfig
+
+    if not sysconfig.get_config_var("Py_ENABLE_SHARED"):
+        return None
+    path = Path(sysconfig.get_config_var("LIBDIR")) / sysconfig.get_config_var("LDLIBRARY")
+    return path if path.is_file() else None
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the C host uses dlopen (Linux)")
+def test_runs_from_a_c_host_without_python(fmus, tmp_path):
+    """A C program loads the FMU's binary; with the Python shared library preloaded and the
+    package importable (what docs/fmu.md tells users), it gives the library's forces."""
+    compiler = shutil.which("cc") or shutil.which("gcc")
+    libpython = _libpython()
+    if compiler is None or libpython is None:
+        pytest.skip("needs a C compiler and a shared libpython")
+    host = tmp_path / "fmi2_host"
+    source = Path(__file__).with_name("data") / "fmi2_host.c"
+    subprocess.run([compiler, "-o", str(host), str(source), "-ldl"], check=True, timeout=60)
+    unzipped = tmp_path / "fmu"
+    with zipfile.ZipFile(fmus["wilac"]) as z:
+        z.extractall(unzipped)
+    md = read_model_description(fmus["wilac"])
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    binary = unzipped / "binaries" / "linux64" / f"{md.coSimulation.modelIdentifier}.so"
+    x = dict(creep_long=-0.03, creep_lat=0.004, spin=0.2, normal_force=80e3, speed=15.0,
+             a=7e-3, b=9e-3, water_flow=28.0)  # fmt: skip
+    args = [str(binary), (unzipped / "resources").as_uri(), md.guid, str(len(x))]
+    for name, value in x.items():
+        args += [str(vr[name]), repr(value)]
+    args += [str(len(OUTPUTS))] + [str(vr[k]) for k in OUTPUTS]
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+    bare = subprocess.run([str(host), *args], capture_output=True, text=True, env=env,
+                          timeout=120)  # fmt: skip
+    assert bare.returncode == 3 and "undefined symbol" in bare.stdout  # needs libpython
+    env["LD_PRELOAD"] = str(libpython)
+    run = subprocess.run([str(host), *args], capture_output=True, text=True, env=env,
+                         timeout=120)  # fmt: skip
+    assert run.returncode == 0, run.stdout + run.stderr
+    lines = run.stdout.split()
+    assert lines[:2] == ["status", "0"]
+    got = [float(v) for v in lines[2:]]
+    assert _close(got, _direct("wilac", default_wilac_parameters(), x))
