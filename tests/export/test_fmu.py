@@ -8,7 +8,9 @@ place as the tests (PYTHONPATH=src).
 from __future__ import annotations
 
 import hashlib
+import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -24,6 +26,7 @@ fmpy = pytest.importorskip("fmpy")
 
 from fmpy import extract, read_model_description  # noqa: E402
 from fmpy.fmi2 import FMU2Slave  # noqa: E402
+from fmpy.util import fmu_info  # noqa: E402
 from fmpy.validation import validate_fmu  # noqa: E402
 
 import railadhesion  # noqa: E402
@@ -149,6 +152,11 @@ def test_every_variable_has_a_defined_unit_and_a_description(fmus, model):
     for v in md.modelVariables:
         assert v.unit in defined and v.unit == expected_units[v.name]
         assert v.description
+    listing = fmu_info(str(fmus[model]))  # FMPy's dump shows them too
+    for v in creep_force_variables(model):
+        if v.causality != "parameter":
+            assert re.search(rf"^\s+{v.name}\s+{v.causality}\s.*\s{re.escape(v.unit)}\s", listing,
+                             re.MULTILINE), v.name  # fmt: skip
     units = {v.name: v.unit for v in md.modelVariables}
     assert units["normal_force"] == "N" and units["Fx"] == "N" and units["spin"] == "rad/m"
     if model == "wilac":
@@ -264,15 +272,17 @@ def test_outputs_follow_inputs_without_a_step(fmus):
         slave.close()
 
 
-def test_lift_off_gives_zero_force_and_bad_input_fails_the_step(fmus):
+def test_lift_off_gives_zero_force_and_bad_input_gives_nan_and_fails_the_step(fmus):
     slave = _Slave(fmus["wilac"])
     try:
         slave.set(creep_long=0.1, normal_force=0.0)
         slave.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-3)
         assert slave.get(*OUTPUTS) == [0.0, 0.0, 0.0]
         slave.set(normal_force=50e3, a=-1e-3)
-        with pytest.raises(Exception, match="fmi2DoStep"):
+        assert all(math.isnan(v) for v in slave.get(*OUTPUTS))  # read without a step: NaN
+        with pytest.raises(Exception, match="fmi2DoStep failed with status 2"):  # discard
             slave.fmu.doStep(currentCommunicationPoint=1e-3, communicationStepSize=1e-3)
+        assert all(math.isnan(v) for v in slave.get(*OUTPUTS))
         slave.set(a=5e-3)  # recovers once the input is valid again
         slave.fmu.doStep(currentCommunicationPoint=1e-3, communicationStepSize=1e-3)
         assert slave.get("Fx")[0] < 0.0  # braking creep: the rail pulls the wheel back

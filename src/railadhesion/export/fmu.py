@@ -353,7 +353,7 @@ class ResolvedParameters:
             parts.append("RECONSTRUCTION, not the original authors' coefficients")
         for key in ("source", "created", "licence"):
             if prov.get(key):
-                parts.append(f"{key}: {prov[key]}")
+                parts.append(f"{key}: {str(prov[key]).rstrip('.')}")
         return "; ".join(parts)
 
 
@@ -498,9 +498,10 @@ def build_creep_force_fmu(
         for v in variables
     ]
     label = "WILAC" if model == "wilac" else "Polach"
+    summary = resolved.summary()
     description = (
         f"railadhesion {railadhesion.__version__}: {label} wheel-rail creep-force law "
-        f"(forces of the rail on the wheel, Kalker's signs). {resolved.summary()}. "
+        f"(forces of the rail on the wheel, Kalker's signs). {summary[0].upper()}{summary[1:]}. "
         f"Embedded as resources/{_PARAMETER_FILE}."
     )
     config = {

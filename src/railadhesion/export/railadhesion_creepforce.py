@@ -10,8 +10,8 @@ Python interpreter that runs the FMU).
 Outputs are evaluated from the current inputs whenever they are read after an input changed
 (the creep-force law is algebraic: direct feedthrough, no state), and at every ``doStep``.
 A normal force <= 0 (wheel lift-off) gives zero forces and zero adhesion; other invalid
-inputs (NaN, a <= 0, negative water flow, ...) make the call fail with the library's message
-in the FMU log.
+inputs (NaN, a <= 0, negative water flow, ...) give NaN outputs, the library's message in the
+FMU log and, at ``doStep``, a failed step (``fmi2Discard``).
 """
 
 from __future__ import annotations
@@ -66,7 +66,6 @@ class RailadhesionCreepForce(Fmi2Slave):
                 Fmi2Status.warning,
             )
         self._dirty = True
-        self._failed = None
         self.Fx = 0.0
         self.Fy = 0.0
         self.adhesion = 0.0
@@ -97,8 +96,8 @@ class RailadhesionCreepForce(Fmi2Slave):
 
     def _output_getter(self, name):
         def getter():
-            if self._dirty and not self._step():
-                raise ValueError(self._failed)
+            if self._dirty:
+                self._step()
             return getattr(self, name)
 
         return getter
@@ -139,8 +138,10 @@ class RailadhesionCreepForce(Fmi2Slave):
         try:
             self._evaluate()
         except ValueError as exc:
-            self._failed = f"railadhesion: {exc}"
-            self.log(self._failed, Fmi2Status.error)
+            # Invalid inputs: NaN outputs (a number would be a wrong force), the message in
+            # the log, and a failed step (pythonfmu reports it as fmi2Discard).
+            self.Fx = self.Fy = self.adhesion = math.nan
+            self._dirty = False
+            self.log(f"railadhesion: {exc}", Fmi2Status.error)
             return False
-        self._failed = None
         return True
