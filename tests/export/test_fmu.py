@@ -20,6 +20,8 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 pytest.importorskip("pythonfmu")
 fmpy = pytest.importorskip("fmpy")
@@ -388,3 +390,32 @@ def test_runs_from_a_c_host_without_python(fmus, tmp_path):
     assert lines[:2] == ["status", "0"]
     got = [float(v) for v in lines[2:]]
     assert _close(got, _direct("wilac", default_wilac_parameters(), x))
+
+
+# --------------------------------------------------------------------------------------------
+# Property: any valid scalar input gives the library's numbers
+
+
+@pytest.fixture(scope="module")
+def wilac_slave(fmus):
+    slave = _Slave(fmus["wilac"])
+    yield slave
+    slave.close()
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    creep_long=st.floats(-1.0, 1.0),
+    creep_lat=st.floats(-0.2, 0.2),
+    spin=st.floats(-5.0, 5.0),
+    normal_force=st.floats(1.0, 3e5),
+    speed=st.floats(0.0, 100.0),
+    a=st.floats(1e-4, 0.05),
+    b=st.floats(1e-4, 0.05),
+    water_flow=st.floats(0.0, 1e4),
+)
+def test_any_valid_input_matches_the_library(wilac_slave, **x):
+    wilac_slave.set(**x)
+    wilac_slave.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-3)
+    got = wilac_slave.get(*OUTPUTS)
+    assert _close(got, _direct("wilac", wilac_slave.params, x)), (x, got)

@@ -192,3 +192,15 @@ def test_bad_grids_and_mismatched_parameters_are_refused():
         interpolation_error(custom)
     with pytest.raises(ValueError, match="digits"):
         write_table_csv(t, "unused.csv", digits=30)
+
+
+def test_symmetric_grid_gives_odd_forces():
+    """Kalker's signs: with no spin, Fx is odd in creep_long and Fy odd in creep_lat; the
+    table, on grids symmetric about zero, keeps that symmetry exactly."""
+    grid = dict(SMALL, creep_lat=[-0.01, -0.002, 0.0, 0.002, 0.01])
+    t = creep_force_table("polach", spin=0.0, check=False, **grid)
+    fx = t["Fx"].transpose(..., "creep_lat", "creep_long").values
+    fy = t["Fy"].transpose(..., "creep_lat", "creep_long").values
+    assert np.abs(fy).max() > 1e3  # not trivially zero
+    np.testing.assert_allclose(fx, -fx[..., ::-1], rtol=1e-13, atol=1e-9)
+    np.testing.assert_allclose(fy, -fy[..., ::-1, :], rtol=1e-13, atol=1e-9)
