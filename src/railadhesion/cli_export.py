@@ -55,7 +55,7 @@ def export_fmu(
     try:
         resolved = resolve_parameters(model, params, parameter_set)
         path = build_creep_force_fmu(
-            out, model, resolved.params if params is None else params,
+            out, model, params, parameter_set=parameter_set,
             shear_modulus=shear_modulus, poisson=poisson,
         )  # fmt: skip
     except ValueError as exc:

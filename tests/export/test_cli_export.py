@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import zipfile
+from xml.etree import ElementTree as ET
 
 import pytest
 from typer.testing import CliRunner
@@ -25,6 +26,19 @@ def test_export_fmu_writes_a_valid_fmu(tmp_path):
     assert "polach2005_wet" in result.output
     with zipfile.ZipFile(out) as z:
         assert "resources/parameters.toml" in z.namelist()
+        description = ET.fromstring(z.read("modelDescription.xml")).get("description")
+    assert "'polach2005_wet' (built-in named Polach set)" in description
+
+
+def test_export_fmu_default_wilac_embeds_the_package_file(tmp_path):
+    from importlib import resources
+
+    out = tmp_path / "w.fmu"
+    result = runner.invoke(app, ["export", "fmu", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    package_file = resources.files("railadhesion").joinpath("data", "wilac_default.toml")
+    with zipfile.ZipFile(out) as z:
+        assert z.read("resources/parameters.toml") == package_file.read_bytes()
 
 
 def test_export_fmu_embeds_a_parameter_file(tmp_path):

@@ -419,3 +419,13 @@ def test_any_valid_input_matches_the_library(wilac_slave, **x):
     wilac_slave.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-3)
     got = wilac_slave.get(*OUTPUTS)
     assert _close(got, _direct("wilac", wilac_slave.params, x)), (x, got)
+
+
+def test_building_leaves_no_slave_module_behind(tmp_path, monkeypatch):
+    """The build imports the slave from a temporary folder; it must not stay importable (a
+    later FMU instance in this process would otherwise reuse a module whose file is gone)."""
+    monkeypatch.delitem(sys.modules, "railadhesion_creepforce", raising=False)
+    path = list(sys.path)
+    build_creep_force_fmu(tmp_path / "p.fmu", "polach")
+    assert "railadhesion_creepforce" not in sys.modules
+    assert sys.path == path

@@ -125,9 +125,9 @@ def _isolated_import_state():
     finally:
         sys.path[:] = path
         for name in set(sys.modules) - modules:
-            if name.startswith(("pythonfmu", "railadhesion")):
-                continue
-            del sys.modules[name]
+            package = name.split(".")[0]
+            if package not in ("pythonfmu", "railadhesion"):  # the slave module goes
+                del sys.modules[name]
 
 
 def build_fmu(
