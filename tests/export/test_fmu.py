@@ -214,6 +214,25 @@ def test_low_level_stepping_matches_direct_calls(fmus, model):
         slave.close()
 
 
+def test_instances_are_independent(fmus):
+    """Two WILAC instances and a Polach one, alive together (one per wheel, say), stepped
+    alternately with different inputs: each returns its own library numbers."""
+    slaves = [(_Slave(fmus["wilac"]), "wilac"), (_Slave(fmus["wilac"]), "wilac"),
+              (_Slave(fmus["polach"]), "polach")]  # fmt: skip
+    try:
+        rng = np.random.default_rng(7)
+        for step, xs in enumerate(zip(*[_random_inputs(rng, 20) for _ in slaves], strict=True)):
+            for (slave, model), x in zip(slaves, xs, strict=True):
+                slave.set(**{k: x[k] for k in _inputs(model)})
+            for (slave, _), _x in zip(slaves, xs, strict=True):
+                slave.fmu.doStep(currentCommunicationPoint=step * 1e-3, communicationStepSize=1e-3)
+            for (slave, model), x in zip(slaves, xs, strict=True):
+                assert _close(slave.get(*OUTPUTS), _direct(model, slave.params, x))
+    finally:
+        for slave, _ in slaves:
+            slave.close()
+
+
 def test_embedded_parameters_equal_the_requested_set(fmus):
     slave = _Slave(fmus["wilac"])
     try:
