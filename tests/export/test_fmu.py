@@ -299,6 +299,8 @@ def test_lift_off_gives_zero_force_and_bad_input_gives_nan_and_fails_the_step(fm
         slave.set(creep_long=0.1, normal_force=0.0)
         slave.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-3)
         assert slave.get(*OUTPUTS) == [0.0, 0.0, 0.0]
+        slave.set(normal_force=-math.inf)
+        assert all(math.isnan(v) for v in slave.get(*OUTPUTS))  # not a lift-off: invalid
         slave.set(normal_force=50e3, a=-1e-3)
         assert all(math.isnan(v) for v in slave.get(*OUTPUTS))  # read without a step: NaN
         with pytest.raises(Exception, match="fmi2DoStep failed with status 2"):  # discard

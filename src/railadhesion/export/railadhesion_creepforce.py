@@ -106,7 +106,7 @@ class RailadhesionCreepForce(Fmi2Slave):
 
     def _evaluate(self) -> None:
         q = self.normal_force
-        if q <= 0.0 and not math.isnan(q):  # wheel lift-off: no contact, no force
+        if q <= 0.0 and math.isfinite(q):  # wheel lift-off: no contact, no force
             self.Fx = self.Fy = self.adhesion = 0.0
             self._dirty = False
             return
