@@ -381,5 +381,9 @@ def fit_wilac_cmd(
     console.print(f"WILAC parameters written to {escape(str(out))}")
 
 
+from railadhesion import cli_export  # noqa: E402
+
+cli_export.register(app)
+
 if __name__ == "__main__":  # pragma: no cover
     app()

@@ -1,0 +1,160 @@
+"""``railadhesion export``: FMUs and creep-force tables for co-simulation and table-driven tools.
+
+A thin shell over :mod:`railadhesion.export`. Creepages on the command line are in percent,
+like the other commands; forces in N, speeds in m/s, water flow rates in µl/s.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+from rich.console import Console
+from rich.markup import escape
+
+export_app = typer.Typer(
+    no_args_is_help=True,
+    help="Use the models from other tools: FMI 2.0 co-simulation FMUs and creep-force tables.",
+)
+console = Console()
+
+_MODEL_HELP = "Creep-force model: wilac or polach."
+_PARAMS_HELP = "Parameter file (TOML, docs/parameter-files.md); embedded in the export."
+_SET_HELP = "Named parameter set: Polach, see 'railadhesion params list'; WILAC, 'default'."
+
+
+def _fail(message) -> None:
+    console.print(f"[red]error:[/red] {escape(str(message))}")
+    raise typer.Exit(code=2)
+
+
+def _floats(text: str | None, name: str, scale: float = 1.0):
+    if text is None:
+        return None
+    try:
+        values = [float(x) * scale for x in text.split(",") if x.strip()]
+    except ValueError:
+        _fail(f"{name}: expected numbers separated by commas, got {text!r}")
+    if not values:
+        _fail(f"{name}: expected at least one number")
+    return values
+
+
+@export_app.command("fmu")
+def export_fmu(
+    model: str = typer.Option("wilac", help=_MODEL_HELP),
+    params: Path | None = typer.Option(None, "--params", help=_PARAMS_HELP),
+    parameter_set: str | None = typer.Option(None, "--set", help=_SET_HELP),
+    out: Path = typer.Option(Path("creepforce.fmu"), help="The FMU file to write (.fmu)."),
+    shear_modulus: float = typer.Option(8.2e10, help="Start value of parameter G [Pa]."),
+    poisson: float = typer.Option(0.28, help="Start value of Poisson's ratio [-]."),
+) -> None:
+    """Write an FMI 2.0 co-simulation FMU of a creep-force law (needs Python on the host)."""
+    from railadhesion.export import build_creep_force_fmu, resolve_parameters
+
+    try:
+        resolved = resolve_parameters(model, params, parameter_set)
+        path = build_creep_force_fmu(
+            out, model, params, parameter_set=parameter_set,
+            shear_modulus=shear_modulus, poisson=poisson,
+        )  # fmt: skip
+    except ValueError as exc:
+        _fail(exc)
+    except OSError as exc:
+        _fail(f"cannot write {out}: {exc.strerror or exc}")
+    console.print(f"FMU written to {escape(str(path))}")
+    console.print(escape(f"{model}: {resolved.summary()}"))
+    try:
+        from fmpy.validation import validate_fmu
+    except ImportError:  # pragma: no cover - fmpy is optional at run time
+        return
+    problems = validate_fmu(str(path))
+    if problems:
+        _fail("the FMU does not pass FMPy's validation: " + "; ".join(problems))
+    console.print("modelDescription.xml passes FMPy's validation")
+
+
+@export_app.command("table")
+def export_table(
+    model: str = typer.Option("wilac", help=_MODEL_HELP),
+    params: Path | None = typer.Option(None, "--params", help=_PARAMS_HELP),
+    parameter_set: str | None = typer.Option(None, "--set", help=_SET_HELP),
+    out: Path = typer.Option(Path("creepforce_table.nc"), help="NetCDF file to write."),
+    csv: Path | None = typer.Option(
+        None, help="CSV file to write (default: OUT with suffix .csv)."
+    ),
+    no_csv: bool = typer.Option(False, "--no-csv", help="Write the NetCDF file only."),
+    creep_long_percent: str | None = typer.Option(
+        None, help="Longitudinal creepage grid [%], comma-separated (default: 39 values)."
+    ),
+    creep_lat_percent: str | None = typer.Option(
+        None, help="Lateral creepage grid [%], comma-separated (default: 23 values)."
+    ),
+    normal_force: str | None = typer.Option(None, help="Normal force grid [N]."),
+    speed: str | None = typer.Option(None, help="Rolling speed grid [m/s]."),
+    water: str | None = typer.Option(None, help="Water flow grid [µl/s] (WILAC)."),
+    spin: float = typer.Option(0.0, help="Spin creepage of the whole table [rad/m]."),
+    wheel_radius: float = typer.Option(0.625, help="Wheel rolling radius for Hertz [m]."),
+    rail_lateral_radius: float = typer.Option(0.3, help="Rail head radius for Hertz [m]."),
+    digits: int = typer.Option(12, help="Significant digits in the CSV (17: exact)."),
+) -> None:
+    """Evaluate a model on a grid; write NetCDF and CSV; report the interpolation error."""
+    from railadhesion.export import (
+        DEFAULT_GRID,
+        creep_force_table,
+        write_table_csv,
+        write_table_netcdf,
+    )
+
+    grid = {
+        "creep_long": _floats(creep_long_percent, "--creep-long-percent", 0.01),
+        "creep_lat": _floats(creep_lat_percent, "--creep-lat-percent", 0.01),
+        "normal_force": _floats(normal_force, "--normal-force"),
+        "speed": _floats(speed, "--speed"),
+        "water_flow": _floats(water, "--water"),
+    }
+    grid = {k: DEFAULT_GRID[k] if v is None else v for k, v in grid.items()}
+    csv_path = None if no_csv else (csv or out.with_suffix(".csv"))
+    try:
+        table = creep_force_table(
+            model, params, parameter_set=parameter_set, spin=spin, wheel_radius=wheel_radius,
+            rail_lateral_radius=rail_lateral_radius, **grid,
+        )  # fmt: skip
+        write_table_netcdf(table, out)
+        if csv_path is not None:
+            write_table_csv(table, csv_path, digits=digits)
+    except ValueError as exc:
+        _fail(exc)
+    except OSError as exc:
+        _fail(f"cannot write the table: {exc.strerror or exc}")
+    sizes = " x ".join(f"{d} {n}" for d, n in table["Fx"].sizes.items())
+    a = table.attrs
+    console.print(escape(f"{model} table, parameter set '{a['parameter_set']}': {sizes} "
+                         f"= {table['Fx'].size} points, spin {spin:g} rad/m"))  # fmt: skip
+    err = {k: a[f"interpolation_{k}"] for k in (
+        "max_error_Fx_over_Q", "rms_error_Fx_over_Q", "max_error_Fy_over_Q", "rms_error_Fy_over_Q"
+    )}  # fmt: skip
+    console.print(
+        escape(
+            f"interpolation error at {a['interpolation_check_points']} cell midpoints "
+            f"(multilinear vs model, |error|/Q): Fx max {err['max_error_Fx_over_Q']:.3g} "
+            f"RMS {err['rms_error_Fx_over_Q']:.3g}; Fy max {err['max_error_Fy_over_Q']:.3g} "
+            f"RMS {err['rms_error_Fy_over_Q']:.3g}"
+        )
+    )
+    per_axis = [
+        f"{k[len('interpolation_max_error_over_Q_'):-len('_only')]} {v:.3g}"
+        for k, v in a.items()
+        if k.endswith("_only")
+    ]
+    console.print(escape("max error with one axis at midpoints: " + ", ".join(per_axis)))
+    console.print(f"NetCDF written to {escape(str(out))}")
+    if csv_path is not None:
+        console.print(
+            f"CSV written to {escape(str(csv_path))} (layout: docs/creep-force-tables.md)"
+        )
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``export`` command group to the main CLI."""
+    app.add_typer(export_app, name="export")

@@ -1,0 +1,43 @@
+"""Use the models from other tools: FMI 2.0 co-simulation FMUs and creep-force tables.
+
+* :func:`build_creep_force_fmu`: a WILAC or Polach creep-force law as an FMU (pythonfmu);
+* :func:`creep_force_table`: a model evaluated on a grid, written as NetCDF
+  (:func:`write_table_netcdf`) and as a plain CSV (:func:`write_table_csv`), with the error
+  of multilinear interpolation in the table measured at the cell midpoints.
+
+See the README section "Using the models from other tools" and ``docs/creep-force-tables.md``.
+"""
+
+from railadhesion.export.fmu import (
+    FMU_MODELS,
+    FmuVariable,
+    build_creep_force_fmu,
+    build_fmu,
+    creep_force_variables,
+    resolve_parameters,
+)
+from railadhesion.export.tables import (
+    DEFAULT_GRID,
+    InterpolationError,
+    creep_force_table,
+    interpolation_error,
+    read_table_csv,
+    write_table_csv,
+    write_table_netcdf,
+)
+
+__all__ = [
+    "DEFAULT_GRID",
+    "FMU_MODELS",
+    "FmuVariable",
+    "InterpolationError",
+    "build_creep_force_fmu",
+    "build_fmu",
+    "creep_force_table",
+    "creep_force_variables",
+    "interpolation_error",
+    "read_table_csv",
+    "resolve_parameters",
+    "write_table_csv",
+    "write_table_netcdf",
+]

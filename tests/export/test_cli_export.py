@@ -1,0 +1,95 @@
+"""``railadhesion export fmu|table`` from the command line."""
+
+from __future__ import annotations
+
+import zipfile
+from xml.etree import ElementTree as ET
+
+import pytest
+from typer.testing import CliRunner
+
+from railadhesion.cli import app
+from railadhesion.io.paramfiles import save_polach_parameters
+from railadhesion.models import polach_parameters
+
+pytest.importorskip("pythonfmu")
+runner = CliRunner()
+
+
+def test_export_fmu_writes_a_valid_fmu(tmp_path):
+    out = tmp_path / "wet.fmu"
+    result = runner.invoke(
+        app, ["export", "fmu", "--model", "polach", "--set", "polach2005_wet", "--out", str(out)]
+    )
+    assert result.exit_code == 0, result.output
+    assert "passes FMPy's validation" in result.output
+    assert "polach2005_wet" in result.output
+    with zipfile.ZipFile(out) as z:
+        assert "resources/parameters.toml" in z.namelist()
+        description = ET.fromstring(z.read("modelDescription.xml")).get("description")
+    assert "'polach2005_wet' (built-in named Polach set)" in description
+
+
+def test_export_fmu_default_wilac_embeds_the_package_file(tmp_path):
+    from importlib import resources
+
+    out = tmp_path / "w.fmu"
+    result = runner.invoke(app, ["export", "fmu", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    package_file = resources.files("railadhesion").joinpath("data", "wilac_default.toml")
+    with zipfile.ZipFile(out) as z:
+        assert z.read("resources/parameters.toml") == package_file.read_bytes()
+
+
+def test_export_fmu_embeds_a_parameter_file(tmp_path):
+    path = save_polach_parameters(polach_parameters("polach2005_dry").replace(name="mine"),
+                                  tmp_path / "mine.toml")  # fmt: skip
+    out = tmp_path / "mine.fmu"
+    result = runner.invoke(
+        app, ["export", "fmu", "--model", "polach", "--params", str(path), "--out", str(out)]
+    )
+    assert result.exit_code == 0, result.output
+    with zipfile.ZipFile(out) as z:
+        assert z.read("resources/parameters.toml") == path.read_bytes()
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--model", "fletcher"], "model must be one of"),
+        (["--model", "polach", "--set", "nope"], "parameter_set must be one of"),
+        (["--model", "wilac", "--params", "missing.toml"], "cannot read"),
+        (["--model", "polach", "--out", "x.zip"], "ending in .fmu"),
+    ],
+)
+def test_export_fmu_user_errors_exit_2(args, message, tmp_path):
+    result = runner.invoke(app, ["export", "fmu", *args])
+    assert result.exit_code == 2
+    assert message in " ".join(result.output.split())
+
+
+def test_export_table_writes_netcdf_and_csv_and_reports_the_error(tmp_path):
+    out = tmp_path / "t.nc"
+    result = runner.invoke(
+        app,
+        ["export", "table", "--model", "wilac", "--out", str(out),
+         "--creep-long-percent=-10,-1,0,1,10", "--creep-lat-percent", "0,1",
+         "--normal-force", "20000,80000", "--speed", "10", "--water", "0,20,60"],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    assert "= 60 points" in text
+    assert "interpolation error at 8 cell midpoints" in text and "Fx max" in text
+    assert out.is_file() and out.with_suffix(".csv").is_file()
+
+
+def test_export_table_rejects_bad_grids(tmp_path):
+    result = runner.invoke(
+        app, ["export", "table", "--model", "polach", "--speed", "10,5", "--no-csv",
+              "--out", str(tmp_path / "t.nc")],
+    )  # fmt: skip
+    assert result.exit_code == 2
+    assert "speed: grid values must be strictly increasing" in " ".join(result.output.split())
+    result = runner.invoke(app, ["export", "table", "--speed", "ten"])
+    assert result.exit_code == 2
+    assert "--speed: expected numbers" in result.output
