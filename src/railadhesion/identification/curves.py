@@ -9,8 +9,9 @@ with ``s`` the absolute slip v - R omega [m/s] (or the relative slip (v - R omeg
 ratio of the adhesion at large slip to ``mu_s``, ``B`` [s/m or -] the rate of the fall. It
 rises linearly from 0 (slope ``mu_s/s0``), peaks, and falls towards ``A mu_s``: the shape of
 seed 002's Figs. 8-10 and of Polach's curves at large creep. Each speed band is fitted on the
-samples of the log (all axles), by weighted least squares on slip bins (equivalent to a fit to
-the samples when the slip is constant within a bin).
+samples of the log (all axles), by weighted least squares on 200 slip bins (equivalent to a
+fit to the samples when the slip is constant within a bin; R^2 and RMSE are then computed on
+the samples themselves).
 
 Uncertainty [our approximation]: the standard errors are the linearised ones
 (``s^2 (J^T W J)^-1``) with the residual variance of the samples, inflated by
@@ -113,8 +114,6 @@ def _fit_one(x, y, n_eff, slip_kind, bins=200):
     xb = sx[ok] / cnt[ok]
     yb = sy[ok] / cnt[ok]
     w = cnt[ok]
-    dev = y - (sy / np.maximum(cnt, 1))[k]
-    ss_within = float(dev @ dev)
     sw = np.sqrt(w)
     peak_i = int(np.argmax(yb))
     peak = float(yb[peak_i])
@@ -140,8 +139,8 @@ def _fit_one(x, y, n_eff, slip_kind, bins=200):
             if best is None or res.cost < best.cost:
                 best = res
     p = best.x
-    ss_between = float(2.0 * best.cost)
-    ssr = ss_between + ss_within
+    r = falling_adhesion(x, *p) - y  # residuals on the samples themselves
+    ssr = float(r @ r)
     n = float(x.size)
     sst = float(np.sum((y - y.mean()) ** 2))
     dof = max(n - 4.0, 1.0)
