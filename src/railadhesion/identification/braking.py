@@ -119,7 +119,8 @@ class BrakingIdentification:
     slip_rate, relative_slip_rate : ndarray (n, N)
         Time derivatives of the two slips [m/s^2], [1/s].
     use : ndarray of bool (n, N)
-        Samples usable for identification (valid data, v >= min_speed, wheel not locked).
+        Samples usable for identification (valid data, v >= min_speed, wheel not locked, not
+        within 1/f_c of a segment's ends where the filters start up).
     phase : ndarray of int8 (n, N)
         +1 inside a loss-of-adhesion window, -1 inside a recovery window, 0 elsewhere.
     windows : pandas.DataFrame
@@ -444,10 +445,12 @@ def identify_adhesion(
     slip = np.empty((n, n_ax))
     slip_rate = np.empty((n, n_ax))
     edge = np.zeros(n, bool)
+    edge_fast = np.zeros(n, bool)
     for a, b in _segments(log.segment):
         ts = t[a:b]
         if b - a < 8:
             edge[a:b] = True
+            edge_fast[a:b] = True
             v_f[a:b] = log.train_speed[a:b]
             d_f[a:b] = 0.0
             wd2[a:b] = wd05[a:b] = 0.0
@@ -474,6 +477,9 @@ def identify_adhesion(
         slip[a:b] = fast[:, 1 + 2 * n_ax:]
         slip_rate[a:b] = derivative(slip[a:b], ts)
         edge[a:b] = (ts - ts[0] < _EDGE_TIME) | (ts[-1] - ts < _EDGE_TIME)
+        # filter start-up / end effects of the fast filter: 1/fc either side
+        tf = 1.0 / wheel_cutoff
+        edge_fast[a:b] = (ts - ts[0] < tf) | (ts[-1] - ts < tf)
     step("brake coefficient (eq. 14)")
     turning = np.all(log.wheel_speed * r > 0.05 * np.maximum(log.train_speed, 1e-9)[:, None],
                      axis=1)
@@ -495,7 +501,8 @@ def identify_adhesion(
             rel_rate[a:b] = derivative(np.nan_to_num(rel[a:b]), t[a:b])
     rel_rate[~fast_ok] = np.nan
     wheel_turning = log.wheel_speed * r > 0.05 * np.maximum(log.train_speed, 1e-9)[:, None]
-    use = log.valid & ~sub[None, :] & fast_ok[:, None] & wheel_turning & np.isfinite(mu)
+    use = (log.valid & ~sub[None, :] & fast_ok[:, None] & wheel_turning & np.isfinite(mu)
+           & ~edge_fast[:, None])
     step("identification windows")
     phase = np.zeros((n, n_ax), np.int8)
     rows = []
