@@ -156,26 +156,34 @@ class BrakingIdentification:
     settings: dict
     log: BrakingLog = field(repr=False)
     vehicle: object = field(repr=False)
+    _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def n_axles(self) -> int:
         return int(self.mu.shape[1])
 
     def samples(self, phase: str = "all"):
-        """Flat arrays (speed, slip, relative_slip, mu, axle) of the usable samples.
+        """Flat arrays (speed, slip, relative_slip, mu, axle) of the usable samples, axle by axle.
 
         ``phase``: ``"all"``, ``"loss"`` or ``"recovery"`` (samples inside windows of that
         phase).
         """
         check_choice(phase, "phase", ("all", "loss", "recovery"))
-        mask = self.use.copy()
-        if phase == "loss":
-            mask &= self.phase == 1
-        elif phase == "recovery":
-            mask &= self.phase == -1
-        rows, axles = np.nonzero(mask)
-        return (self.speed[rows], self.slip[rows, axles], self.relative_slip[rows, axles],
-                self.mu[rows, axles], axles)  # fmt: skip
+        if phase in self._cache:
+            return self._cache[phase]
+        parts = []
+        for i in range(self.n_axles):
+            mask = self.use[:, i]
+            if phase == "loss":
+                mask = mask & (self.phase[:, i] == 1)
+            elif phase == "recovery":
+                mask = mask & (self.phase[:, i] == -1)
+            rows = np.flatnonzero(mask)
+            parts.append((self.speed[rows], self.slip[rows, i], self.relative_slip[rows, i],
+                          self.mu[rows, i], np.full(rows.size, i)))
+        out = tuple(np.concatenate(col) for col in zip(*parts, strict=True))
+        self._cache[phase] = out
+        return out
 
     def summary_dict(self) -> dict:
         """JSON-ready summary: c, counts, slip range, windows per phase, settings."""

@@ -31,6 +31,7 @@ test logs it also gives the smaller bias of mu at small slip (``docs/identificat
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 from scipy import signal
 
 from railadhesion._validate import check_choice, check_positive
@@ -117,16 +118,91 @@ def lowpass(x, cutoff: float, fs: float, mode: str = "zero-phase", axis: int = 0
     n = x.shape[axis]
     if n < 2:
         return x.copy()
+    if mode == "zero-phase":
+        b, a = _coefficients(_zero_phase_cutoff(cutoff, fs), fs)
+    zi = float(signal.lfilter_zi(b, a)[0])
+    # time first, channels flattened last: the kernels run along time, all channels at once
+    moved = np.moveaxis(x, axis, 0)
+    cols = np.ascontiguousarray(moved.reshape(n, -1))
     if mode == "causal":
-        zi = signal.lfilter_zi(b, a)
-        shape = [1] * x.ndim
-        shape[axis] = zi.size
-        first = np.take(x, [0], axis=axis)
-        y, _ = signal.lfilter(b, a, x, axis=axis, zi=zi.reshape(shape) * first)
-        return y
-    b, a = _coefficients(_zero_phase_cutoff(cutoff, fs), fs)
-    padlen = min(n - 1, max(3, int(3 * fs / cutoff)))
-    return signal.filtfilt(b, a, x, axis=axis, padtype="odd", padlen=padlen)
+        out = _first_order(cols, float(b[0]), float(b[1]), float(a[1]), zi)
+    else:
+        padlen = min(n - 1, max(3, int(3 * fs / cutoff)))
+        out = _first_order_filtfilt(cols, float(b[0]), float(b[1]), float(a[1]), zi, padlen)
+    return np.moveaxis(out.reshape(moved.shape), 0, axis)
+
+
+@njit(cache=True)
+def _first_order(x, b0, b1, a1, zi):  # pragma: no cover - compiled
+    """First-order IIR (direct form II transposed) along axis 0 of an (n, m) array, from
+    steady state at the first sample: :func:`scipy.signal.lfilter` with
+    ``zi = lfilter_zi * x[0]``."""
+    n, m = x.shape
+    y = np.empty_like(x)
+    z = np.empty(m)
+    for j in range(m):
+        z[j] = zi * x[0, j]
+    for k in range(n):
+        for j in range(m):
+            xk = x[k, j]
+            yk = b0 * xk + z[j]
+            z[j] = b1 * xk - a1 * yk
+            y[k, j] = yk
+    return y
+
+
+@njit(cache=True)
+def _first_order_filtfilt(x, b0, b1, a1, zi, padlen):  # pragma: no cover - compiled
+    """Forward-backward first-order IIR along axis 0 with odd extension: the same as
+    :func:`scipy.signal.filtfilt` (``padtype="odd"``, ``method="pad"``)."""
+    n, m = x.shape
+    length = n + 2 * padlen
+    ext = np.empty((length, m))
+    for k in range(padlen):
+        for j in range(m):
+            ext[k, j] = 2.0 * x[0, j] - x[padlen - k, j]
+            ext[padlen + n + k, j] = 2.0 * x[n - 1, j] - x[n - 2 - k, j]
+    for k in range(n):
+        for j in range(m):
+            ext[padlen + k, j] = x[k, j]
+    z = np.empty(m)
+    for j in range(m):
+        z[j] = zi * ext[0, j]
+    for k in range(length):
+        for j in range(m):
+            xk = ext[k, j]
+            yk = b0 * xk + z[j]
+            z[j] = b1 * xk - a1 * yk
+            ext[k, j] = yk
+    for j in range(m):
+        z[j] = zi * ext[length - 1, j]
+    for k in range(length - 1, -1, -1):
+        for j in range(m):
+            xk = ext[k, j]
+            yk = b0 * xk + z[j]
+            z[j] = b1 * xk - a1 * yk
+            ext[k, j] = yk
+    return ext[padlen:padlen + n].copy()
+
+
+@njit(cache=True)
+def _gradient(x, t):  # pragma: no cover - compiled
+    """d x / d t along axis 0 of an (n, m) array: :func:`numpy.gradient` (second order inside,
+    first order at the ends) for non-uniform times."""
+    n, m = x.shape
+    g = np.empty_like(x)
+    for j in range(m):
+        g[0, j] = (x[1, j] - x[0, j]) / (t[1] - t[0])
+        g[n - 1, j] = (x[n - 1, j] - x[n - 2, j]) / (t[n - 1] - t[n - 2])
+    for k in range(1, n - 1):
+        h0 = t[k] - t[k - 1]
+        h1 = t[k + 1] - t[k]
+        c0 = -h1 / (h0 * (h0 + h1))
+        c1 = (h1 - h0) / (h0 * h1)
+        c2 = h0 / (h1 * (h0 + h1))
+        for j in range(m):
+            g[k, j] = c0 * x[k - 1, j] + c1 * x[k, j] + c2 * x[k + 1, j]
+    return g
 
 
 def lowpass_gain(frequency, cutoff: float, fs: float, mode: str = "zero-phase"):
@@ -151,8 +227,8 @@ def lowpass_gain(frequency, cutoff: float, fs: float, mode: str = "zero-phase"):
 def derivative(x, t, axis: int = 0):
     """Finite-difference derivative dx/dt (central inside, one-sided at the ends).
 
-    :func:`numpy.gradient` with the sample times, second-order accurate on non-uniform
-    spacing. ``x`` and ``t`` must have the same length along ``axis``.
+    The formula of :func:`numpy.gradient` with the sample times (second-order accurate on
+    non-uniform spacing), compiled. ``x`` and ``t`` must have the same length along ``axis``.
 
     Examples
     --------
@@ -162,7 +238,10 @@ def derivative(x, t, axis: int = 0):
     True
     """
     x = np.asarray(x, dtype=float)
-    t = np.asarray(t, dtype=float)
-    if x.shape[axis] < 2:
+    t = np.ascontiguousarray(t, dtype=float)
+    n = x.shape[axis]
+    if n < 2:
         return np.zeros_like(x)
-    return np.gradient(x, t, axis=axis)
+    moved = np.moveaxis(x, axis, 0)
+    g = _gradient(np.ascontiguousarray(moved.reshape(n, -1)), t)
+    return np.moveaxis(g.reshape(moved.shape), 0, axis)
