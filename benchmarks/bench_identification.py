@@ -87,12 +87,17 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--hours", type=float, default=1.0)
+    ap.add_argument("--keep", type=Path, default=None,
+                    help="Write the log here (log.csv/log.parquet) and reuse it if present.")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
-        base = Path(tmp) / "log"
+        base = (args.keep or Path(tmp)) / "log"
+        base.parent.mkdir(parents=True, exist_ok=True)
         t0 = time.perf_counter()
-        n = make_log(base, args.hours)
-        print(f"log: {n} samples x 4 axles ({args.hours:g} h at 2.4 ms), made in "
+        if not (base.with_suffix(".parquet").exists() and base.with_suffix(".csv").exists()):
+            make_log(base, args.hours)
+        n = len(pd.read_parquet(base.with_suffix(".parquet"), columns=["time"]))
+        print(f"log: {n} samples x 4 axles ({n * PERIOD / 3600:g} h at 2.4 ms), ready in "
               f"{time.perf_counter() - t0:.1f} s")
         times: dict[str, list[float]] = {}
 

@@ -500,9 +500,8 @@ def identify_adhesion(
     step("normal loads and adhesion (eqs. 10-13)")
     loads = np.asarray(vehicle.axle_normal_loads(d_f))
     mu = (j * wd2 + c * p2) / (r * loads)
-    rel = np.full((n, n_ax), np.nan)
     fast_ok = v_f >= min_speed
-    rel[fast_ok] = slip[fast_ok] / v_f[fast_ok, None]
+    rel = np.where(fast_ok[:, None], slip / np.where(fast_ok, v_f, 1.0)[:, None], np.nan)
     rel_rate = np.full((n, n_ax), np.nan)
     for a, b in _segments(log.segment):
         if b - a >= 2:
