@@ -80,6 +80,7 @@ _FIELDS = {
     "cg_height": ("cg_height_m", 0.0, 5.0, False, False),
     "half_pivot_spacing": ("half_pivot_spacing_m", 0.5, 50.0, False, False),
     "secondary_stiffness": ("secondary_stiffness_N_per_m", 0.0, 1e9, True, False),
+    "bogie_wheelbase": ("bogie_wheelbase_m", 0.0, 10.0, False, False),
     "davis_a": ("davis_a_N", 0.0, 1e6, False, False),
     "davis_b": ("davis_b_N_s_per_m", 0.0, 1e5, False, False),
     "davis_c": ("davis_c_N_s2_per_m2", 0.0, 1e3, False, False),
@@ -117,6 +118,9 @@ class Vehicle:
     secondary_stiffness : float or None
         k_2, vertical secondary-suspension stiffness of one bogie [N/m]; needed only for
         :meth:`pitch_angle` (eq. 13).
+    bogie_wheelbase : float
+        Distance between the first and last axle of a bogie [m] (default 2.5 m, an
+        assumption); used only to place the axles along the track (:meth:`axle_offsets`).
     davis_a, davis_b, davis_c : float
         Running resistance ``F = a + b v + c v²`` [N, N s/m, N s²/m²] (Davis form); 0 by
         default (the paper neglects it, eq. 7).
@@ -135,6 +139,7 @@ class Vehicle:
     cg_height: float = 0.8
     half_pivot_spacing: float = 9.5
     secondary_stiffness: float | None = None
+    bogie_wheelbase: float = 2.5
     davis_a: float = 0.0
     davis_b: float = 0.0
     davis_c: float = 0.0
@@ -196,6 +201,12 @@ class Vehicle:
         bogie = 0.5 * self.body_mass * GRAVITY + sign * transfer
         loads = bogie / k + self.bogie_mass * GRAVITY / k + self.wheelset_mass * GRAVITY
         return np.maximum(loads, 0.0)
+
+    def axle_offsets(self) -> np.ndarray:
+        """Distance of each axle behind axle 1 [m] (leading axle first)."""
+        k = self.axles_per_bogie
+        inner = np.linspace(0.0, self.bogie_wheelbase, k) if k > 1 else np.zeros(1)
+        return np.concatenate([inner, inner + 2.0 * self.half_pivot_spacing])
 
     def pitch_angle(self, deceleration=0.0):
         """Car-body pitch angle [rad], eq. 13: θ = −M_c h d / (2 k_2 l²) (negative: nose down)."""
