@@ -387,3 +387,7 @@ cli_export.register(app)
 
 if __name__ == "__main__":  # pragma: no cover
     app()
+
+from railadhesion.cli_identification import register as _register_identification  # noqa: E402
+
+_register_identification(app)
