@@ -15,12 +15,14 @@ checks of the default parameter set) or directly as the semi-axes ``(a, b)`` in 
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from matplotlib.figure import Figure
 
 from railadhesion._validate import check_finite, check_nonnegative, check_positive
+
+# The named contact geometries live in railadhesion.contact (re-exported here, where they
+# were first defined, for compatibility).
+from railadhesion.contact.geometry import WILAC_GEOMETRIES, contact_semi_axes
 
 __all__ = [
     "WILAC_GEOMETRIES",
@@ -31,88 +33,9 @@ __all__ = [
     "plot_wilac_speeds",
 ]
 
-#: Named wheel–rail (or wheel–roller) geometries for the WILAC figures, as the radii of
-#: :func:`railadhesion.contact.hertz.hertz_3d` [m] (steel, E = 210 GPa, ν = 0.28).
-#: ``tram``: seed 000 §4 — wheel diameter 0.696 m on a rail roller of diameter 0.905 m,
-#: effective lateral radius of the contact 0.660 m (put on the roller, the wheel taken as
-#: laterally straight). ``locomotive``: our choice for the 110 kN checks (the paper does not
-#: state its locomotive contact): wheel radius 0.625 m (as CONTACT's Eurosprinter example),
-#: laterally straight (conical) tread on a rail head of lateral radius 0.300 m (a/b ≈ 1.6 at
-#: 110 kN). The same numbers are used by ``scripts/build_default_wilac.py``.
-WILAC_GEOMETRIES: dict[str, dict[str, float]] = {
-    "tram": {
-        "wheel_radius": 0.348,
-        "rail_radius": 0.4525,
-        "wheel_lateral_radius": math.inf,
-        "rail_lateral_radius": 0.660,
-    },
-    "locomotive": {
-        "wheel_radius": 0.625,
-        "rail_radius": math.inf,
-        "wheel_lateral_radius": math.inf,
-        "rail_lateral_radius": 0.300,
-    },
-}
-
 _CREEP_LABEL = "longitudinal creep $c_x$ [%] (traction < 0)"
 _ADHESION_LABEL = "adhesion $T_x/Q$ [-]"
 _WATER_LABEL = "water flow rate $w$ [µl/s]"
-
-
-def contact_semi_axes(geometry, normal_force) -> tuple[float, float]:
-    """Semi-axes ``(a, b)`` [m] of a named geometry at a normal force, or ``geometry`` itself.
-
-    Parameters
-    ----------
-    geometry : str or (float, float)
-        A key of :data:`WILAC_GEOMETRIES` (Hertz contact via
-        :func:`railadhesion.contact.hertz.hertz_3d`), or the semi-axes ``(a, b)`` [m] along the
-        rolling direction and laterally.
-    normal_force : float
-        Normal force Q [N], > 0.
-
-    Returns
-    -------
-    (float, float)
-        ``a`` (rolling direction) and ``b`` (lateral) [m].
-
-    Examples
-    --------
-    >>> a, b = contact_semi_axes("tram", 4200.0)
-    >>> round(a * 1e3, 2), round(b * 1e3, 2)
-    (1.41, 3.15)
-    """
-    q = float(check_positive(normal_force, "normal_force"))
-    if isinstance(geometry, str):
-        if geometry not in WILAC_GEOMETRIES:
-            raise _geometry_error(geometry)
-        from railadhesion.contact.hertz import hertz_3d
-
-        g = WILAC_GEOMETRIES[geometry]
-        contact = hertz_3d(
-            q,
-            g["wheel_radius"],
-            g["wheel_lateral_radius"],
-            g["rail_lateral_radius"],
-            g["rail_radius"],
-            young=2.1e11,
-            poisson=0.28,
-        )
-        return float(contact.a), float(contact.b)
-    try:
-        a, b = (float(x) for x in geometry)
-    except (TypeError, ValueError) as exc:
-        raise _geometry_error(geometry) from exc
-    check_positive(a, "geometry a")
-    check_positive(b, "geometry b")
-    return a, b
-
-
-def _geometry_error(geometry) -> ValueError:
-    return ValueError(
-        f"geometry must be one of {sorted(WILAC_GEOMETRIES)} or an (a, b) pair in m, "
-        f"got {geometry!r}"
-    )
 
 
 def _params(params):

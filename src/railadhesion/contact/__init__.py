@@ -1,6 +1,7 @@
 """Contact mechanics: Hertz, Kalker linear theory, FASTSIM."""
 
 from railadhesion.contact.fastsim import FastsimResult, fastsim
+from railadhesion.contact.geometry import NAMED_GEOMETRIES, contact_semi_axes
 from railadhesion.contact.hertz import (
     HertzContact,
     LineContact,
@@ -17,11 +18,13 @@ from railadhesion.contact.kalker import (
 )
 
 __all__ = [
+    "NAMED_GEOMETRIES",
     "FastsimResult",
     "HertzContact",
     "KalkerCoefficients",
     "LineContact",
     "combined_elastic_constants",
+    "contact_semi_axes",
     "fastsim",
     "hertz_3d",
     "hertz_3d_from_curvatures",
