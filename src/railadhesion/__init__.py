@@ -7,9 +7,12 @@ oppose the creepage (Kalker's convention, as in CONTACT).
 
 import numpy as _np
 
+from railadhesion._labelled import labelled as _labelled
+
 __version__ = "0.1.0"
 
 
+@_labelled(units="1")
 def adhesion(fx, fy, normal_force):
     """Adhesion coefficient |T|/Q = sqrt(Fx^2 + Fy^2)/Q (dimensionless, >= 0).
 

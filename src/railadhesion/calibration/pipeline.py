@@ -210,6 +210,19 @@ class WilacCalibration:
             for cf in self.curve_fits
         ]
 
+    def to_dataframe(self):
+        """:meth:`curve_table` as a :class:`pandas.DataFrame` (one row per curve), units in
+        ``attrs["units"]``; ``attrs["warnings"]`` lists the check's findings."""
+        import pandas as pd
+
+        df = pd.DataFrame(self.curve_table())
+        df.attrs["units"] = {
+            "normal_force_N": "N", "speed_m_s": "m/s", "water_flow_ul_s": "µl/s",
+            "fit_rmse": "1", "calibrated_rmse": "1", "calibrated_max_error": "1",
+        }  # fmt: skip
+        df.attrs["warnings"] = list(self.warnings)
+        return df
+
     def summary(self) -> str:
         """Readable report: curves per condition, fit quality, regression terms."""
         lines = [f"WILAC calibration from {len(self.curve_fits)} creep curves"]
