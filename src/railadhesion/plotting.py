@@ -31,6 +31,7 @@ __all__ = [
     "plot_wilac_curves",
     "plot_wilac_water",
     "plot_wilac_speeds",
+    "plot_fit",
 ]
 
 _CREEP_LABEL = "longitudinal creep $c_x$ [%] (traction < 0)"
@@ -376,4 +377,67 @@ def plot_wilac_speeds(
         (-100 * float(creep_max), 0.0),
         fontsize="small",
     )
+    return fig
+
+
+def plot_fit(result, *, title: str = "", n_points: int = 200, ax=None):
+    """Fitted model against the measured creep curve (from :func:`~railadhesion.calibration.
+    fitting.fit_polach` or :func:`~railadhesion.calibration.fitting.fit_fletcher`).
+
+    Parameters
+    ----------
+    result : FitResult
+        The fit; its data (``creep``, ``adhesion``) and model (``predict``) are drawn.
+    title : str, optional
+        Axes title; default names the model, R² and RMSE.
+    n_points : int, optional
+        Samples of the model curve.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Markers: measured adhesion; line: the fitted model over the measured creep range
+        (at the data points only when the fit had per-point conditions); x: |creep| [%].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from railadhesion.calibration import fit_polach
+    >>> creep = -np.geomspace(1e-5, 0.3, 12)
+    >>> from railadhesion.models.polach import polach_forces
+    >>> fx, _ = polach_forces(creep, 0, 0, 4200.0, 5.0, 4e-3, 3e-3, mu0=0.3, k_A=0.5)
+    >>> res = fit_polach(creep, np.abs(fx) / 4200, normal_force=4200.0, speed=5.0, a=4e-3,
+    ...                  b=3e-3, fit=("mu0", "k_A"))
+    >>> len(plot_fit(res).axes[0].lines)
+    2
+    """
+    creep = np.asarray(result.creep, dtype=float)
+    fig, ax = _axes(ax)
+    order = np.argsort(np.abs(creep))
+    ax.plot(100 * np.abs(creep[order]), np.asarray(result.adhesion)[order], "o", ms=4,
+            color="0.2", label=f"measured ({result.n_points} points)")  # fmt: skip
+    per_point = any(np.ndim(v) > 0 for v in result.conditions.values())
+    if per_point:
+        c = creep[order]
+        model = np.asarray(result.predict())[order]
+    else:
+        sign = -1.0 if np.mean(creep) < 0 else 1.0
+        mags = np.abs(creep)
+        c = sign * np.linspace(0.0, float(mags.max()), int(n_points))
+        model = np.asarray(result.predict(c))
+    fitted = ", ".join(result.fitted)
+    ax.plot(100 * np.abs(c), model, color="C0",
+            label=f"{result.model.capitalize()} fit ({fitted})")  # fmt: skip
+    ax.set_xlabel("|creep| [%]")
+    ax.set_ylabel("adhesion |T|/Q [-]")
+    ax.set_title(
+        title or f"{result.model.capitalize()} fit: R² = {result.r_squared:.4f}, "
+        f"RMSE = {result.rmse:.3g}"
+    )
+    ax.set_xlim(left=0.0)
+    ax.set_ylim(bottom=0.0)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
     return fig

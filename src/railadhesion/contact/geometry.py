@@ -102,15 +102,21 @@ def geometry_description(geometry) -> str:
 
     Examples
     --------
-    >>> geometry_description("tram").split(", ")[:2]
-    ['tram: wheel radius 0.348 m', 'rail radius 0.4525 m']
+    >>> print(geometry_description("locomotive").replace(" (", "\n("))
+    locomotive: wheel radius 0.625 m, rail lateral radius 0.3 m
+    (rail radius, wheel lateral radius infinite)
     """
     if isinstance(geometry, str):
         if geometry not in NAMED_GEOMETRIES:
             raise _geometry_error(geometry)
-        radii = ", ".join(
-            f"{k.replace('_', ' ')} {v:g} m" for k, v in NAMED_GEOMETRIES[geometry].items()
-        )
-        return f"{geometry}: {radii}"
+        radii = [
+            f"{k.replace('_', ' ')} {v:g} m"
+            for k, v in NAMED_GEOMETRIES[geometry].items()
+            if math.isfinite(v)
+        ]
+        flat = [k.replace("_", " ") for k, v in NAMED_GEOMETRIES[geometry].items()
+                if not math.isfinite(v)]  # fmt: skip
+        text = f"{geometry}: {', '.join(radii)}"
+        return text + (f" ({', '.join(flat)} infinite)" if flat else "")
     a, b = (float(x) for x in geometry)
     return f"semi-axes a = {a:g} m, b = {b:g} m"
