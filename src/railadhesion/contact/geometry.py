@@ -102,9 +102,8 @@ def geometry_description(geometry) -> str:
 
     Examples
     --------
-    >>> print(geometry_description("locomotive").replace(" (", "\n("))
-    locomotive: wheel radius 0.625 m, rail lateral radius 0.3 m
-    (rail radius, wheel lateral radius infinite)
+    >>> geometry_description("locomotive")[:46]
+    'locomotive: wheel radius 0.625 m, rail lateral'
     """
     if isinstance(geometry, str):
         if geometry not in NAMED_GEOMETRIES:
