@@ -249,3 +249,161 @@ def test_help_of_every_command(command):
     result = _run(*command, "--help")
     assert result.exit_code == 0, result.output
     assert "Usage" in result.output
+
+
+# ---- issue 9, item 8: help texts, output files, warnings, geometry, params, version, exports
+
+
+def test_help_texts_keep_units_in_brackets():
+    result = _run("hertz", "--help")
+    text = " ".join(result.output.split())
+    assert "Wheel rolling radius [m]" in text
+    assert "Rail (or roller) rolling radius [m]" in text
+    result = _run("wilac", "curves", "--help")
+    assert "[m/s]" in result.output
+
+
+def test_version():
+    import railadhesion
+
+    result = _run("--version")
+    assert result.exit_code == 0
+    assert result.output.strip() == f"railadhesion {railadhesion.__version__}"
+
+
+def test_out_without_extension_names_the_file_written(tmp_path):
+    out = tmp_path / "noext"
+    result = _run("wilac", "weights", "--out", str(out))
+    assert result.exit_code == 0, result.output
+    assert (tmp_path / "noext.png").stat().st_size > 1000
+    assert "noext.png" in " ".join(result.output.split()).replace(" ", "")
+
+
+def _write_curve_with_bad_row(path):
+    path.write_text(
+        "# normal_force_N = 4200\n# speed_m_s = 5\n# a_m = 0.004\n# b_m = 0.003\n"
+        "creep,adhesion\n-0.001,0.05\n-0.01,0.2\nabc,0.3\n-0.02,0.25\n-0.05,0.27\n"
+        "-0.1,0.26\n-0.2,0.24\n-0.3,0.23\n",
+        encoding="utf-8",
+    )
+
+
+def test_warnings_are_plain_lines_without_source_location(tmp_path):
+    csv_path = tmp_path / "curve.csv"
+    _write_curve_with_bad_row(csv_path)
+    result = _run("fit", "polach", str(csv_path), "--fit", "mu0,k_A")
+    assert result.exit_code == 0, result.output
+    assert "warning:" in result.output
+    assert ".py:" not in result.output and "warnings.warn" not in result.output
+    assert "creepcurves" not in result.output
+
+
+def test_polach_geometry_is_settable_and_printed():
+    loco = _run("polach", "--creep-percent", "1", "--format", "csv")
+    tram = _run("polach", "--creep-percent", "1", "--geometry", "tram", "--format", "csv")
+    given = _run("polach", "--creep-percent", "1", "--a", "0.004", "--b", "0.003",
+                 "--format", "csv")  # fmt: skip
+    values = [float(r.output.strip().splitlines()[1].split(",")[2]) for r in (loco, tram, given)]
+    assert len(set(values)) == 3  # three contacts, three adhesions
+    table = _run("polach", "--creep-percent", "1", "--geometry", "tram")
+    text = " ".join(table.output.split())
+    assert "contact: tram" in text and "a = " in text and "b = " in text
+    bad = _run("polach", "--geometry", "metro")
+    assert bad.exit_code == 2 and "locomotive" in bad.output
+    half = _run("polach", "--a", "0.004")
+    assert half.exit_code == 2 and "--b" in half.output
+
+
+def test_polach_rejects_creep_beyond_100_percent():
+    result = _run("polach", "--creep-percent", "1,150")
+    assert result.exit_code == 2
+    assert "[-100, 100]" in result.output
+
+
+def test_params_check_on_wilac_prints_provenance(tmp_path):
+    from importlib import resources
+
+    path = resources.files("railadhesion").joinpath("data", "wilac_default.toml")
+    result = _run("params", "check", str(path))
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    assert "reconstruction: YES" in text
+    assert "source:" in text and "speed range:" in text
+
+
+def test_params_list_lists_wilac_sets_and_fletcher_conditions():
+    result = _run("params", "list")
+    assert result.exit_code == 0, result.output
+    text = result.output
+    assert "polach2005_dry" in text and "WILAC" in text and "default" in text
+    for code in ("W1", "D3", "O1"):
+        assert code in text
+    fletcher = _run("params", "list", "--kind", "fletcher", "--format", "csv")
+    rows = fletcher.output.strip().splitlines()
+    assert rows[0].startswith("test_code,lubricant") and len(rows) == 11
+    both = _run("params", "list", "--format", "csv")
+    assert both.exit_code == 2 and "--kind" in both.output
+
+
+@pytest.mark.parametrize(
+    "args",
+    [["hertz"], ["polach", "--creep-percent", "1,2"], ["wilac", "table", "--water", "0,25"],
+     ["params", "list", "--kind", "polach"]],
+)  # fmt: skip
+def test_every_table_command_exports_csv_and_json(tmp_path, args):
+    import csv as csvmod
+    import json
+
+    as_json = _run(*args, "--format", "json")
+    assert as_json.exit_code == 0, as_json.output
+    records = json.loads(as_json.output)
+    assert isinstance(records, list) and records and isinstance(records[0], dict)
+    out = tmp_path / "table.csv"
+    written = _run(*args, "--out", str(out))
+    assert written.exit_code == 0, written.output
+    rows = list(csvmod.DictReader(out.open(encoding="utf-8")))
+    assert len(rows) == len(records)
+    assert set(rows[0]) == set(records[0])
+
+
+def test_fit_polach_states_fixed_values_sets_them_and_writes_figure(tmp_path):
+    csv_path = tmp_path / "c.csv"
+    params = dict(k_A=0.6, k_S=0.2, mu0=0.35, A=0.4, B=0.5)
+    _write_synthetic_curve(csv_path, params, 4200.0, 5.0, 0.0)
+    fig = tmp_path / "fit.png"
+    result = _run("fit", "polach", str(csv_path), "--fit", "k_A,k_S,mu0", "--figure", str(fig))
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    assert "not fitted, held at A = 1, B = 0 (model defaults" in text
+    assert fig.stat().st_size > 1000
+    good = _run("fit", "polach", str(csv_path), "--fit", "k_A,k_S,mu0", "--fixed", "A=0.4,B=0.5",
+                "--format", "json")  # fmt: skip
+    assert good.exit_code == 0, good.output
+    import json
+
+    table = {r["parameter"]: r for r in json.loads(good.output.split("\nnote:")[0])}
+    assert table["A"]["value"] == 0.4 and table["A"]["fitted"].startswith("no")
+    assert table["mu0"]["value"] == pytest.approx(0.35, rel=1e-3)
+    clash = _run("fit", "polach", str(csv_path), "--fit", "A,mu0", "--fixed", "A=0.4")
+    assert clash.exit_code == 2 and "fitted or fixed" in clash.output
+
+
+def test_fit_wilac_knobs_and_per_curve_csv(tmp_path):
+    sets = {0.0: dict(k_A=1.0, k_S=0.4, mu0=0.45, A=0.4, B=0.6),
+            25.0: dict(k_A=0.3, k_S=0.1, mu0=0.15, A=0.4, B=0.3),
+            35.0: dict(k_A=0.3, k_S=0.1, mu0=0.2, A=0.8, B=0.2),
+            350.0: dict(k_A=0.2, k_S=0.1, mu0=0.15, A=0.9, B=0.1)}  # fmt: skip
+    folder = tmp_path / "curves"
+    folder.mkdir()
+    for w, params in sets.items():
+        for q in (3000.0, 6000.0):
+            _write_synthetic_curve(folder / f"w{w:g}_q{q:g}.csv", params, q, 5.0, w)
+    table = tmp_path / "curves.csv"
+    result = _run("fit", "wilac", str(folder), "--out", str(tmp_path / "w.toml"),
+                  "--speed-range", "2,10", "--criterion", "bic", "--max-terms", "2",
+                  "--no-refine", "--table", str(table))  # fmt: skip
+    assert result.exit_code == 0, result.output
+    lines = table.read_text(encoding="utf-8").splitlines()
+    assert lines[0].startswith("curve,condition,normal_force_N") and len(lines) == 9
+    bad = _run("fit", "wilac", str(folder), "--criterion", "adjusted")
+    assert bad.exit_code == 2 and "criterion" in bad.output

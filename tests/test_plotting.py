@@ -114,3 +114,38 @@ def test_bad_arguments():
         plot_wilac_curves(water_flows=(-1,))
     with pytest.raises(ValueError, match="params"):
         plot_wilac_speeds(params="default")
+
+
+# ---- issue 9, item 9: creep zoom, hidden curves said in the legend, labelled flow-rate marks
+
+
+def test_creep_figures_have_a_zoom_panel_on_the_first_percent():
+    fig = plot_wilac_curves(n_points=40)
+    zoom, main = fig.axes
+    assert zoom.get_xlim() == (-3.0, 0.0)
+    assert main.get_xlim() == (-100.0, 0.0)
+    # the zoom panel resolves the rise: many samples within 0-3 % creep
+    x = np.asarray(zoom.lines[0].get_xdata())
+    assert np.count_nonzero((x >= -3) & (x <= 0)) >= 100
+    one = plot_wilac_speeds(n_points=30, zoom=None)
+    assert len(one.axes) == 1
+
+
+def test_hidden_curves_are_named_in_the_legend():
+    fig = plot_wilac_curves(n_points=40)
+    labels = [t.get_text() for t in fig.axes[1].get_legend().get_texts()]
+    assert "w = 350 µl/s (same as w = 60 µl/s)" in labels
+    hidden = fig.axes[1].lines[-1]
+    assert hidden.get_linestyle() != fig.axes[1].lines[-2].get_linestyle()
+    fig = plot_wilac_speeds(n_points=40)
+    labels = [t.get_text() for t in fig.axes[1].get_legend().get_texts()]
+    assert any("v = 10 m/s (same as WILAC, v = 10 m/s)" in lab for lab in labels)
+    assert sum("same as" in lab for lab in labels) == 1  # only the truly coinciding curve
+
+
+def test_flow_rate_marks_are_labelled():
+    fig = plot_wilac_water(marks=(25, 35, 60), n_points=50)
+    ax = fig.axes[0]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "measured flow rates (25, 35, 60 µl/s)" in labels
+    assert {t.get_text() for t in ax.texts} == {"25", "35", "60"}

@@ -5,13 +5,14 @@ xi = (V - omega R)/V (braking positive); forces are exerted by the rail on the w
 oppose the creepage (Kalker's convention, as in CONTACT).
 """
 
-from __future__ import annotations
+import numpy as _np
 
-import numpy as np
+from railadhesion._labelled import labelled as _labelled
 
 __version__ = "0.1.0"
 
 
+@_labelled(units="1")
 def adhesion(fx, fy, normal_force):
     """Adhesion coefficient |T|/Q = sqrt(Fx^2 + Fy^2)/Q (dimensionless, >= 0).
 
@@ -30,11 +31,12 @@ def adhesion(fx, fy, normal_force):
     from railadhesion._validate import check_positive
 
     q = check_positive(normal_force, "normal_force")
-    return np.hypot(fx, fy) / q
+    return _np.hypot(fx, fy) / q
 
 
 # The public API at the top level (imported after ``adhesion``, which the models use).
 from railadhesion.contact import (  # noqa: E402
+    contact_semi_axes,
     fastsim,
     hertz_3d,
     kalker_coefficients,
@@ -64,6 +66,7 @@ __all__ = [
     "WilacParameters",
     "adhesion",
     "carter",
+    "contact_semi_axes",
     "default_wilac_parameters",
     "elastic_foundation",
     "fastsim",

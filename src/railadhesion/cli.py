@@ -7,6 +7,11 @@ water flow rates in µl/s, forces in N, speeds in m/s, lengths in m.
 
 from __future__ import annotations
 
+import csv
+import io
+import json
+import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -15,25 +20,134 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
+# rich_markup_mode=None: help texts are plain text, so units such as "[m]" and "[m/s]" are
+# shown as written (Rich markup would take them for tags and drop them).
 app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
+    rich_markup_mode=None,
     help="Wheel-rail adhesion: contact mechanics, creep-force models (Polach, WILAC, Fletcher), "
     "calibration. Units: SI; creep in percent on the command line; water flow in µl/s.",
 )
-wilac_app = typer.Typer(no_args_is_help=True, help="WILAC water-induced low adhesion model.")
-params_app = typer.Typer(no_args_is_help=True, help="Named parameter sets and parameter files.")
-fit_app = typer.Typer(no_args_is_help=True, help="Fit model parameters to measured creep curves.")
+wilac_app = typer.Typer(
+    no_args_is_help=True, rich_markup_mode=None, help="WILAC water-induced low adhesion model."
+)
+params_app = typer.Typer(
+    no_args_is_help=True, rich_markup_mode=None, help="Named parameter sets and parameter files."
+)
+fit_app = typer.Typer(
+    no_args_is_help=True, rich_markup_mode=None,
+    help="Fit model parameters to measured creep curves.",
+)  # fmt: skip
 app.add_typer(wilac_app, name="wilac")
 app.add_typer(params_app, name="params")
 app.add_typer(fit_app, name="fit")
 
 console = Console()
 
-# Locomotive-scale default contact (CONTACT's Eurosprinter example: 625 mm wheel radius,
-# Q = 106.7 kN; MODELS.md §3) is computed with Hertz from these radii.
-_LOCO = {"wheel_radius": 0.625, "wheel_lateral_radius": np.inf, "rail_lateral_radius": 0.3}
+#: Output formats of the table commands.
+FORMATS = ("table", "csv", "json")
 
+
+def _version(value: bool) -> None:
+    if value:
+        import railadhesion
+
+        console.print(f"railadhesion {railadhesion.__version__}", highlight=False)
+        raise typer.Exit()
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Print a Python warning as one plain line, without the source location."""
+    console.print(f"[yellow]warning:[/yellow] {escape(str(message))}", highlight=False)
+
+
+@app.callback()
+def _main(
+    ctx: typer.Context,
+    version: bool = typer.Option(
+        False, "--version", callback=_version, is_eager=True, help="Print the version and exit."
+    ),
+) -> None:
+    """Wheel-rail adhesion: contact mechanics, creep-force models, calibration."""
+    # Warnings of the library (excluded CSV rows, an untrustworthy calibration) are shown to
+    # the user as plain lines: no file name and line number of our source.
+    catcher = warnings.catch_warnings()
+    catcher.__enter__()
+    warnings.simplefilter("default")
+    warnings.showwarning = _show_warning
+    ctx.call_on_close(lambda: catcher.__exit__(None, None, None))
+
+
+def _format_option():
+    return typer.Option(
+        "table", "--format", help="Output: 'table' (readable), 'csv' or 'json' (for other tools)."
+    )
+
+
+def _emit(title: str, columns, rows, fmt: str, out: Path | None, note: str = "") -> None:
+    """Print or write a table.
+
+    ``columns`` is a list of ``(key, label, fmt)``: ``key`` names the column in CSV/JSON
+    (snake case with the unit, e.g. ``fx_kN``), ``label`` heads the readable table, ``fmt`` is
+    a format spec for the readable table. ``rows`` hold raw values. ``out``: write there
+    (format from ``fmt``, or from the file suffix .csv/.json when ``fmt`` is 'table').
+    """
+    if fmt not in FORMATS:
+        _fail(f"--format must be one of {list(FORMATS)}, got {fmt!r}")
+    if out is not None and fmt == "table":
+        fmt = {".csv": "csv", ".json": "json"}.get(out.suffix.lower(), "table")
+    keys = [c[0] for c in columns]
+    if fmt == "table":
+        table = Table(title=escape(title))
+        for _, label, _ in columns:
+            table.add_column(escape(label), justify="right")
+        for row in rows:
+            table.add_row(*[_cell(v, c[2]) for v, c in zip(row, columns, strict=True)])
+        if out is None:
+            console.print(table)
+            if note:
+                console.print(escape(note), highlight=False)
+            return
+        buffer = Console(file=io.StringIO(), width=200, color_system=None)
+        buffer.print(table)
+        if note:
+            buffer.print(note, markup=False, highlight=False)
+        text = buffer.file.getvalue()
+    elif fmt == "csv":
+        buf = io.StringIO()
+        writer = csv.writer(buf, lineterminator="\n")
+        writer.writerow(keys)
+        writer.writerows([[_plain(v) for v in row] for row in rows])
+        text = buf.getvalue()
+    else:
+        records = [dict(zip(keys, [_plain(v) for v in row], strict=True)) for row in rows]
+        text = json.dumps(records, indent=1, allow_nan=True) + "\n"
+    if out is None:
+        console.print(text, end="", markup=False, highlight=False, soft_wrap=True)
+        return
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(text, encoding="utf-8")
+    except OSError as exc:
+        _fail(f"cannot write the table to {out}: {exc}")
+    console.print(f"{title}: {fmt} written to {escape(str(out))}", highlight=False)
+
+
+def _plain(value):
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
+    return value
+
+
+def _cell(value, spec: str) -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, str) or not spec:
+        return str(value)
+    return format(value, spec)
 
 def _floats(text: str, name: str) -> np.ndarray:
     """Parse a comma-separated list of numbers, naming the option on error."""
@@ -48,6 +162,16 @@ def _floats(text: str, name: str) -> np.ndarray:
     return np.asarray(values)
 
 
+def _creep_percent(text: str) -> np.ndarray:
+    """Creepages given in percent: |creep| <= 100 % (a locked wheel is 100 %)."""
+    values = _floats(text, "--creep-percent")
+    if np.any(~np.isfinite(values)) or np.any(np.abs(values) > 100):
+        raise typer.BadParameter(
+            f"--creep-percent: creepages must be in [-100, 100] %, got {text!r}"
+        )
+    return values / 100
+
+
 def _fail(exc: Exception) -> None:
     # escape(): messages hold brackets ("[low, high]", "[0, inf)") that Rich would otherwise
     # take for markup and drop from the output.
@@ -58,6 +182,8 @@ def _fail(exc: Exception) -> None:
 def _save(fig, out: Path | None) -> None:
     if out is None:
         return
+    if not out.suffix:  # matplotlib would add ".png" itself; say which file is written
+        out = out.with_name(out.name + ".png")
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
         fig.savefig(out, dpi=110, bbox_inches="tight")
@@ -92,6 +218,8 @@ def hertz(
     ),
     young: float = typer.Option(2.1e11, help="Young's modulus of both bodies [Pa]."),
     poisson: float = typer.Option(0.28, help="Poisson's ratio of both bodies."),
+    fmt: str = _format_option(),
+    out: Path | None = typer.Option(None, help="Write the table here (.csv, .json or text)."),
 ) -> None:
     """Hertz elliptical contact of a wheel on a rail or roller."""
     from railadhesion.contact.hertz import hertz_3d
@@ -103,20 +231,21 @@ def hertz(
         )
     except ValueError as exc:
         _fail(exc)
-    table = Table(title="Hertz contact")
-    table.add_column("quantity")
-    table.add_column("value", justify="right")
-    for label, value in [
-        ("a (rolling direction) [mm]", h.a * 1e3),
-        ("b (lateral) [mm]", h.b * 1e3),
-        ("a/b", h.a_over_b),
-        ("max pressure p0 [MPa]", h.max_pressure / 1e6),
-        ("approach [µm]", h.approach * 1e6),
-        ("curvature A [1/m]", h.curvature_A),
-        ("curvature B [1/m]", h.curvature_B),
-    ]:
-        table.add_row(escape(label), f"{float(value):.4g}")
-    console.print(table)
+    rows = [
+        ("a (rolling direction) [mm]", "a_mm", h.a * 1e3),
+        ("b (lateral) [mm]", "b_mm", h.b * 1e3),
+        ("a/b", "a_over_b", h.a_over_b),
+        ("max pressure p0 [MPa]", "max_pressure_MPa", h.max_pressure / 1e6),
+        ("approach [µm]", "approach_um", h.approach * 1e6),
+        ("curvature A [1/m]", "curvature_A_per_m", h.curvature_A),
+        ("curvature B [1/m]", "curvature_B_per_m", h.curvature_B),
+    ]
+    if fmt == "table" and (out is None or out.suffix.lower() not in (".csv", ".json")):
+        _emit("Hertz contact", [("quantity", "quantity", ""), ("value", "value", ".4g")],
+              [(label, float(v)) for label, _, v in rows], fmt, out)  # fmt: skip
+    else:  # one record, one column per quantity (with its unit in the name)
+        _emit("Hertz contact", [(key, key, ".4g") for _, key, _ in rows],
+              [[float(v) for _, _, v in rows]], fmt, out)  # fmt: skip
 
 
 @app.command()
@@ -127,38 +256,63 @@ def polach(
     ),
     normal_force: float = typer.Option(110e3, help="Normal force Q [N]."),
     speed: float = typer.Option(10.0, help="Rolling speed V [m/s]."),
-    out: Path | None = typer.Option(None, help="Write a creep-curve figure here."),
+    geometry: str = typer.Option(
+        "locomotive",
+        help="Named contact geometry ('locomotive': 0.625 m wheel on a rail head of lateral "
+        "radius 0.3 m; 'tram': the tram wheel rig of Trummer et al.); Hertz gives a, b.",
+    ),
+    a: float | None = typer.Option(
+        None, "--a", help="Semi-axis a in the rolling direction [m] (with --b: overrides "
+        "--geometry).",
+    ),
+    b: float | None = typer.Option(None, "--b", help="Lateral semi-axis b [m] (with --a)."),
+    fmt: str = _format_option(),
+    out: Path | None = typer.Option(
+        None, help="Write the creep-curve figure here (.png, .pdf, .svg), or the table (.csv, "
+        ".json, or any file with --format csv|json).",
+    ),
 ) -> None:
     """Polach creep curve (adhesion against longitudinal creep) for a named parameter set."""
     from railadhesion import adhesion
-    from railadhesion.contact.hertz import hertz_3d
+    from railadhesion.contact.geometry import contact_semi_axes, geometry_description
     from railadhesion.models.parameters import polach_parameters
     from railadhesion.models.polach import Polach
 
     try:
         params = polach_parameters(parameter_set)
-        creep = _floats(creep_percent, "--creep-percent") / 100
-        h = hertz_3d(normal_force, **_LOCO)
-        fx, fy = Polach(params).forces(creep, 0.0, 0.0, normal_force, speed, h.a, h.b)
+        creep = _creep_percent(creep_percent)
+        if (a is None) != (b is None):
+            raise ValueError("give both --a and --b (the contact semi-axes in m), or neither")
+        geo = (a, b) if a is not None else geometry
+        ca, cb = contact_semi_axes(geo, normal_force)
+        fx, fy = Polach(params).forces(creep, 0.0, 0.0, normal_force, speed, ca, cb)
     except ValueError as exc:
         _fail(exc)
     mu = adhesion(fx, fy, normal_force)
+    contact = (
+        f"contact: {geometry_description(geo)}; at Q = {normal_force:g} N: "
+        f"a = {ca * 1e3:.3g} mm, b = {cb * 1e3:.3g} mm"
+    )
     title = f"Polach '{params.name}' at Q = {normal_force:g} N, V = {speed:g} m/s"
-    table = Table(title=escape(title))
-    table.add_column(escape("creep [%]"), justify="right")
-    table.add_column(escape("Fx [kN]"), justify="right")
-    table.add_column(escape("adhesion |T|/Q"), justify="right")
-    for c, f, m in zip(creep, np.atleast_1d(fx), np.atleast_1d(mu), strict=True):
-        table.add_row(f"{c * 100:g}", f"{f / 1e3:.2f}", f"{m:.4f}")
-    console.print(table)
-    if out is not None:
+    table_out = out is not None and (
+        fmt != "table" or out.suffix.lower() in (".csv", ".json")
+    )
+    _emit(
+        title,
+        [("creep_percent", "creep [%]", "g"), ("fx_kN", "Fx [kN]", ".2f"),
+         ("adhesion", "adhesion |T|/Q", ".4f")],
+        [(c * 100, f / 1e3, m) for c, f, m in
+         zip(creep, np.atleast_1d(fx), np.atleast_1d(mu), strict=True)],
+        fmt, out if table_out else None, note=contact,
+    )  # fmt: skip
+    if out is not None and not table_out:
         import matplotlib.pyplot as plt
 
         fig, ax = plt.subplots(figsize=(6, 4))
         ax.plot(creep * 100, mu, marker="o")
         ax.set_xlabel("longitudinal creep [%]")
         ax.set_ylabel("adhesion |T|/Q [-]")
-        ax.set_title(f"Polach {params.name}")
+        ax.set_title(f"Polach {params.name}, {geo if isinstance(geo, str) else 'given a, b'}")
         ax.grid(True, alpha=0.3)
         _save(fig, out)
 
@@ -212,7 +366,7 @@ def wilac_water(
 
     try:
         fig = plot_wilac_water(
-            creeps=tuple(_floats(creep_percent, "--creep-percent") / 100),
+            creeps=tuple(_creep_percent(creep_percent)),
             normal_force=normal_force, speed=speed, params=_load_wilac(params_file),
         )
     except ValueError as exc:
@@ -248,30 +402,32 @@ def wilac_table(
     normal_force: float = typer.Option(4200.0, help="Normal force Q [N]."),
     speed: float = typer.Option(5.0, help="Rolling speed [m/s]."),
     params_file: Path | None = typer.Option(None, "--params", help="WILAC TOML file."),
+    fmt: str = _format_option(),
+    out: Path | None = typer.Option(None, help="Write the table here (.csv, .json or text)."),
 ) -> None:
     """Print WILAC adhesion |T|/Q over water flow rate and creep at the tram-rig contact."""
     from railadhesion.models.wilac import Wilac
 
     try:
         w = _floats(water, "--water")
-        creep = _floats(creep_percent, "--creep-percent") / 100
+        creep = _creep_percent(creep_percent)
         a, b = _tram_contact(normal_force)
         model = Wilac(_load_wilac(params_file))
         mu = model.adhesion(creep[None, :], 0.0, 0.0, normal_force, speed, a, b, w[:, None])
     except ValueError as exc:
         _fail(exc)
-    table = Table(title=f"WILAC adhesion at Q = {normal_force:g} N, v = {speed:g} m/s")
-    table.add_column(escape("w [µl/s]"), justify="right")
-    for c in creep:
-        table.add_column(escape(f"{c * 100:g} %"), justify="right")
-    for wi, row in zip(w, mu, strict=True):
-        table.add_row(f"{wi:g}", *[f"{x:.3f}" for x in row])
-    console.print(table)
+    columns = [("water_flow_ul_s", "w [µl/s]", "g")] + [
+        (f"adhesion_at_{c * 100:g}_percent", f"{c * 100:g} %", ".3f") for c in creep
+    ]
+    _emit(
+        f"WILAC adhesion at Q = {normal_force:g} N, v = {speed:g} m/s",
+        columns, [(wi, *row) for wi, row in zip(w, mu, strict=True)], fmt, out,
+    )  # fmt: skip
 
 
 def _tram_contact(normal_force: float):
     """Hertz semi-axes of the Pardubice tram rig (seed 000 §4): 0.696 m wheel on 0.905 m roller."""
-    from railadhesion.plotting import contact_semi_axes
+    from railadhesion.contact.geometry import contact_semi_axes
 
     return contact_semi_axes("tram", normal_force)
 
@@ -288,24 +444,88 @@ def _load_wilac(path: Path | None):
 
 
 @params_app.command("list")
-def params_list() -> None:
-    """List the named Polach parameter sets, their values and sources."""
-    from railadhesion.models.parameters import POLACH_PARAMETER_SETS
+def params_list(
+    kind: str = typer.Option(
+        "all", help="Which sets: 'polach', 'wilac', 'fletcher' or 'all' (readable/JSON only)."
+    ),
+    fmt: str = _format_option(),
+    out: Path | None = typer.Option(None, help="Write the table(s) here (.csv, .json or text)."),
+) -> None:
+    """List the named parameter sets: Polach sets, WILAC sets, Fletcher's conditions."""
+    kinds = ("polach", "wilac", "fletcher")
+    if kind not in (*kinds, "all"):
+        _fail(f"--kind must be one of {[*kinds, 'all']}, got {kind!r}")
+    chosen = kinds if kind == "all" else (kind,)
+    as_format = fmt
+    if out is not None and fmt == "table":
+        as_format = {".csv": "csv", ".json": "json"}.get(out.suffix.lower(), "table")
+    if as_format == "csv" and len(chosen) > 1:
+        _fail("CSV holds one table: choose --kind polach, wilac or fletcher")
+    tables = {k: _parameter_sets(k) for k in chosen}
+    if as_format == "json" and len(chosen) > 1:
+        text = json.dumps(
+            {k: [dict(zip([c[0] for c in cols], [_plain(v) for v in row], strict=True))
+                 for row in rows] for k, (_, cols, rows) in tables.items()},
+            indent=1,
+        ) + "\n"  # fmt: skip
+        if out is None:
+            console.print(text, end="", markup=False, highlight=False, soft_wrap=True)
+        else:
+            try:
+                out.parent.mkdir(parents=True, exist_ok=True)
+                out.write_text(text, encoding="utf-8")
+            except OSError as exc:
+                _fail(f"cannot write the table to {out}: {exc}")
+            console.print(f"parameter sets: json written to {escape(str(out))}")
+        return
+    if as_format == "table" and out is not None and len(chosen) > 1:
+        _fail("a text file holds one table: choose --kind, or write --format json")
+    for title, cols, rows in tables.values():
+        _emit(title, cols, rows, fmt, out)
 
-    table = Table(title="Polach parameter sets")
-    for col in ("name", "k_A", "k_S", "mu0", "A", "B [s/m]", "source"):
-        table.add_column(escape(col))
-    for name, p in POLACH_PARAMETER_SETS.items():
-        table.add_row(
-            name, f"{p.k_A:g}", f"{p.k_S:g}", f"{p.mu0:g}", f"{p.A:g}", f"{p.B:g}", p.source
-        )
-    console.print(table)
+
+def _parameter_sets(kind: str):
+    """(title, columns, rows) of one kind of named parameter set."""
+    if kind == "polach":
+        from railadhesion.models.parameters import POLACH_PARAMETER_SETS
+
+        cols = [("name", "name", ""), ("k_A", "k_A", "g"), ("k_S", "k_S", "g"),
+                ("mu0", "mu0", "g"), ("A", "A", "g"), ("B_s_per_m", "B [s/m]", "g"),
+                ("source", "source", "")]  # fmt: skip
+        rows = [(n, p.k_A, p.k_S, p.mu0, p.A, p.B, p.source)
+                for n, p in POLACH_PARAMETER_SETS.items()]  # fmt: skip
+        return "Polach parameter sets", cols, rows
+    if kind == "wilac":
+        from railadhesion.models.wilac import default_wilac_parameters
+
+        p = default_wilac_parameters()
+        prov = p.provenance
+        cols = [("name", "name", ""), ("normal_force_range_N", "Q range [N]", ""),
+                ("speed_range_m_s", "v range [m/s]", ""),
+                ("reconstruction", "reconstruction", ""), ("source", "source", "")]  # fmt: skip
+        rows = [(
+            f"default ({p.name})" if p.name else "default",
+            f"{p.normal_force_range[0]:g}-{p.normal_force_range[1]:g}",
+            f"{p.speed_range[0]:g}-{p.speed_range[1]:g}",
+            "yes" if prov.get("reconstruction") else "no",
+            prov.get("source", ""),
+        )]  # fmt: skip
+        return "WILAC parameter sets (load your own with --params FILE)", cols, rows
+    from railadhesion.models.twod import FLETCHER_CONDITIONS
+
+    cols = [("test_code", "code", ""), ("lubricant", "lubricant", ""),
+            ("max_pressure_MPa", "p0 [MPa]", "g"), ("mu", "mu", "g"), ("k_a", "k_a", "g"),
+            ("k_s", "k_s", "g")]  # fmt: skip
+    rows = [(c.test_code, c.lubricant, c.max_pressure / 1e6, c.mu, c.k_a, c.k_s)
+            for c in FLETCHER_CONDITIONS.values()]  # fmt: skip
+    return "Fletcher 2013 conditions (Tables 1 and 2)", cols, rows
 
 
 @params_app.command("check")
 def params_check(path: Path = typer.Argument(..., help="A parameter file (TOML).")) -> None:
     """Validate a parameter file; print what it holds or exactly what is wrong."""
     from railadhesion.io.paramfiles import load_parameter_file
+    from railadhesion.models.wilac import WilacParameters
 
     try:
         params = load_parameter_file(path)
@@ -315,32 +535,104 @@ def params_check(path: Path = typer.Argument(..., help="A parameter file (TOML).
         f"[green]ok[/green]: {escape(str(path))} holds {type(params).__name__} "
         f"{escape(repr(params.name))}"
     )
+    if isinstance(params, WilacParameters):
+        prov = dict(params.provenance)
+        rec = prov.pop("reconstruction", None)
+        flag = {True: "YES: a reconstruction, not measured data (read its provenance)",
+                False: "no", None: "not stated"}[rec]  # fmt: skip
+        lines = [
+            f"reconstruction: {flag}",
+            f"normal force range: {params.normal_force_range[0]:g} to "
+            f"{params.normal_force_range[1]:g} N (Q_ref {params.normal_force_ref:g} N)",
+            f"speed range: {params.speed_range[0]:g} to {params.speed_range[1]:g} m/s "
+            f"(v_ref {params.speed_ref:g} m/s)",
+        ]
+        lines += [f"{key}: {value}" for key, value in prov.items()]
+        for line in lines:
+            console.print("  " + line, markup=False, highlight=False)
+    else:
+        for key in ("source", "notes"):
+            value = getattr(params, key, "")
+            if value:
+                console.print(f"  {key}: {value}", markup=False, highlight=False)
 
 
 @fit_app.command("polach")
 def fit_polach_cmd(
-    csv: Path = typer.Argument(..., help="Creep-curve CSV (docs/creep-curve-csv.md)."),
+    csv_file: Path = typer.Argument(..., metavar="CSV", help="Creep-curve CSV "
+                                    "(docs/creep-curve-csv.md)."),
     fit: str = typer.Option("k_A,k_S,mu0,A,B", help="Parameters to fit, comma-separated."),
+    fixed: str = typer.Option(
+        "", help="Values of the parameters not fitted, e.g. 'A=0.4,B=0.3' (default: the "
+        "model's A = 1, B = 0, k_A = k_S = 1: friction independent of slip velocity).",
+    ),
     out: Path | None = typer.Option(None, help="Write the fitted set as a Polach TOML file."),
+    figure: Path | None = typer.Option(None, help="Write the fit-vs-data figure here."),
+    fmt: str = _format_option(),
+    table: Path | None = typer.Option(None, help="Write the parameter table here."),
 ) -> None:
     """Fit Polach parameters to one measured creep curve."""
-    from railadhesion.calibration.fitting import fit_polach
+    from railadhesion.calibration.fitting import POLACH_NAMES, fit_polach
     from railadhesion.io.creepcurves import read_creep_curve
     from railadhesion.io.paramfiles import save_polach_parameters
 
     try:
-        curve = read_creep_curve(csv)
+        curve = read_creep_curve(csv_file)
         curve.require("normal_force", "speed", "a", "b")
     except ValueError as exc:  # the message names the file
         _fail(exc)
+    names = tuple(s.strip() for s in fit.split(",") if s.strip())
+    initial = {}
+    for item in (x.strip() for x in fixed.split(",") if x.strip()):
+        key, sep, value = item.partition("=")
+        try:
+            initial[key.strip()] = float(value)
+        except ValueError:
+            sep = ""
+        if not sep or key.strip() not in POLACH_NAMES:
+            _fail(f"--fixed: expected NAME=VALUE with NAME in {list(POLACH_NAMES)}, got {item!r}")
+        if key.strip() in names:
+            _fail(f"--fixed: {key.strip()} is also in --fit; a parameter is fitted or fixed")
     try:
         result = fit_polach(
             curve.creep, curve.adhesion, normal_force=curve.normal_force, speed=curve.speed,
-            a=curve.a, b=curve.b, fit=tuple(s.strip() for s in fit.split(",") if s.strip()),
-        )
+            a=curve.a, b=curve.b, fit=names, initial=initial or None,
+        )  # fmt: skip
     except ValueError as exc:
-        _fail(f"{csv}: {exc}")
-    console.print(str(result), highlight=False, markup=False)
+        _fail(f"{csv_file}: {exc}")
+    held = [n for n in POLACH_NAMES if n not in result.fitted]
+    if fmt == "table" and table is None:
+        console.print(str(result), highlight=False, markup=False)
+    else:
+        _emit(
+            f"Polach fit to {csv_file.name}",
+            [("parameter", "parameter", ""), ("value", "value", ".6g"),
+             ("stderr", "stderr", ".2g"), ("fitted", "fitted", "")],
+            [(n, result.params[n], result.stderr.get(n, float("nan")),
+              "yes" if n in result.fitted else "no (fixed)") for n in POLACH_NAMES],
+            fmt, table,
+        )  # fmt: skip
+    if held:
+        given = [n for n in held if n in initial]
+        default = [n for n in held if n not in initial]
+        parts = []
+        if given:
+            parts.append(", ".join(f"{n} = {result.params[n]:g}" for n in given) + " (--fixed)")
+        if default:
+            parts.append(
+                ", ".join(f"{n} = {result.params[n]:g}" for n in default)
+                + " (model defaults; set them with --fixed, e.g. --fixed A=0.4,B=0.3)"
+            )
+        console.print("note: not fitted, held at " + "; ".join(parts), markup=False,
+                      highlight=False)  # fmt: skip
+    if figure is not None:
+        from railadhesion.plotting import plot_fit
+
+        try:
+            fig = plot_fit(result, title=f"Polach fit to {csv_file.name}")
+        except ValueError as exc:
+            _fail(exc)
+        _save(fig, figure)
     if out is not None:
         try:
             save_polach_parameters(result.as_polach_parameters(), out)
@@ -360,24 +652,69 @@ def fit_wilac_cmd(
         None, help="Validity range of v [m/s] as 'low,high' (default: span of the data)."
     ),
     name: str = typer.Option("", help="Name stored in the parameter file."),
+    criterion: str = typer.Option(
+        "cv", help="Term selection: 'cv' (leave-one-out cross-validation), 'aicc', 'bic' or "
+        "'r2' (the paper's R² rule alone).",
+    ),
+    max_order: int = typer.Option(3, help="Largest number of factors in a regression term."),
+    min_r2_gain: float = typer.Option(1e-4, help="Smallest R² gain for a term to enter."),
+    max_terms: int | None = typer.Option(
+        None, help="Most terms per regression (default: one per three curves of a condition)."
+    ),
+    min_curves: int = typer.Option(
+        3, help="Conditions with fewer curves get constant parameters (the mean)."
+    ),
+    refine: bool = typer.Option(
+        True, help="Refit each condition's regressions jointly to its measured adhesion."
+    ),
+    fmt: str = _format_option(),
+    table: Path | None = typer.Option(None, help="Write the per-curve table here."),
 ) -> None:
     """Calibrate a complete WILAC parameter file from a folder of creep curves."""
+    from rich.progress import BarColumn, Progress, TextColumn
+
     from railadhesion.calibration.pipeline import calibrate_wilac_to_toml
 
-    kwargs = {"name": name}
+    kwargs = {"name": name, "criterion": criterion, "max_order": max_order,
+              "min_r2_gain": min_r2_gain, "max_terms": max_terms, "min_curves": min_curves,
+              "refine": refine}  # fmt: skip
     for key, text in (("normal_force_range", normal_force_range), ("speed_range", speed_range)):
         if text is not None:
             values = _floats(text, "--" + key.replace("_", "-"))
             if values.size != 2:
                 raise typer.BadParameter(f"--{key.replace('_', '-')}: expected 'low,high'")
             kwargs[key] = (float(values[0]), float(values[1]))
+    labels = {"fit": "Polach fit per curve", "regress": "regressions per condition",
+              "check": "check between the data"}  # fmt: skip
+    progress = Progress(TextColumn("{task.description}"), BarColumn(),
+                        TextColumn("{task.completed}/{task.total}"), console=console,
+                        transient=True)  # fmt: skip
+    tasks = {}
+
+    def report(stage: str, done: int, total: int) -> None:
+        if stage not in tasks:
+            tasks[stage] = progress.add_task(labels.get(stage, stage), total=total)
+        progress.update(tasks[stage], completed=done, total=total)
+
     try:
-        calibration = calibrate_wilac_to_toml(folder, out, **kwargs)
+        with progress:
+            calibration = calibrate_wilac_to_toml(folder, out, progress=report, **kwargs)
     except ValueError as exc:
         _fail(exc)
     except OSError as exc:  # the output file cannot be written
         _fail(f"cannot write the parameter file {out}: {exc}")
-    console.print(calibration.summary(), highlight=False, markup=False)
+    if fmt == "table" and table is None:
+        console.print(calibration.summary(), highlight=False, markup=False)
+    else:
+        rows = calibration.curve_table()
+        keys = list(rows[0]) if rows else []
+        _emit("WILAC calibration per curve", [(k, k, ".4g") for k in keys],
+              [[r[k] for k in keys] for r in rows], fmt, table)  # fmt: skip
+    if not calibration.trusted:
+        console.print(
+            f"[bold red]WARNING[/bold red]: {len(calibration.warnings)} problem(s) between the "
+            "data points: do not trust the calibrated set there (see above)."
+        )
     console.print(f"WILAC parameters written to {escape(str(out))}")
 
 

@@ -15,12 +15,14 @@ checks of the default parameter set) or directly as the semi-axes ``(a, b)`` in 
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from matplotlib.figure import Figure
 
 from railadhesion._validate import check_finite, check_nonnegative, check_positive
+
+# The named contact geometries live in railadhesion.contact (re-exported here, where they
+# were first defined, for compatibility).
+from railadhesion.contact.geometry import WILAC_GEOMETRIES, contact_semi_axes
 
 __all__ = [
     "WILAC_GEOMETRIES",
@@ -29,90 +31,12 @@ __all__ = [
     "plot_wilac_curves",
     "plot_wilac_water",
     "plot_wilac_speeds",
+    "plot_fit",
 ]
-
-#: Named wheel–rail (or wheel–roller) geometries for the WILAC figures, as the radii of
-#: :func:`railadhesion.contact.hertz.hertz_3d` [m] (steel, E = 210 GPa, ν = 0.28).
-#: ``tram``: seed 000 §4 — wheel diameter 0.696 m on a rail roller of diameter 0.905 m,
-#: effective lateral radius of the contact 0.660 m (put on the roller, the wheel taken as
-#: laterally straight). ``locomotive``: our choice for the 110 kN checks (the paper does not
-#: state its locomotive contact): wheel radius 0.625 m (as CONTACT's Eurosprinter example),
-#: laterally straight (conical) tread on a rail head of lateral radius 0.300 m (a/b ≈ 1.6 at
-#: 110 kN). The same numbers are used by ``scripts/build_default_wilac.py``.
-WILAC_GEOMETRIES: dict[str, dict[str, float]] = {
-    "tram": {
-        "wheel_radius": 0.348,
-        "rail_radius": 0.4525,
-        "wheel_lateral_radius": math.inf,
-        "rail_lateral_radius": 0.660,
-    },
-    "locomotive": {
-        "wheel_radius": 0.625,
-        "rail_radius": math.inf,
-        "wheel_lateral_radius": math.inf,
-        "rail_lateral_radius": 0.300,
-    },
-}
 
 _CREEP_LABEL = "longitudinal creep $c_x$ [%] (traction < 0)"
 _ADHESION_LABEL = "adhesion $T_x/Q$ [-]"
 _WATER_LABEL = "water flow rate $w$ [µl/s]"
-
-
-def contact_semi_axes(geometry, normal_force) -> tuple[float, float]:
-    """Semi-axes ``(a, b)`` [m] of a named geometry at a normal force, or ``geometry`` itself.
-
-    Parameters
-    ----------
-    geometry : str or (float, float)
-        A key of :data:`WILAC_GEOMETRIES` (Hertz contact via
-        :func:`railadhesion.contact.hertz.hertz_3d`), or the semi-axes ``(a, b)`` [m] along the
-        rolling direction and laterally.
-    normal_force : float
-        Normal force Q [N], > 0.
-
-    Returns
-    -------
-    (float, float)
-        ``a`` (rolling direction) and ``b`` (lateral) [m].
-
-    Examples
-    --------
-    >>> a, b = contact_semi_axes("tram", 4200.0)
-    >>> round(a * 1e3, 2), round(b * 1e3, 2)
-    (1.41, 3.15)
-    """
-    q = float(check_positive(normal_force, "normal_force"))
-    if isinstance(geometry, str):
-        if geometry not in WILAC_GEOMETRIES:
-            raise _geometry_error(geometry)
-        from railadhesion.contact.hertz import hertz_3d
-
-        g = WILAC_GEOMETRIES[geometry]
-        contact = hertz_3d(
-            q,
-            g["wheel_radius"],
-            g["wheel_lateral_radius"],
-            g["rail_lateral_radius"],
-            g["rail_radius"],
-            young=2.1e11,
-            poisson=0.28,
-        )
-        return float(contact.a), float(contact.b)
-    try:
-        a, b = (float(x) for x in geometry)
-    except (TypeError, ValueError) as exc:
-        raise _geometry_error(geometry) from exc
-    check_positive(a, "geometry a")
-    check_positive(b, "geometry b")
-    return a, b
-
-
-def _geometry_error(geometry) -> ValueError:
-    return ValueError(
-        f"geometry must be one of {sorted(WILAC_GEOMETRIES)} or an (a, b) pair in m, "
-        f"got {geometry!r}"
-    )
 
 
 def _params(params):
@@ -141,6 +65,53 @@ def _finish_adhesion_axes(ax, xlabel: str, title: str, xlim, **legend) -> None:
     ax.set_ylim(bottom=0.0)
     ax.grid(True, alpha=0.3)
     ax.legend(**legend)
+
+
+def _creep_axes(ax, zoom):
+    """(figure, main axes, zoom axes or None). A new figure gets two panels: the creep range
+    0 to ``-zoom`` % on the left (where the curves rise and peak), the full range on the
+    right, sharing the adhesion axis."""
+    if ax is not None:
+        return ax.figure, ax, None
+    if zoom is None:
+        fig, ax = _axes(None)
+        return fig, ax, None
+    zoom = float(check_positive(zoom, "zoom"))
+    fig = Figure(figsize=(9.6, 4.6), layout="constrained")
+    ax_zoom, ax_main = fig.subplots(1, 2, sharey=True, width_ratios=(1, 1.6))
+    return fig, ax_main, ax_zoom
+
+
+def _draw_distinguishable(axes, x, rows, labels, styles, tol=2e-3):
+    """Plot ``rows`` on every axes of ``axes``; a row that lies within ``tol`` (adhesion) of an
+    earlier one everywhere is drawn dotted with markers and its legend entry says which curve
+    it hides under."""
+    drawn = []
+    for row, label, style in zip(rows, labels, styles, strict=True):
+        style = dict(style)
+        twin = next((lab for r, lab in drawn if np.nanmax(np.abs(row - r)) <= tol), None)
+        if twin is not None:
+            label = f"{label} (same as {twin})"
+            style.update(ls=(0, (1, 2)), lw=2.2, marker="o", markevery=0.1, ms=4,
+                         mfc="none")  # fmt: skip
+        for i, ax in enumerate(axes):
+            ax.plot(x, row, label=label if i == len(axes) - 1 else None, **style)
+        drawn.append((row, label.split(" (same as")[0]))
+
+
+def _finish_zoom(ax_zoom, zoom: float, ax=None) -> None:
+    if ax_zoom is None:
+        return
+    if ax is not None:  # the figure's title above both panels; the main panel: full range
+        ax.figure.suptitle(ax.get_title())
+        ax.set_title("full range")
+        ax.set_ylabel("")
+    ax_zoom.set_xlim(-float(zoom), 0.0)
+    ax_zoom.set_ylim(bottom=0.0)
+    ax_zoom.set_xlabel(f"creep $c_x$ [%], 0 to {-float(zoom):g} %")
+    ax_zoom.set_ylabel(_ADHESION_LABEL)
+    ax_zoom.set_title("rise and peak (zoom)")
+    ax_zoom.grid(True, alpha=0.3)
 
 
 def _traction_creep(creep_max: float, n_points: int) -> np.ndarray:
@@ -224,6 +195,7 @@ def plot_wilac_curves(
     params=None,
     creep_max=1.0,
     n_points=200,
+    zoom=3.0,
     ax=None,
 ):
     """Adhesion against longitudinal creep for several water flow rates (seed 000, Fig. 7).
@@ -244,14 +216,18 @@ def plot_wilac_curves(
         Largest creep magnitude [-], in (0, 1].
     n_points : int, optional
         Creep samples per curve.
+    zoom : float or None, optional
+        A new figure gets a left panel with the creep range 0 to ``-zoom`` % [%] (the rise
+        and the peak, a few pixels wide on the full axis); ``None``: one panel.
     ax : matplotlib.axes.Axes, optional
-        Axes to draw into; a new figure by default.
+        Axes to draw into (one panel, no zoom); a new figure by default.
 
     Returns
     -------
     matplotlib.figure.Figure
-        One line per water flow rate; x: creep c_x [%], traction negative as in the paper;
-        y: T_x/Q [-].
+        One line per water flow rate (per panel); x: creep c_x [%], traction negative as in
+        the paper; y: T_x/Q [-]. A curve hidden under an earlier one (e.g. 60 and 350 µl/s,
+        both "wet") is dotted with markers and its legend entry says so.
 
     Notes
     -----
@@ -261,8 +237,8 @@ def plot_wilac_curves(
     Examples
     --------
     >>> fig = plot_wilac_curves(water_flows=(0, 350), n_points=20)
-    >>> len(fig.axes[0].lines)
-    2
+    >>> [len(ax.lines) for ax in fig.axes]     # zoom panel, full range
+    [2, 2]
     """
     from railadhesion.models.wilac import wilac_forces
 
@@ -272,16 +248,22 @@ def plot_wilac_curves(
     flows = check_nonnegative(np.atleast_1d(np.asarray(water_flows, dtype=float)), "water_flows")
     a, b = contact_semi_axes(geometry, q)
     creep = -_traction_creep(creep_max, n_points)
-    fig, ax = _axes(ax)
+    if zoom is not None:  # dense in the zoomed range too
+        creep = np.unique(np.concatenate([creep, -np.linspace(0, float(zoom) / 100, 120)]))
+    fig, ax, ax_zoom = _creep_axes(ax, zoom)
     fx, _ = wilac_forces(creep[None, :], 0.0, 0.0, q, v, a, b, flows[:, None], p)
-    for w, row in zip(flows, np.asarray(fx) / q, strict=True):
-        ax.plot(100 * creep, row, label=f"w = {w:g} µl/s")
+    axes = [x for x in (ax_zoom, ax) if x is not None]
+    _draw_distinguishable(
+        axes, 100 * creep, list(np.asarray(fx) / q), [f"w = {w:g} µl/s" for w in flows],
+        [{"color": f"C{i}"} for i in range(flows.size)],
+    )  # fmt: skip
     _finish_adhesion_axes(
         ax,
         _CREEP_LABEL,
         f"WILAC, Q = {q / 1e3:g} kN, v = {v:g} m/s (cf. Trummer et al., Fig. 7)",
         (-100 * float(creep_max), 0.0),
     )
+    _finish_zoom(ax_zoom, zoom, ax)
     return fig
 
 
@@ -314,8 +296,9 @@ def plot_wilac_water(
     water_flow_max : float, optional
         Upper end of the water-flow axis [µl/s].
     marks : sequence of float, optional
-        Water flow rates marked by grey vertical lines (the paper marks the rates where it
-        measured; those above ``water_flow_max`` are skipped).
+        Water flow rates marked by labelled grey dotted vertical lines, one legend entry for
+        all (the paper marks the rates where it measured; those above ``water_flow_max`` are
+        skipped).
     n_points : int, optional
         Water-flow samples.
     ax : matplotlib.axes.Axes, optional
@@ -345,9 +328,16 @@ def plot_wilac_water(
     fx, _ = wilac_forces(-mags[:, None], 0.0, 0.0, q, v, a, b, w[None, :], p)
     for c, row in zip(mags, np.asarray(fx) / q, strict=True):
         ax.plot(w, row, label=f"$c_x$ = {-100 * c:g} %")
-    for m in marks:
-        if 0 <= m <= wmax:
-            ax.axvline(m, color="0.6", lw=0.8, ls=":", zorder=0)
+    shown = [float(m) for m in marks if 0 <= m <= wmax]
+    for i, m in enumerate(shown):
+        label = (
+            f"measured flow rates ({', '.join(f'{x:g}' for x in shown)} µl/s)"
+            if i == 0
+            else None
+        )
+        ax.axvline(m, color="0.5", lw=0.9, ls=":", zorder=0, label=label)
+        ax.annotate(f"{m:g}", (m, 1.0), xycoords=("data", "axes fraction"), xytext=(2, -10),
+                    textcoords="offset points", color="0.4", fontsize="small")  # fmt: skip
     _finish_adhesion_axes(
         ax,
         _WATER_LABEL,
@@ -368,6 +358,7 @@ def plot_wilac_speeds(
     polach_speed=10.0,
     creep_max=0.6,
     n_points=200,
+    zoom=3.0,
     ax=None,
 ):
     """Adhesion against creep at several speeds (seed 000, Fig. 9; with Fig. 11's comparison).
@@ -393,13 +384,18 @@ def plot_wilac_speeds(
         Largest creep magnitude [-], in (0, 1].
     n_points : int, optional
         Creep samples per curve.
+    zoom : float or None, optional
+        A new figure gets a left panel with the creep range 0 to ``-zoom`` % [%];
+        ``None``: one panel.
     ax : matplotlib.axes.Axes, optional
-        Axes to draw into.
+        Axes to draw into (one panel, no zoom).
 
     Returns
     -------
     matplotlib.figure.Figure
-        ``len(speeds)`` solid lines, and as many dashed ones if ``compare_polach``.
+        ``len(speeds)`` solid lines, and as many dashed ones if ``compare_polach`` (per
+        panel). The fixed-parameter curve at ``polach_speed`` coincides with WILAC's there:
+        it is dotted with markers and its legend entry says so.
 
     Notes
     -----
@@ -411,8 +407,8 @@ def plot_wilac_speeds(
     Examples
     --------
     >>> fig = plot_wilac_speeds(speeds=(5, 20), n_points=20)
-    >>> len(fig.axes[0].lines)
-    4
+    >>> [len(ax.lines) for ax in fig.axes]     # zoom panel, full range
+    [4, 4]
     """
     from railadhesion.models.polach import polach_forces
     from railadhesion.models.wilac import WILAC_CONDITIONS, wilac_forces, wilac_weights
@@ -423,11 +419,15 @@ def plot_wilac_speeds(
     vs = check_nonnegative(np.atleast_1d(np.asarray(speeds, dtype=float)), "speeds")
     a, b = contact_semi_axes(geometry, q)
     creep = -_traction_creep(creep_max, n_points)
-    fig, ax = _axes(ax)
+    if zoom is not None:
+        creep = np.unique(np.concatenate([creep, -np.linspace(0, float(zoom) / 100, 120)]))
+    fig, ax, ax_zoom = _creep_axes(ax, zoom)
+    axes = [x for x in (ax_zoom, ax) if x is not None]
     fx, _ = wilac_forces(creep[None, :], 0.0, 0.0, q, vs[:, None], a, b, w, p)
     colors = [f"C{i}" for i in range(len(vs))]
-    for v, row, col in zip(vs, np.asarray(fx) / q, colors, strict=True):
-        ax.plot(100 * creep, row, color=col, label=f"WILAC, v = {v:g} m/s")
+    rows = list(np.asarray(fx) / q)
+    labels = [f"WILAC, v = {v:g} m/s" for v in vs]
+    styles = [{"color": col} for col in colors]
     if compare_polach:
         vp = float(check_nonnegative(polach_speed, "polach_speed"))
         weights = wilac_weights(w, p.transitions)
@@ -442,10 +442,10 @@ def plot_wilac_speeds(
             )
             total = total + weights[i] * np.asarray(fxi)
         for v, row, col in zip(vs, total / q, colors, strict=True):
-            ax.plot(
-                100 * creep, row, color=col, ls="--",
-                label=f"Polach, fixed parameters of {vp:g} m/s, v = {v:g} m/s",
-            )
+            rows.append(row)
+            labels.append(f"Polach, fixed parameters of {vp:g} m/s, v = {v:g} m/s")
+            styles.append({"color": col, "ls": "--"})
+    _draw_distinguishable(axes, 100 * creep, rows, labels, styles)
     _finish_adhesion_axes(
         ax,
         _CREEP_LABEL,
@@ -453,4 +453,68 @@ def plot_wilac_speeds(
         (-100 * float(creep_max), 0.0),
         fontsize="small",
     )
+    _finish_zoom(ax_zoom, zoom, ax)
+    return fig
+
+
+def plot_fit(result, *, title: str = "", n_points: int = 200, ax=None):
+    """Fitted model against the measured creep curve (from :func:`~railadhesion.calibration.
+    fitting.fit_polach` or :func:`~railadhesion.calibration.fitting.fit_fletcher`).
+
+    Parameters
+    ----------
+    result : FitResult
+        The fit; its data (``creep``, ``adhesion``) and model (``predict``) are drawn.
+    title : str, optional
+        Axes title; default names the model, R² and RMSE.
+    n_points : int, optional
+        Samples of the model curve.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Markers: measured adhesion; line: the fitted model over the measured creep range
+        (at the data points only when the fit had per-point conditions); x: |creep| [%].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from railadhesion.calibration import fit_polach
+    >>> creep = -np.geomspace(1e-5, 0.3, 12)
+    >>> from railadhesion.models.polach import polach_forces
+    >>> fx, _ = polach_forces(creep, 0, 0, 4200.0, 5.0, 4e-3, 3e-3, mu0=0.3, k_A=0.5)
+    >>> res = fit_polach(creep, np.abs(fx) / 4200, normal_force=4200.0, speed=5.0, a=4e-3,
+    ...                  b=3e-3, fit=("mu0", "k_A"))
+    >>> len(plot_fit(res).axes[0].lines)
+    2
+    """
+    creep = np.asarray(result.creep, dtype=float)
+    fig, ax = _axes(ax)
+    order = np.argsort(np.abs(creep))
+    ax.plot(100 * np.abs(creep[order]), np.asarray(result.adhesion)[order], "o", ms=4,
+            color="0.2", label=f"measured ({result.n_points} points)")  # fmt: skip
+    per_point = any(np.ndim(v) > 0 for v in result.conditions.values())
+    if per_point:
+        c = creep[order]
+        model = np.asarray(result.predict())[order]
+    else:
+        sign = -1.0 if np.mean(creep) < 0 else 1.0
+        mags = np.abs(creep)
+        c = sign * np.linspace(0.0, float(mags.max()), int(n_points))
+        model = np.asarray(result.predict(c))
+    fitted = ", ".join(result.fitted)
+    ax.plot(100 * np.abs(c), model, color="C0",
+            label=f"{result.model.capitalize()} fit ({fitted})")  # fmt: skip
+    ax.set_xlabel("|creep| [%]")
+    ax.set_ylabel("adhesion |T|/Q [-]")
+    ax.set_title(
+        title or f"{result.model.capitalize()} fit: R² = {result.r_squared:.4f}, "
+        f"RMSE = {result.rmse:.3g}"
+    )
+    ax.set_xlim(left=0.0)
+    ax.set_ylim(bottom=0.0)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize="small")
     return fig

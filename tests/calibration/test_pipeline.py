@@ -200,7 +200,9 @@ def test_condition_for_water_flow_errors():
 def test_without_atol_the_r2_rule_models_fit_scatter():
     # The paper's R² rule alone: the ~1e-13 scatter of exactly constant fitted values is
     # "explained" by extra terms (large relative R² gains). Documented reason for atol.
-    result = run_wilac_calibration(_curves(), regression_atol=None)
+    result = run_wilac_calibration(
+        _curves(), regression_atol=None, criterion="r2", max_terms=8, refine=False
+    )
     n_terms = [len(r.terms) for regs in result.regressions.values() for r in regs.values() if r]
     assert max(n_terms) > 2
     with pytest.raises(ValueError, match="regression_atol must be"):
@@ -209,11 +211,18 @@ def test_without_atol_the_r2_rule_models_fit_scatter():
 
 def test_run_returns_fits_per_curve():
     curves = _curves()
-    result = run_wilac_calibration(curves, min_curves=7)  # every condition constant
+    # every condition constant; without the joint refinement: the mean of the fits
+    result = run_wilac_calibration(curves, min_curves=7, refine=False)
     assert all(r is None for regs in result.regressions.values() for r in regs.values())
     mu0 = result.parameters.conditions["dry"].mu0.coefficients[0]
     fitted = [cf.fit.params["mu0"] for cf in result.curve_fits if cf.condition == "dry"]
     assert mu0 == pytest.approx(np.mean(fitted))
+    # the joint refinement of the constants reproduces the curves better than the means
+    refined = run_wilac_calibration(curves, min_curves=7)
+    for cond in ("dry", "damp2"):
+        rms = [cf.calibrated_rmse for cf in result.curve_fits if cf.condition == cond]
+        rms_ref = [cf.calibrated_rmse for cf in refined.curve_fits if cf.condition == cond]
+        assert np.sqrt(np.mean(np.square(rms_ref))) < np.sqrt(np.mean(np.square(rms)))
 
 
 def test_a_curve_that_cannot_be_fitted_is_named():

@@ -147,6 +147,34 @@ class FitResult:
             )
         return PolachParameters(**self.params, name=name, source=source, notes=notes)
 
+    def to_dataframe(self):
+        """Data and fit as a :class:`pandas.DataFrame`: ``creep``, ``adhesion`` (measured),
+        ``model`` and ``residual`` (model minus measured), all dimensionless; ``attrs`` holds
+        the parameters, their standard errors, R², RMSE and ``units``."""
+        import pandas as pd
+
+        df = pd.DataFrame(
+            {
+                "creep": np.asarray(self.creep),
+                "adhesion": np.asarray(self.adhesion),
+                "model": np.asarray(self.adhesion) + np.asarray(self.residuals),
+                "residual": np.asarray(self.residuals),
+            }
+        )
+        df.attrs.update(
+            {
+                "model": self.model,
+                "params": dict(self.params),
+                "fitted": list(self.fitted),
+                "stderr": dict(self.stderr),
+                "r_squared": self.r_squared,
+                "rmse": self.rmse,
+                "units": {"creep": "1", "adhesion": "1", "model": "1", "residual": "1",
+                          "B": "s/m"},
+            }
+        )  # fmt: skip
+        return df
+
     def summary(self) -> str:
         """Readable multi-line report."""
         head = (

@@ -155,6 +155,21 @@ def _lstsq(columns: np.ndarray, y: np.ndarray):
     return coef, scaled @ coef_s, int(rank), cond
 
 
+def _press(columns: np.ndarray, y: np.ndarray) -> float:
+    """Leave-one-out prediction error sum of squares of least squares on ``columns``.
+
+    Exact for linear least squares: e_i / (1 - h_ii) with h the diagonal of the hat matrix
+    (Allen 1974); inf when a sample has leverage 1 (its left-out prediction is undetermined).
+    """
+    norms = np.linalg.norm(columns, axis=0)
+    q, _ = np.linalg.qr(columns / np.where(norms > 0, norms, 1.0))
+    h = np.sum(q**2, axis=1)
+    resid = y - q @ (q.T @ y)
+    if np.any(h > 1 - 1e-10):
+        return np.inf
+    return float(np.sum((resid / (1 - h)) ** 2))
+
+
 def build_regression(
     q_norm,
     v_norm,
@@ -167,6 +182,7 @@ def build_regression(
     max_condition: float = 1e8,
     method: str = "forward",
     atol: float = 0.0,
+    criterion: str = "r2",
 ) -> RegressionFit:
     """Build a WILAC parameter regression by forward selection of terms.
 
@@ -209,6 +225,15 @@ def build_regression(
         is at or below ``atol``. Set it to the noise level of ``y`` (e.g. the standard error of
         fitted parameters) so that the selection does not model noise: with few samples the
         R² rule alone accepts terms that fit noise, since their relative gain is large.
+    criterion : {"r2", "cv", "aicc", "bic"}, default "r2"
+        What a new term must improve besides the R² gain rule. ``"r2"``: nothing else (the
+        paper's rule). ``"cv"``: the leave-one-out cross-validation error (PRESS, the sum of
+        squared leave-one-out prediction errors, computed exactly from the hat matrix) must
+        fall. ``"aicc"`` / ``"bic"``: the small-sample Akaike or the Bayesian information
+        criterion of the Gaussian least-squares fit must fall. The candidate is always the
+        one raising R² most (the paper's choice); the criterion decides whether it enters.
+        The three refuse terms that fit noise, which the R² rule accepts when samples are
+        few.
 
     Returns
     -------
@@ -232,6 +257,9 @@ def build_regression(
     ----------
     G. Trummer et al., Wheel-rail creep force model for predicting water induced low adhesion
     phenomena, Tribology International (2017), section 5.2.
+
+    D. M. Allen, The relationship between variable selection and data augmentation and a
+    method for prediction, Technometrics 16 (1974) 125-127 (PRESS).
 
     P. Pudil, J. Novovičová, J. Kittler, Floating search methods in feature selection, Pattern
     Recognition Letters 15 (1994) 1119-1125.
@@ -265,6 +293,7 @@ def build_regression(
     if max_terms is not None and (int(max_terms) != max_terms or max_terms < 1):
         raise ValueError(f"max_terms must be an integer >= 1 or None, got {max_terms!r}")
     check_choice(method, "method", ("forward", "floating"))
+    check_choice(criterion, "criterion", ("r2", "cv", "aicc", "bic"))
     if not max_condition > 1:
         raise ValueError(f"max_condition must be in (1, inf], got {max_condition!r}")
     if candidates is None:
@@ -293,7 +322,22 @@ def build_regression(
             return None
         return 1.0 - float(np.sum((yy - fitted) ** 2)) / ss_tot, coef_, cnd
 
+    def score(idx: list[int], r2_: float) -> float:
+        """Model-selection score of ``criterion`` (lower is better; -R² for "r2")."""
+        if criterion == "r2":
+            return -r2_
+        k = len(idx) + 1
+        ssr = max((1.0 - r2_) * ss_tot, 1e-300)
+        if criterion == "cv":
+            return _press(design(idx), yy)
+        if criterion == "bic":
+            return n * np.log(ssr / n) + k * np.log(n)
+        if n - k - 1 <= 0:
+            return np.inf
+        return n * np.log(ssr / n) + 2 * k + 2 * k * (k + 1) / (n - k - 1)
+
     coef, cond, r2 = np.array([mean]), 1.0, 0.0
+    current_score = np.inf
     if ss_tot <= (1e-10 * scale) ** 2 * n:
         reason, r2 = "y is constant", 1.0
     elif ss_tot <= tol**2 * n:
@@ -305,6 +349,7 @@ def build_regression(
             pool_cols = design_matrix(pool, q, v) if pool else np.empty((n, 0))
         usable = np.all(np.isfinite(pool_cols), axis=0)
         best_by_size = {0: 0.0}
+        current_score = score([], 0.0)
         reason = "no candidate left"
         for _ in range(10 * len(pool) + 10):  # floating search: guard against cycling
             if (1.0 - r2) * ss_tot <= tol**2 * n:
@@ -324,8 +369,9 @@ def build_regression(
                 res = evaluate(chosen + [i])
                 if res is None:
                     n_skipped += 1
-                elif best is None or res[0] > best[1][0]:
-                    best = (i, res)
+                    continue
+                if best is None or res[0] > best[1][0]:
+                    best = (i, res, None)
             if best is None:
                 reason = (
                     "no candidate left"
@@ -333,15 +379,21 @@ def build_regression(
                     else "every remaining candidate is collinear or ill-conditioned"
                 )
                 break
-            i, (r2_try, c_try, cnd) = best
+            i, (r2_try, c_try, cnd), _ = best
+            sc = score(chosen + [i], r2_try)
             gain = r2_try - r2
-            accepted = gain >= gain_min
+            improves = criterion == "r2" or sc < current_score
+            accepted = gain >= gain_min and improves
             history.append(SelectionStep(pool[i], r2_try, gain, accepted, n_skipped, "add"))
             if not accepted:
-                reason = f"best R^2 gain {gain:.3g} < min_r2_gain {gain_min:g}"
+                reason = (
+                    f"best R^2 gain {gain:.3g} < min_r2_gain {gain_min:g}"
+                    if gain < gain_min
+                    else f"no candidate improves the {criterion} criterion"
+                )
                 break
             chosen.append(i)
-            coef, r2, cond = c_try, r2_try, cnd
+            coef, r2, cond, current_score = c_try, r2_try, cnd, sc
             best_by_size[len(chosen)] = max(best_by_size.get(len(chosen), -np.inf), r2)
             # Floating search (Pudil et al. 1994): drop an earlier term while the smaller
             # model beats the best model of that size seen so far.
@@ -356,6 +408,7 @@ def build_regression(
                 chosen.remove(k)
                 history.append(SelectionStep(pool[k], res[0], res[0] - r2, True, 0, "remove"))
                 r2, coef, cond = res
+                current_score = score(chosen, r2)
                 best_by_size[len(chosen)] = r2
         else:
             reason = "iteration limit of the floating search reached"

@@ -7,6 +7,7 @@ from railadhesion.contact.exact import (
     tangential_influence,
 )
 from railadhesion.contact.fastsim import FastsimResult, fastsim
+from railadhesion.contact.geometry import NAMED_GEOMETRIES, contact_semi_axes
 from railadhesion.contact.hertz import (
     HertzContact,
     LineContact,
@@ -24,12 +25,14 @@ from railadhesion.contact.kalker import (
 
 __all__ = [
     "ExactResult",
+    "NAMED_GEOMETRIES",
     "FastsimResult",
     "HertzContact",
     "KalkerCoefficients",
     "LineContact",
     "combined_elastic_constants",
     "exact_rolling",
+    "contact_semi_axes",
     "fastsim",
     "hertz_3d",
     "hertz_3d_from_curvatures",

@@ -28,6 +28,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from railadhesion._labelled import FASTSIM_UNITS, labelled
 from railadhesion._validate import (
     check_choice,
     check_finite,
@@ -188,6 +189,7 @@ def _flexibilities(a, b, xi, eta, phi, normal_force, mu, g_mod, nu, blended):
     )
 
 
+@labelled(units=FASTSIM_UNITS)
 def fastsim(
     creep_long,
     creep_lat,

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import ellipe, ellipkm1
 
+from railadhesion._labelled import HERTZ_UNITS, LINE_UNITS, labelled
 from railadhesion._validate import as_float_array, check_positive, check_range
 
 __all__ = [
@@ -250,6 +251,7 @@ def _axis_ratio_scalar(ratio: float) -> tuple[float, float, float]:
     return k, float(ellipkm1(k * k)), float(ellipe(1.0 - k * k))
 
 
+@labelled(units=HERTZ_UNITS)
 def hertz_3d_from_curvatures(
     normal_force,
     curvature_A,
@@ -386,6 +388,7 @@ def _check_radius_nonzero(value, name: str) -> np.ndarray:
     return arr
 
 
+@labelled(units=HERTZ_UNITS)
 def hertz_3d(
     normal_force,
     wheel_radius,
@@ -478,6 +481,7 @@ def _reduced_radius(radius_1, radius_2) -> np.ndarray:
     return 1.0 / inv
 
 
+@labelled(units=LINE_UNITS)
 def line_contact(
     load_per_length,
     radius_1,
@@ -527,6 +531,7 @@ def line_contact(
     return _line_result(a, p0, p, r, e_star)
 
 
+@labelled(units=LINE_UNITS)
 def line_contact_from_pressure(
     max_pressure,
     radius_1,

@@ -29,6 +29,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from railadhesion._labelled import labelled
 from railadhesion._validate import check_finite, check_positive, check_range
 
 __all__ = ["KalkerCoefficients", "kalker_coefficients", "linear_creep_forces"]
@@ -149,6 +150,7 @@ def _asymptotes(g: np.ndarray, nu: np.ndarray, le: np.ndarray) -> np.ndarray:
     )
 
 
+@labelled(units="1")
 def kalker_coefficients(a_over_b, poisson) -> KalkerCoefficients:
     """Kalker's linear-theory creepage coefficients C11, C22, C23, C33 of an elliptical contact.
 
@@ -317,6 +319,7 @@ def axis_ratio(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return r
 
 
+@labelled(units=("N", "N", "N m"))
 def linear_creep_forces(creep_long, creep_lat, spin, a, b, shear_modulus, poisson):
     """Creep forces and spin moment of Kalker's linear theory (small creepages, full stick).
 

@@ -172,6 +172,53 @@ class CreepCurve:
     def __len__(self) -> int:
         return int(self.creep.size)
 
+    def _attrs(self) -> dict:
+        attrs = {"name": self.name, "source": self.source}
+        if self.condition is not None:
+            attrs["condition"] = self.condition
+        for key, (attr, _unit, _) in METADATA_KEYS.items():
+            value = getattr(self, attr)
+            if value is not None:
+                attrs[key] = value  # the key carries the unit (normal_force_N, speed_m_s...)
+        attrs["units"] = {"creep": "1", "adhesion": "1"}
+        return attrs
+
+    def to_dataframe(self):
+        """The curve as a :class:`pandas.DataFrame` (columns ``creep``, ``adhesion``).
+
+        ``attrs`` holds the metadata (keys with units as in the CSV header, e.g.
+        ``normal_force_N``) and ``attrs["units"]`` the units of the columns ("1":
+        dimensionless fractions).
+
+        Examples
+        --------
+        >>> c = CreepCurve([-0.01, -0.02], [0.2, 0.25], normal_force=4200.0)
+        >>> df = c.to_dataframe()
+        >>> list(df.columns), df.attrs["normal_force_N"]
+        (['creep', 'adhesion'], 4200.0)
+        """
+        import pandas as pd
+
+        df = pd.DataFrame({"creep": np.asarray(self.creep), "adhesion": np.asarray(self.adhesion)})
+        df.attrs.update(self._attrs())
+        return df
+
+    def to_dataset(self):
+        """The curve as an :class:`xarray.Dataset`: ``adhesion`` over the coordinate ``creep``,
+        units in each variable's ``attrs``, metadata in the dataset's ``attrs``."""
+        import xarray as xr
+
+        attrs = self._attrs()
+        attrs.pop("units")
+        ds = xr.Dataset(
+            {"adhesion": ("creep", np.asarray(self.adhesion), {"units": "1",
+                                                               "long_name": "|T|/Q"})},
+            coords={"creep": ("creep", np.asarray(self.creep), {"units": "1",
+                                                               "long_name": "creepage xi"})},
+        )  # fmt: skip
+        ds.attrs.update({k: v for k, v in attrs.items() if v is not None})
+        return ds
+
     @property
     def metadata(self) -> dict[str, float | None]:
         """Numeric metadata by attribute name: normal_force, speed, water_flow, a, b."""

@@ -27,6 +27,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from railadhesion._labelled import labelled
 from railadhesion._validate import (
     as_float_array,
     check_finite,
@@ -56,6 +57,7 @@ def _kalker_scalar(a_over_b: float, poisson: float) -> tuple[float, float, float
     return float(c.c11), float(c.c22), float(c.c23)
 
 
+@labelled(units=("N", "N"))
 def polach_forces(
     creep_long,
     creep_lat,

@@ -46,6 +46,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from railadhesion._labelled import TWOD_UNITS, labelled
 from railadhesion._validate import (
     check_finite,
     check_nonnegative,
@@ -116,6 +117,7 @@ def _scalar(x: np.ndarray):
     return x[()]
 
 
+@labelled(units=TWOD_UNITS)
 def carter(creep, normal_load, half_width, radius, mu) -> TwoDTraction:
     """Carter's (1926) 2D rolling-contact creep force, closed form.
 
@@ -188,6 +190,7 @@ def carter(creep, normal_load, half_width, radius, mu) -> TwoDTraction:
     )
 
 
+@labelled(units=TWOD_UNITS)
 def fletcher(creep, normal_load, half_width, radius, mu, k_a=1.0, k_s=1.0) -> TwoDTraction:
     """Fletcher's (2013) 2D elastic-foundation creep force with reduction factors k_a, k_s.
 
@@ -272,6 +275,7 @@ def fletcher(creep, normal_load, half_width, radius, mu, k_a=1.0, k_s=1.0) -> Tw
     return TwoDTraction(_scalar(traction), _scalar(stick), _scalar(slip), _scalar(c))
 
 
+@labelled(units=TWOD_UNITS)
 def elastic_foundation(creep, normal_load, half_width, radius, mu) -> TwoDTraction:
     """Johnson's 2D elastic-foundation creep force (Fletcher 2013 with ``k_a = k_s = 1``).
 
@@ -315,6 +319,7 @@ def elastic_foundation(creep, normal_load, half_width, radius, mu) -> TwoDTracti
     return fletcher(creep, normal_load, half_width, radius, mu, 1.0, 1.0)
 
 
+@labelled(units="1")
 def creep_from_surface_speeds(v1, v2):
     """Creep ratio from two surface speeds, Fletcher's (2013) eq. (1), as a fraction.
 

@@ -32,6 +32,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.special import erf
 
+from railadhesion._labelled import labelled
 from railadhesion._validate import (
     as_float_array,
     check_choice,
@@ -183,6 +184,7 @@ def _as_transition_key(transitions) -> tuple:
         raise
 
 
+@labelled(units="1", leading={"transition": ("e1", "e2", "e3")})
 def wilac_transitions(water_flow, transitions=PAPER_TRANSITIONS) -> np.ndarray:
     """Transition functions e_1, e_2, e_3 of the WILAC model.
 
@@ -223,6 +225,7 @@ def wilac_transitions(water_flow, transitions=PAPER_TRANSITIONS) -> np.ndarray:
     return _erf_transitions(w, m, s)
 
 
+@labelled(units="1", leading={"condition": WILAC_CONDITIONS})
 def wilac_weights(water_flow, transitions=PAPER_TRANSITIONS) -> np.ndarray:
     """Blending weights f_Dry, f_Damp2, f_Damp1, f_Wet of the WILAC model.
 
@@ -633,6 +636,7 @@ def _evaluate_condition(params: WilacParameters, condition: str, qn, vn) -> dict
     return {name: np.array(x) for name, x in zip(POLACH_PARAMETER_NAMES, values, strict=True)}
 
 
+@labelled(units=("N", "N"))
 def wilac_forces(
     creep_long,
     creep_lat,
