@@ -383,3 +383,8 @@ def fit_wilac_cmd(
 
 if __name__ == "__main__":  # pragma: no cover
     app()
+
+
+from railadhesion import cli_sweeps  # noqa: E402
+
+cli_sweeps.register(app)

@@ -29,6 +29,7 @@ from railadhesion.sweeps.run import (
     sweep_dataset,
     sweep_errors,
 )
+from railadhesion.sweeps.spec import SpecError, SweepSpec, load_sweep_spec
 
 __all__ = [
     "DIMENSIONS",
@@ -36,10 +37,13 @@ __all__ = [
     "PolachSweep",
     "SweepModel",
     "SweepPlan",
+    "SpecError",
     "SweepResult",
+    "SweepSpec",
     "TwoDSweep",
     "WilacSweep",
     "adhesion_at_creep",
+    "load_sweep_spec",
     "max_adhesion",
     "min_adhesion_water_flow",
     "open_sweep",

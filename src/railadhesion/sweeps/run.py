@@ -410,6 +410,11 @@ def run_sweep(model, grid=None, out=None, *, fixed=None, chunks=None, chunk_poin
     local = None if client is not None else _local_scheduler(scheduler)
     link = getattr(client, "dashboard_link", None) if client is not None else None
     try:
+        if str(out).endswith(".nc") and local == "processes":
+            raise ValueError(
+                "scheduler: a NetCDF file is written from one process; use 'threads', "
+                "'synchronous' or a cluster, or write a Zarr store (*.zarr)"
+            )
         if out is None or str(out).endswith(".nc"):
             return _run_whole(plan, out, client, local, link, on_start, attrs)
         path = Path(out).absolute()
