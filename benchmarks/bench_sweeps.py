@@ -120,7 +120,6 @@ def chunk_breakdown(plan, out: Path, n: int = 3):
     """Seconds to evaluate and to write one chunk (median of ``n`` chunks)."""
     import zarr
 
-    from railadhesion.sweeps.plan import VARIABLES
     from railadhesion.sweeps.run import _init_store
 
     _init_store(plan, out, True, None)  # an empty store of the plan's layout
@@ -130,7 +129,7 @@ def chunk_breakdown(plan, out: Path, n: int = 3):
         t0 = time.perf_counter()
         data, _ = plan.evaluate_chunk(index)
         t1 = time.perf_counter()
-        for name in VARIABLES:
+        for name in plan.variables:
             group[name][plan.chunk_slices(index)] = data[name]
         writes.append(time.perf_counter() - t1)
         evals.append(t1 - t0)

@@ -10,12 +10,15 @@ import xarray as xr
 import railadhesion as ra
 from railadhesion.plotting import contact_semi_axes
 from railadhesion.sweeps import (
+    FunctionSweep,
     PolachSweep,
     TwoDSweep,
     WilacSweep,
     adhesion_at_creep,
+    full_factorial,
     max_adhesion,
     min_adhesion_water_flow,
+    monte_carlo,
     plan_sweep,
     run_sweep,
     sweep_errors,
@@ -217,3 +220,46 @@ def test_default_chunks_keep_leading_dimensions_whole():
     plan = plan_sweep(WilacSweep(), WILAC_GRID, chunk_points=12 * 3 * 2)
     assert plan.chunk_shape == (12, 3, 2, 1)
     assert sum(1 for _ in plan.chunk_indices()) == plan.n_chunks == 2 * 6
+
+
+def test_monte_carlo_design_equals_direct_calls(tmp_path):
+    design = monte_carlo(40, seed=7, speed=("uniform", 2.5, 20.0),
+                         normal_force=("choice", [2000.0, 4200.0]),
+                         water_flow=("lognormal", 3.0, 1.0))  # fmt: skip
+    again = monte_carlo(40, seed=7, speed=("uniform", 2.5, 20.0),
+                        normal_force=("choice", [2000.0, 4200.0]),
+                        water_flow=("lognormal", 3.0, 1.0))  # fmt: skip
+    for name in ("speed", "normal_force", "water_flow"):
+        np.testing.assert_array_equal(design["sample"][name], again["sample"][name])
+    grid = {"creep_long": [0.02, 0.3], **design}
+    res = run_sweep(WilacSweep(), grid, tmp_path / "mc.zarr", chunks={"sample": 7})
+    ds = res.dataset.load()
+    assert ds.adhesion.dims == ("creep_long", "sample") and res.chunks_total == 6
+    assert ds.speed.dims == ("sample",) and ds.speed.attrs["units"] == "m/s"
+    params = ra.default_wilac_parameters()
+    for i in range(40):
+        v, q, w = (float(design["sample"][k][i]) for k in ("speed", "normal_force", "water_flow"))
+        a, b = contact_semi_axes("tram", q)
+        fx, _ = ra.wilac_forces(0.3, 0.0, 0.0, q, v, a, b, w, params)
+        _close(float(ds.fx.sel(creep_long=0.3, sample=i)), fx)
+
+
+def _stop_task(speed, mu):
+    """A stand-in task: the stopping distance v^2/(2 mu g) of a stop at constant mu."""
+    if mu <= 0:
+        raise ValueError(f"mu must be > 0, got {mu}")
+    return speed**2 / (2 * mu * 9.81), speed / (mu * 9.81)
+
+
+def test_task_function_over_a_scenario_design_records_failures():
+    model = FunctionSweep(_stop_task, {"speed": None, "mu": None},
+                          {"stopping_distance": "m", "stopping_time": "s"}, name="stop")
+    ds = run_sweep(model, full_factorial(speed=[10.0, 20.0], mu=[0.0, 0.05, 0.1]),
+                   chunk_points=4).dataset  # fmt: skip
+    np.testing.assert_allclose(ds.stopping_distance.sel(mu=0.1).values,
+                               [100 / 1.962, 400 / 1.962], rtol=1e-12)  # fmt: skip
+    assert ds.stopping_time.attrs["units"] == "s"
+    np.testing.assert_array_equal(ds.error.values, [[1, 0, 0], [1, 0, 0]])
+    assert ds.attrs["model"] == "stop"
+    with pytest.raises(ValueError, match="grid.sample.mu: 2 values"):
+        plan_sweep(model, {"sample": {"speed": [1.0, 2.0, 3.0], "mu": [0.1, 0.2]}})

@@ -15,13 +15,14 @@ from railadhesion.sweeps.derived import adhesion_at_creep, max_adhesion, min_adh
 from railadhesion.sweeps.models import (
     DIMENSIONS,
     SWEEP_MODELS,
+    FunctionSweep,
     PolachSweep,
     SweepModel,
     TwoDSweep,
     WilacSweep,
     sweep_model,
 )
-from railadhesion.sweeps.plan import SweepPlan, plan_sweep
+from railadhesion.sweeps.plan import SweepPlan, full_factorial, monte_carlo, plan_sweep
 from railadhesion.sweeps.run import (
     SweepResult,
     open_sweep,
@@ -34,6 +35,7 @@ from railadhesion.sweeps.spec import SpecError, SweepSpec, load_sweep_spec
 __all__ = [
     "DIMENSIONS",
     "SWEEP_MODELS",
+    "FunctionSweep",
     "PolachSweep",
     "SweepModel",
     "SweepPlan",
@@ -43,9 +45,11 @@ __all__ = [
     "TwoDSweep",
     "WilacSweep",
     "adhesion_at_creep",
+    "full_factorial",
     "load_sweep_spec",
     "max_adhesion",
     "min_adhesion_water_flow",
+    "monte_carlo",
     "open_sweep",
     "plan_sweep",
     "run_sweep",

@@ -14,6 +14,7 @@ Fletcher's test codes).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -27,6 +28,7 @@ __all__ = [
     "WilacSweep",
     "PolachSweep",
     "TwoDSweep",
+    "FunctionSweep",
     "SWEEP_MODELS",
     "sweep_model",
 ]
@@ -106,6 +108,16 @@ class SweepModel:
     labels: dict = field(default_factory=dict, init=False, repr=False, compare=False)
     force_units = "N"
 
+    @property
+    def outputs(self) -> dict[str, tuple[str, str]]:
+        """Output variables in the order :meth:`evaluate` returns them: name -> (units, text)."""
+        return {
+            "fx": (self.force_units, "longitudinal force of the rail on the wheel (Kalker's "
+                   "signs)"),
+            "fy": (self.force_units, "lateral force of the rail on the wheel (Kalker's signs)"),
+            "adhesion": ("1", "adhesion coefficient |T|/Q"),
+        }  # fmt: skip
+
     def check_label(self, dim: str, label: str) -> None:
         """Raise ValueError if ``label`` is not valid for label dimension ``dim``."""
         self.resolve(dim, label)
@@ -114,7 +126,7 @@ class SweepModel:
         raise ValueError(f"{dim}: the model {self.name!r} takes no labels")
 
     def evaluate(self, values: dict, labels: dict):  # pragma: no cover - overridden
-        """Forces and adhesion ``(fx, fy, adhesion)`` at broadcastable ``values``."""
+        """The :attr:`outputs` (e.g. ``(fx, fy, adhesion)``) at broadcastable ``values``."""
         raise NotImplementedError
 
     def describe(self) -> dict:
@@ -363,6 +375,101 @@ class TwoDSweep(SweepModel):
                 "parameters": {"k_a": c.k_a, "k_s": c.k_s, "mu": c.mu,
                                "normal_load": c.normal_load, "half_width": c.half_width,
                                "radius": c.radius}}  # fmt: skip
+
+
+@dataclass(frozen=True, eq=False)
+class FunctionSweep(SweepModel):
+    """Any task function as a sweep model: a study is a function over a scenario design.
+
+    Parameters
+    ----------
+    function : callable
+        ``function(**inputs) -> mapping or tuple`` of the outputs, in the order of
+        ``outputs``. Must be importable by name (a module-level function) to run on a
+        cluster, and pure: the same inputs give the same outputs.
+    inputs : mapping
+        Input names and defaults (``None``: must be swept or fixed).
+    outputs : mapping
+        Output names and their units (or ``(units, description)``).
+    vectorized : bool, optional
+        ``True``: ``function`` is called once per block with broadcastable arrays.
+        ``False`` (default): once per point with floats, and a point that raises is recorded
+        in ``error`` without affecting its neighbours.
+    name : str, optional
+        Stored in the attrs; default the function's qualified name.
+    input_attrs : mapping, optional
+        Per input name, attrs of its coordinate (``{"units": ..., "long_name": ...}``).
+    description : mapping, optional
+        JSON-serialisable parameters and provenance stored in the attrs.
+
+    Examples
+    --------
+    >>> import math
+    >>> from railadhesion.sweeps import run_sweep
+    >>> def radius(x, y):
+    ...     return math.sqrt(x * x - y)        # raises for y > x**2
+    >>> model = FunctionSweep(radius, {"x": None, "y": 0.0}, {"r": "m"})
+    >>> ds = run_sweep(model, {"x": [2.0, 3.0], "y": [0.0, 5.0]}).dataset
+    >>> ds.r.values, ds.error.values
+    (array([[ 2., nan],
+           [ 3.,  2.]]), array([[0, 1],
+           [0, 0]], dtype=uint8))
+    """
+
+    function: Callable = None
+    input_defaults: Mapping = field(default_factory=dict)
+    output_units: Mapping = field(default_factory=dict)
+    vectorized: bool = False
+    model_name: str = ""
+    input_attrs: Mapping = field(default_factory=dict)
+    description: Mapping = field(default_factory=dict)
+
+    def __init__(self, function, inputs, outputs, *, vectorized=False, name="",
+                 input_attrs=None, description=None):  # fmt: skip
+        if not callable(function):
+            raise ValueError(f"function: expected a callable, got {function!r}")
+        if not inputs or not outputs:
+            raise ValueError("inputs, outputs: expected at least one of each")
+        for attr, value in (
+            ("function", function), ("input_defaults", dict(inputs)),
+            ("output_units", dict(outputs)), ("vectorized", bool(vectorized)),
+            ("model_name", name or getattr(function, "__qualname__", "function")),
+            ("input_attrs", dict(input_attrs or {})), ("description", dict(description or {})),
+            ("inputs", dict(inputs)), ("labels", {}),
+        ):  # fmt: skip
+            object.__setattr__(self, attr, value)
+
+    @property
+    def name(self) -> str:
+        return self.model_name
+
+    @property
+    def pointwise(self) -> bool:
+        return not self.vectorized
+
+    @property
+    def outputs(self):
+        return {k: (v, k) if isinstance(v, str) else tuple(v)
+                for k, v in self.output_units.items()}  # fmt: skip
+
+    def evaluate(self, values, labels):
+        if self.vectorized:
+            res = self.function(**values)
+        else:
+            res = self.function(**{k: float(np.ravel(v)[0]) for k, v in values.items()})
+        if isinstance(res, Mapping):
+            return tuple(res[k] for k in self.output_units)
+        res = tuple(res) if isinstance(res, tuple | list) else (res,)
+        if len(res) != len(self.output_units):
+            raise ValueError(f"{self.name} returned {len(res)} values for the "
+                             f"{len(self.output_units)} outputs {list(self.output_units)}")
+        return res
+
+    def describe(self):
+        mod = getattr(self.function, "__module__", "?")
+        return {"model": f"task function {mod}.{self.model_name}",
+                "function": f"{mod}.{getattr(self.function, '__qualname__', '?')}",
+                "vectorized": self.vectorized, **self.description}  # fmt: skip
 
 
 def _geometry_text(geometry) -> str:

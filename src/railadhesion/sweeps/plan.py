@@ -10,25 +10,22 @@ import hashlib
 import itertools
 import json
 import math
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
 
 from railadhesion.sweeps.models import DIMENSIONS, LABEL_DIMENSIONS, SweepModel
 
-__all__ = ["SweepPlan", "plan_sweep", "DEFAULT_CHUNK_POINTS", "VARIABLES"]
+__all__ = ["SweepPlan", "plan_sweep", "full_factorial", "monte_carlo", "DEFAULT_CHUNK_POINTS"]
 
 #: Default number of grid points per chunk (about 2 MB per float64 variable).
 DEFAULT_CHUNK_POINTS = 2**18
 
-#: Output variables: name -> (dtype, units key, description).
-VARIABLES = {
-    "fx": ("float64", "force", "longitudinal force of the rail on the wheel (Kalker's signs)"),
-    "fy": ("float64", "force", "lateral force of the rail on the wheel (Kalker's signs)"),
-    "adhesion": ("float64", "1", "adhesion coefficient |T|/Q"),
-    "error": ("uint8", "", "1 where the model raised for this point (message in attrs), else 0"),
-}
+#: The per-point failure flag every map carries besides the model's outputs.
+ERROR_VARIABLE = ("uint8", "", "1 where the model raised for this point (message in attrs), "
+                  "else 0")  # fmt: skip
 
 
 def _as_coordinate(dim: str, values, where: str) -> np.ndarray:
@@ -76,6 +73,14 @@ class SweepPlan:
     coords: tuple[np.ndarray, ...]
     fixed: dict
     chunk_shape: tuple[int, ...]
+    along: dict = field(default_factory=dict)
+
+    @property
+    def variables(self) -> dict[str, tuple[str, str, str]]:
+        """Stored variables: name -> (dtype, units, description); the model's outputs, error."""
+        out = {k: ("float64", u, t) for k, (u, t) in self.model.outputs.items()}
+        out["error"] = ERROR_VARIABLE
+        return out
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -122,6 +127,7 @@ class SweepPlan:
             "coords": [c.tolist() for c in self.coords],
             "fixed": {k: (v if isinstance(v, str) else float(v)) for k, v in self.fixed.items()},
             "chunk_shape": list(self.chunk_shape),
+            "along": {k: [d, v.tolist()] for k, (d, v) in sorted(self.along.items())},
         }
         text = json.dumps(doc, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()
@@ -139,7 +145,7 @@ class SweepPlan:
         }
 
     def evaluate_chunk(self, index) -> tuple[dict[str, np.ndarray], list]:
-        """Evaluate chunk ``index``: the arrays of :data:`VARIABLES` and the failed points.
+        """Evaluate chunk ``index``: the arrays of :attr:`variables` and the failed points.
 
         A block is evaluated by one broadcasting call of the model; if that raises, the block
         is bisected until the failing points are isolated, each recorded with its message
@@ -148,12 +154,8 @@ class SweepPlan:
         sl = self.chunk_slices(index)
         block = {d: c[s] for d, c, s in zip(self.dims, self.coords, sl, strict=True)}
         shape = tuple(len(v) for v in block.values())
-        out = {
-            "fx": np.full(shape, np.nan),
-            "fy": np.full(shape, np.nan),
-            "adhesion": np.full(shape, np.nan),
-            "error": np.zeros(shape, dtype=np.uint8),
-        }
+        out = {name: np.full(shape, np.nan) for name in self.model.outputs}
+        out["error"] = np.zeros(shape, dtype=np.uint8)
         errors: list = []
         label_dims = [d for d in self.dims if d in LABEL_DIMENSIONS]
         numeric_axes = [i for i, d in enumerate(self.dims) if d not in LABEL_DIMENSIONS]
@@ -173,7 +175,13 @@ class SweepPlan:
         ndim = len(self.dims)
         values = {}
         for name, default in self.model.inputs.items():
-            if name in block:
+            if name in self.along:  # a scenario input: varies along its scenario dimension
+                dim, column = self.along[name]
+                k = self.dims.index(dim)
+                lo, hi = region[k]
+                v = column[block[dim][lo:hi]]  # the scenario coordinate is 0 .. n-1
+                values[name] = v.reshape((1,) * k + (hi - lo,) + (1,) * (ndim - k - 1))
+            elif name in block:
                 k = self.dims.index(name)
                 lo, hi = region[k]
                 v = block[name][lo:hi].astype(float)
@@ -182,8 +190,16 @@ class SweepPlan:
                 values[name] = float(self.fixed.get(name, default))
         target = tuple(slice(lo, hi) for lo, hi in region)
         rshape = tuple(hi - lo for lo, hi in region)
+        if getattr(self.model, "pointwise", False) and math.prod(rshape) > 1:
+            # one task call per point (e.g. a braking simulation): failures are isolated
+            # directly, without bisecting.
+            for sub in np.ndindex(*rshape):
+                point = tuple((lo + k, lo + k + 1) for (lo, _), k in zip(region, sub,
+                                                                          strict=True))
+                self._evaluate_region(block, labels, numeric_axes, point, out, errors, shape)
+            return
         try:
-            fx, fy, adh = self.model.evaluate(values, labels)
+            results = self.model.evaluate(values, labels)
         except Exception as exc:  # noqa: BLE001 - any failure of a point is recorded, not fatal
             sizes = [(rshape[k], k) for k in numeric_axes if rshape[k] > 1]
             if not sizes:
@@ -200,9 +216,8 @@ class SweepPlan:
                 self._evaluate_region(block, labels, numeric_axes, tuple(sub), out, errors,
                                       shape)  # fmt: skip
             return
-        out["fx"][target] = np.broadcast_to(fx, rshape)
-        out["fy"][target] = np.broadcast_to(fy, rshape)
-        out["adhesion"][target] = np.broadcast_to(adh, rshape)
+        for name, value in zip(self.model.outputs, results, strict=True):
+            out[name][target] = np.broadcast_to(value, rshape)
 
 
 def _plain(x):
@@ -240,8 +255,13 @@ def plan_sweep(model: SweepModel, grid, *, fixed=None, chunks=None,
         raise ValueError("grid: expected at least one dimension")
     fixed = dict(fixed or {})
     allowed = set(model.inputs) | set(model.labels)
-    dims, coords = [], []
+    dims, coords, along = [], [], {}
     for dim, values in grid.items():
+        if isinstance(values, Mapping):
+            n = _scenario_dimension(model, dim, values, along, allowed)
+            dims.append(dim)
+            coords.append(np.arange(n))
+            continue
         if dim not in allowed:
             raise ValueError(
                 f"grid.{dim}: not an input of the {model.name!r} model; allowed: "
@@ -262,8 +282,8 @@ def plan_sweep(model: SweepModel, grid, *, fixed=None, chunks=None,
                 f"fixed.{name}: not an input of the {model.name!r} model; allowed: "
                 f"{sorted(allowed)}"
             )
-        if name in dims:
-            raise ValueError(f"fixed.{name}: also a grid dimension; give it in one place only")
+        if name in dims or name in along:
+            raise ValueError(f"fixed.{name}: also swept in the grid; give it in one place only")
         if name in model.labels:
             model.check_label(name, str(value))
         else:
@@ -273,7 +293,8 @@ def plan_sweep(model: SweepModel, grid, *, fixed=None, chunks=None,
                 raise ValueError(f"fixed.{name}: expected a number, got {value!r}") from None
             if not math.isfinite(x):
                 raise ValueError(f"fixed.{name}: expected a finite number, got {value!r}")
-    missing = [k for k, v in model.inputs.items() if v is None and k not in dims and k not in fixed]
+    missing = [k for k, v in model.inputs.items()
+               if v is None and k not in dims and k not in fixed and k not in along]  # fmt: skip
     if missing:
         raise ValueError(
             f"grid: the {model.name!r} model needs {missing}: sweep them (grid) or fix them "
@@ -296,12 +317,102 @@ def plan_sweep(model: SweepModel, grid, *, fixed=None, chunks=None,
         min(int(chunks[d]), n) if d in chunks else next(auto)
         for d, n in zip(dims, shape, strict=True)
     )
-    return SweepPlan(model, tuple(dims), tuple(coords), fixed, chunk_shape)
+    return SweepPlan(model, tuple(dims), tuple(coords), fixed, chunk_shape, along)
 
 
-def dimension_attrs(dim: str) -> dict:
-    """Units and description of a sweep dimension, for the coordinate's attrs."""
+def _scenario_dimension(model, dim, columns, along, allowed) -> int:
+    """Check a scenario dimension (inputs varying together along ``dim``); its length."""
+    if dim in allowed:
+        raise ValueError(f"grid.{dim}: a scenario dimension needs a name that is not an input "
+                         "(e.g. 'scenario' or 'sample')")  # fmt: skip
+    if not columns:
+        raise ValueError(f"grid.{dim}: expected at least one input varying along it")
+    n = None
+    for name, values in columns.items():
+        where = f"grid.{dim}.{name}"
+        if name not in model.inputs:
+            raise ValueError(f"{where}: not a numeric input of the {model.name!r} model; "
+                             f"inputs: {sorted(model.inputs)}")  # fmt: skip
+        if name in along:
+            raise ValueError(f"{where}: already varies along {along[name][0]!r}")
+        try:
+            arr = np.asarray(values, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"{where}: expected numbers") from None
+        if arr.ndim != 1 or arr.size == 0 or not np.all(np.isfinite(arr)):
+            raise ValueError(f"{where}: expected a non-empty 1-D sequence of finite numbers")
+        if n is not None and arr.size != n:
+            raise ValueError(f"{where}: {arr.size} values, but the other inputs along {dim!r} "
+                             f"have {n}")  # fmt: skip
+        n = arr.size
+        along[name] = (dim, arr)
+    return n
+
+
+def full_factorial(**axes) -> dict:
+    """A full-factorial design: every combination of the given values (the plain grid).
+
+    >>> list(full_factorial(speed=[5.0, 10.0], water_flow=[0.0, 25.0]))
+    ['speed', 'water_flow']
+    """
+    return {name: np.atleast_1d(np.asarray(v)) for name, v in axes.items()}
+
+
+def monte_carlo(n: int, seed: int, dim: str = "sample", **distributions) -> dict:
+    """A Monte Carlo design: ``n`` scenarios along dimension ``dim``, inputs drawn at random.
+
+    Parameters
+    ----------
+    n : int
+        Number of scenarios.
+    seed : int
+        Seed of :func:`numpy.random.default_rng`: the same seed gives the same design.
+    dim : str, optional
+        Name of the scenario dimension.
+    **distributions
+        Per input: ``("uniform", low, high)``, ``("normal", mean, sd)``,
+        ``("lognormal", mean_of_log, sd_of_log)`` or ``("choice", [values])``. Inputs are
+        drawn in the order given.
+
+    Returns
+    -------
+    dict
+        ``{dim: {input: values}}``, to be merged into a grid for :func:`plan_sweep`.
+
+    Examples
+    --------
+    >>> d = monte_carlo(3, seed=1, speed=("uniform", 5.0, 40.0))
+    >>> d["sample"]["speed"].round(2)
+    array([22.91, 38.27, 10.05])
+    """
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise ValueError(f"n: expected an integer >= 1, got {n!r}")
+    rng = np.random.default_rng(seed)
+    columns = {}
+    for name, spec in distributions.items():
+        kind, *args = spec
+        if kind == "uniform":
+            columns[name] = rng.uniform(args[0], args[1], n)
+        elif kind == "normal":
+            columns[name] = rng.normal(args[0], args[1], n)
+        elif kind == "lognormal":
+            columns[name] = rng.lognormal(args[0], args[1], n)
+        elif kind == "choice":
+            columns[name] = rng.choice(np.asarray(args[0], dtype=float), n)
+        else:
+            raise ValueError(f"{name}: unknown distribution {kind!r}; expected uniform, normal, "
+                             "lognormal or choice")  # fmt: skip
+    return {dim: columns}
+
+
+def dimension_attrs(dim: str, model: SweepModel | None = None) -> dict:
+    """Units and description of a sweep dimension or input, for the coordinate's attrs."""
     if dim in DIMENSIONS:
         units, text = DIMENSIONS[dim]
         return {"units": units, "long_name": text}
-    return {"long_name": LABEL_DIMENSIONS[dim]}
+    if dim in LABEL_DIMENSIONS:
+        return {"long_name": LABEL_DIMENSIONS[dim]}
+    extra = getattr(model, "input_attrs", {}) or {}
+    if dim in extra:
+        return dict(extra[dim])
+    return {"long_name": f"{dim} (scenario index)"}

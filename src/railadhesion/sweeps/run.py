@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from railadhesion.sweeps.plan import VARIABLES, SweepPlan, dimension_attrs, plan_sweep
+from railadhesion.sweeps.plan import SweepPlan, dimension_attrs, plan_sweep
 
 __all__ = ["SweepResult", "run_sweep", "sweep_dataset", "sweep_errors", "open_sweep"]
 
@@ -77,10 +77,6 @@ class SweepResult:
         return self.plan.size * self.chunks_computed / self.chunks_total / self.elapsed
 
 
-def _units(plan: SweepPlan, key: str) -> str:
-    return plan.model.force_units if key == "force" else key
-
-
 def _attrs(plan: SweepPlan, extra=None) -> dict:
     import dask
     import xarray
@@ -111,20 +107,23 @@ def _template(plan: SweepPlan, attrs=None):
     import dask.array as da
     import xarray as xr
 
-    coords = {d: (d, c, dimension_attrs(d)) for d, c in zip(plan.dims, plan.coords, strict=True)}
+    coords = {d: (d, c, dimension_attrs(d, plan.model))
+              for d, c in zip(plan.dims, plan.coords, strict=True)}  # fmt: skip
+    for name, (dim, column) in plan.along.items():  # scenario inputs, e.g. speed(sample)
+        coords[name] = (dim, column, dimension_attrs(name, plan.model))
     data = {}
-    for name, (dtype, units, text) in VARIABLES.items():
+    for name, (dtype, units, text) in plan.variables.items():
         arr = da.zeros(plan.shape, chunks=plan.chunks, dtype=dtype)
         var_attrs = {"long_name": text}
         if units:
-            var_attrs["units"] = _units(plan, units)
+            var_attrs["units"] = units
         data[name] = (plan.dims, arr, var_attrs)
     return xr.Dataset(data, coords=coords, attrs=_attrs(plan, attrs))
 
 
 def _chunk_block(plan: SweepPlan, index) -> np.ndarray:
     out, _ = plan.evaluate_chunk(index)
-    return np.stack([out["fx"], out["fy"], out["adhesion"], out["error"].astype(float)])
+    return np.stack([out[name].astype(float) for name in plan.variables])
 
 
 def sweep_dataset(plan: SweepPlan, attrs=None):
@@ -143,12 +142,12 @@ def sweep_dataset(plan: SweepPlan, attrs=None):
     task = dask.delayed(_chunk_block, pure=True)
     for index in plan.chunk_indices():
         shape = tuple(s.stop - s.start for s in plan.chunk_slices(index))
-        blocks[index] = da.from_delayed(task(plan, index), (4, *shape), dtype=float)
+        blocks[index] = da.from_delayed(task(plan, index), (len(plan.variables), *shape),
+                                        dtype=float)  # fmt: skip
     stacked = da.block(_nested(blocks, 0, ()), allow_unknown_chunksizes=False)
-    # da.block joins along the last axes; the stacked leading axis (4) is not split.
-    for k, name in enumerate(("fx", "fy", "adhesion")):
-        ds[name] = (plan.dims, stacked[k], ds[name].attrs)
-    ds["error"] = (plan.dims, stacked[3].astype(np.uint8), ds["error"].attrs)
+    # da.block joins along the last axes; the stacked leading axis (variables) is not split.
+    for k, (name, (dtype, _, _)) in enumerate(plan.variables.items()):
+        ds[name] = (plan.dims, stacked[k].astype(dtype), ds[name].attrs)
     return ds
 
 
@@ -181,7 +180,7 @@ def _chunk_task(plan: SweepPlan, path: str, index) -> tuple[tuple, int]:
     out, errors = plan.evaluate_chunk(index)
     group = zarr.open_group(path, mode="r+")
     region = plan.chunk_slices(index)
-    for name in VARIABLES:
+    for name in plan.variables:
         group[name][region] = out[name]
     marker = {
         "failed": len(errors),
@@ -223,7 +222,7 @@ def _init_store(plan: SweepPlan, path: Path, overwrite: bool, attrs) -> bool:
                     "overwrite it (overwrite=True, --overwrite)"
                 )
             return True
-    encoding = {name: {"chunks": plan.chunk_shape} for name in VARIABLES}
+    encoding = {name: {"chunks": plan.chunk_shape} for name in plan.variables}
     ds = _template(plan, attrs)
     ds.attrs["complete"] = 0
     ds.to_zarr(path, mode="w", compute=False, zarr_format=2, consolidated=True,
