@@ -159,12 +159,13 @@ def main(argv=None) -> None:
         ev, wr = chunk_breakdown(small, work / "breakdown.zarr")
         print(f"one chunk of {np.prod(small.chunk_shape):,} points: evaluate {ev * 1e3:.0f} ms, "
               f"write to Zarr {wr * 1e3:.0f} ms ({wr / (ev + wr):.0%} of the chunk's time)")
-        times, cpu = {1: [], 2: []}, {1: [], 2: []}
+        times, cpu, peak = {1: [], 2: []}, {1: [], 2: []}, {1: [], 2: []}
         for _ in range(args.repeats):
             for k in (1, 2):
-                res, _ = one_run(small, k, work / f"scaling{k}.zarr", args.memory_limit)
+                res, mem = one_run(small, k, work / f"scaling{k}.zarr", args.memory_limit)
                 times[k].append(res.elapsed)
                 cpu[k].append(res.worker_cpu)
+                peak[k].append(mem.peak)
         t1, t2 = statistics.median(times[1]), statistics.median(times[2])
         c1, c2 = statistics.median(cpu[1]), statistics.median(cpu[2])
         print(f"scaling on {small.size:,} points ({small.n_chunks} chunks), median of "
@@ -172,8 +173,9 @@ def main(argv=None) -> None:
               f"2 workers {t2:.1f} s ({small.size / t2 / 1e6:.2f} M points/s); "
               f"wall-clock efficiency T1/(2 T2) = {t1 / (2 * t2):.0%}")
         print(f"  runs [s]: 1 worker {[round(t, 1) for t in times[1]]}, "
-              f"2 workers {[round(t, 1) for t in times[2]]}; load average before: "
-              f"{os.getloadavg()[0]:.1f}")
+              f"2 workers {[round(t, 1) for t in times[2]]}; load average now: "
+              f"{os.getloadavg()[0]:.1f}; peak memory (all processes) 1 worker "
+              f"{max(peak[1]) / 2**30:.2f} GiB, 2 workers {max(peak[2]) / 2**30:.2f} GiB")
         print(f"  worker CPU time (median): 1 worker {c1:.1f} s, 2 workers {c2:.1f} s in total; "
               f"work efficiency CPU1/CPU2 = {c1 / c2:.0%} (what 2 workers would reach on 2 "
               "free cores; insensitive to other jobs on the machine)")
@@ -183,7 +185,9 @@ def main(argv=None) -> None:
             res, mem = one_run(plan, 2, out, args.memory_limit)
             dims = " x ".join(f"{d} {n}" for d, n in zip(plan.dims, plan.shape, strict=True))
             print(f"full sweep {dims} = {plan.size:,} points, {plan.n_chunks} chunks, 2 workers: "
-                  f"{res.elapsed:.1f} s, {res.points_per_second / 1e6:.2f} M points/s; "
+                  f"{res.elapsed:.1f} s, {res.points_per_second / 1e6:.2f} M points/s "
+                  f"(worker CPU {res.worker_cpu:.0f} s: {plan.size / res.worker_cpu / 1e6:.2f} "
+                  f"M points per CPU-second; load average now {os.getloadavg()[0]:.1f}); "
                   f"peak memory {mem.peak / 2**30:.2f} GiB (all processes; "
                   f"{mem.baseline / 2**30:.2f} GiB before the sweep); store "
                   f"{store_size(out) / 2**30:.2f} GiB; failed points {res.failed_points}")

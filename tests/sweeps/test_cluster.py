@@ -30,7 +30,7 @@ def cluster():
     env = {"PYTHONPATH": os.pathsep.join(filter(None, [src, os.environ.get("PYTHONPATH")]))}
     with distributed.LocalCluster(
         n_workers=2, threads_per_worker=1, processes=True, memory_limit="600MiB",
-        dashboard_address=None, env=env,
+        dashboard_address=":0", env=env,  # any free port (bokeh, the full dashboard, is absent)
     ) as cluster, distributed.Client(cluster) as client:  # fmt: skip
         yield cluster, client
 
@@ -80,6 +80,25 @@ def test_same_sweep_by_scheduler_address(cluster, tmp_path):
     remote = run_sweep(WilacSweep(), grid, tmp_path / "m.zarr", fixed=fixed,
                        chunks={"water_flow": 1}, scheduler=local_cluster.scheduler_address)
     local = run_sweep(WilacSweep(), grid, fixed=fixed, scheduler="synchronous")
-    assert remote.chunks_computed == 3
+    assert remote.chunks_computed == 3 and remote.dashboard_link.startswith("http")
     xr.testing.assert_allclose(remote.dataset.adhesion.load(), local.dataset.adhesion,
                                rtol=1e-12, atol=0)  # fmt: skip
+
+
+def test_cli_sweep_on_a_cluster_prints_the_dashboard(cluster, tmp_path):
+    from typer.testing import CliRunner
+
+    from railadhesion.cli import app
+
+    local_cluster, _ = cluster
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        'format = "railadhesion-sweep"\nformat_version = 1\n[model]\nname = "fletcher"\n'
+        'condition = "W1"\n[grid]\ncondition = ["W1", "D3"]\n'
+        "creep_long = { start = 0.0, stop = 0.01, num = 11 }\n"
+    )
+    result = CliRunner().invoke(app, ["sweep", str(spec), "--out", str(tmp_path / "m.zarr"),
+                                      "--scheduler", local_cluster.scheduler_address])
+    assert result.exit_code == 0, result.output
+    assert "Dask cluster dashboard: http" in result.output
+    assert "failed points: 0" in result.output
