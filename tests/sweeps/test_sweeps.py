@@ -165,7 +165,10 @@ def test_netcdf_output_equals_in_memory(tmp_path):
     grid = {"creep_long": [0.01, 0.1, 0.5], "water_flow": [0.0, 25.0, 60.0]}
     fixed = {"normal_force": 4200.0, "speed": 5.0}
     mem = run_sweep(WilacSweep(), grid, fixed=fixed, chunks={"water_flow": 1}).dataset
-    nc = run_sweep(WilacSweep(), grid, tmp_path / "m.nc", fixed=fixed, chunks={"water_flow": 1})
+    calls = []
+    nc = run_sweep(WilacSweep(), grid, tmp_path / "m.nc", fixed=fixed, chunks={"water_flow": 1},
+                   on_chunk=lambda done, total: calls.append((done, total)))
+    assert calls == [(1, 3), (2, 3), (3, 3)]
     xr.testing.assert_identical(nc.dataset.load().drop_attrs(), mem.drop_attrs())
     nc.dataset.close()
 

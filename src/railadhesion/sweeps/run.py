@@ -377,8 +377,9 @@ def run_sweep(model, grid=None, out=None, *, fixed=None, chunks=None, chunk_poin
         resumed (only chunks without a completion marker are computed), a different one is an
         error.
     on_chunk : callable, optional
-        ``on_chunk(done, to_do)`` after each chunk of a Zarr sweep (progress bars). An
-        exception raised here stops the sweep; completed chunks stay written.
+        ``on_chunk(done, to_do)`` after each chunk (progress bars; not called for in-memory
+        or NetCDF sweeps on a cluster). An exception raised here stops the sweep; completed
+        chunks of a Zarr store stay written.
     on_start : callable, optional
         ``on_start(result)`` once the store is ready, before computing: ``result`` is the
         :class:`SweepResult` so far (chunks to do, dashboard link).
@@ -415,7 +416,7 @@ def run_sweep(model, grid=None, out=None, *, fixed=None, chunks=None, chunk_poin
                 "'synchronous' or a cluster, or write a Zarr store (*.zarr)"
             )
         if out is None or str(out).endswith(".nc"):
-            return _run_whole(plan, out, client, local, link, on_start, attrs)
+            return _run_whole(plan, out, client, local, link, on_start, attrs, on_chunk)
         path = Path(out).absolute()
         resuming = _init_store(plan, path, overwrite, attrs)
         done = _read_markers(path) if resuming else {}
@@ -439,18 +440,48 @@ def run_sweep(model, grid=None, out=None, *, fixed=None, chunks=None, chunk_poin
             client.close()
 
 
-def _run_whole(plan, out, client, local, link, on_start, attrs) -> SweepResult:
+class _BlockProgress:
+    """Calls ``on_chunk(done, total)`` as the chunk tasks of :func:`sweep_dataset` finish
+    (local schedulers)."""
+
+    def __init__(self, total, on_chunk):
+        self.total, self.on_chunk, self.done, self.cb = total, on_chunk, 0, None
+
+    def __enter__(self):
+        if self.on_chunk is not None:
+            from dask.callbacks import Callback
+
+            def posttask(key, result, dsk, state, worker_id):
+                name = key[0] if isinstance(key, tuple) else key
+                if str(name).startswith("chunk_block"):
+                    self.done += 1
+                    self.on_chunk(self.done, self.total)
+
+            self.cb = Callback(posttask=posttask)
+            self.cb.__enter__()
+        return self
+
+    def __exit__(self, *exc):
+        if self.cb is not None:
+            self.cb.__exit__(*exc)
+
+
+def _run_whole(plan, out, client, local, link, on_start, attrs, on_chunk) -> SweepResult:
     result = SweepResult(None, None if out is None else Path(out), plan.n_chunks, plan.n_chunks,
                          0, 0, 0.0, link, plan)  # fmt: skip
     if on_start is not None:
         on_start(result)
     ds = sweep_dataset(plan, attrs)
     start = time.perf_counter()
-    if out is None:
-        ds = client.compute(ds).result() if client is not None else ds.compute(scheduler=local)
-    else:
-        job = ds.to_netcdf(out, compute=False)
-        client.compute(job).result() if client is not None else job.compute(scheduler=local)
+    with _BlockProgress(plan.n_chunks, on_chunk if client is None else None):
+        if out is None:
+            ds = client.compute(ds).result() if client is not None else ds.compute(
+                scheduler=local)
+        else:
+            job = ds.to_netcdf(out, compute=False)
+            client.compute(job).result() if client is not None else job.compute(
+                scheduler=local)
+    if out is not None:
         import xarray as xr
 
         ds = xr.open_dataset(out, chunks={})
