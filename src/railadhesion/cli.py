@@ -722,9 +722,16 @@ from railadhesion import cli_export  # noqa: E402
 
 cli_export.register(app)
 
-if __name__ == "__main__":  # pragma: no cover
-    app()
 
 from railadhesion.cli_identification import register as _register_identification  # noqa: E402
 
 _register_identification(app)
+
+
+from railadhesion import cli_sweeps  # noqa: E402
+
+cli_sweeps.register(app)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    app()

@@ -1,0 +1,93 @@
+"""CLI commands for sweeps at scale: ``railadhesion sweep SPEC.toml --out map.zarr``.
+
+A thin shell over :mod:`railadhesion.sweeps`: the spec is validated by
+:func:`~railadhesion.sweeps.load_sweep_spec`, the sweep run by
+:func:`~railadhesion.sweeps.run_sweep` with a Rich progress bar.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+from rich.console import Console
+from rich.markup import escape
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+console = Console()
+
+
+def _fail(message) -> None:
+    console.print(f"[red]error:[/red] {escape(str(message))}")
+    raise typer.Exit(code=2)
+
+
+def sweep(
+    spec: Path = typer.Argument(..., help="Sweep spec file (TOML; see examples/wilac_map.toml)."),
+    out: Path = typer.Option(..., "--out", help="Output: a Zarr store (*.zarr, resumable) or "
+                             "NetCDF file (*.nc)."),
+    scheduler: str | None = typer.Option(
+        None, help="Dask cluster address (tcp://HOST:PORT), or a local scheduler: threads "
+        "(default), processes, synchronous."),
+    overwrite: bool = typer.Option(False, "--overwrite", help="Replace an existing output."),
+) -> None:
+    """Evaluate a model over the grid of SPEC with Dask; write the map chunk by chunk.
+
+    A re-run with the same spec and --out resumes: only chunks not yet written are computed.
+    """
+    from railadhesion.sweeps import load_sweep_spec
+
+    try:
+        sweep_spec = load_sweep_spec(spec)
+        plan = sweep_spec.plan()
+    except ValueError as exc:
+        _fail(exc)
+    dims = " x ".join(f"{d} {n}" for d, n in zip(plan.dims, plan.shape, strict=True))
+    console.print(f"{escape(plan.model.name)} over {escape(dims)} = {plan.size:,} points in "
+                  f"{plan.n_chunks} chunks", highlight=False)  # fmt: skip
+    progress = Progress(
+        TextColumn("chunks"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
+        console=console, transient=False,
+    )
+    task = {"id": None}
+
+    def on_start(result):
+        if result.dashboard_link:
+            console.print(f"Dask cluster dashboard: {escape(result.dashboard_link)}")
+        if result.chunks_skipped:
+            console.print(f"resuming: {result.chunks_skipped} of {result.chunks_total} chunks "
+                          "already written")  # fmt: skip
+        task["id"] = progress.add_task("sweep", total=result.chunks_computed)
+        progress.start()
+
+    def on_chunk(done, total):
+        progress.update(task["id"], completed=done)
+
+    try:
+        result = sweep_spec.run(out, scheduler=scheduler, overwrite=overwrite,
+                                on_start=on_start, on_chunk=on_chunk)  # fmt: skip
+    except ValueError as exc:
+        progress.stop()
+        _fail(exc)
+    except OSError as exc:
+        progress.stop()
+        _fail(f"cannot write {out}: {exc}")
+    except KeyboardInterrupt:
+        progress.stop()
+        console.print("interrupted: chunks already written are kept; re-run the same command "
+                      "to resume")  # fmt: skip
+        raise typer.Exit(code=130) from None
+    progress.update(task["id"], completed=result.chunks_computed)
+    progress.stop()
+    rate = result.points_per_second
+    console.print(
+        f"{result.chunks_computed} chunks computed, {result.chunks_skipped} already written; "
+        f"{result.elapsed:.1f} s" + (f", {rate:,.0f} points/s" if rate == rate else "")
+        + f"; failed points: {result.failed_points}", highlight=False,
+    )  # fmt: skip
+    console.print(f"map written to {escape(str(out))}")
+
+
+def register(app: typer.Typer) -> None:
+    """Add the sweep commands to the ``railadhesion`` app."""
+    app.command("sweep")(sweep)
