@@ -113,8 +113,9 @@ def test_weights_sum_to_one_and_are_nonnegative(w):
     np.testing.assert_allclose(f.sum(axis=0), 1.0, atol=1e-14)
     # Not exactly >= 0: the paper's f_Damp1 = e2 - e3 is truly negative, by ~1e-15, where the
     # wide e3 tail (s = 7 µl/s) exceeds the narrow e2 tail (s = 3), e.g. at w = 11 µl/s:
-    # 0.5 erfc(19/3) - 0.5 erfc(39/7) = -1.7e-15. Such weights are negligible, not an error.
-    assert np.all(f >= -1e-13)
+    # 0.5 erfc(19/3) - 0.5 erfc(39/7) = -1.7e-15; the most negative value is -2.35e-13 near
+    # w = 14.56 µl/s. Such weights are negligible, not an error.
+    assert np.all(f >= -2.5e-13)
 
 
 @SETTINGS
