@@ -107,7 +107,7 @@ def _emit(title: str, columns, rows, fmt: str, out: Path | None, note: str = "")
         if out is None:
             console.print(table)
             if note:
-                console.print(escape(note), highlight=False)
+                console.print(escape(note), highlight=False, soft_wrap=True)
             return
         buffer = Console(file=io.StringIO(), width=200, color_system=None)
         buffer.print(table)
@@ -289,10 +289,9 @@ def polach(
     except ValueError as exc:
         _fail(exc)
     mu = adhesion(fx, fy, normal_force)
-    contact = (
-        f"contact: {geometry_description(geo)}; at Q = {normal_force:g} N: "
-        f"a = {ca * 1e3:.3g} mm, b = {cb * 1e3:.3g} mm"
-    )
+    where = "given semi-axes" if a is not None else geometry_description(geo)
+    contact = f"contact: {where}\nHertz at Q = {normal_force:g} N: a = {ca * 1e3:.3g} mm, " \
+        f"b = {cb * 1e3:.3g} mm"
     title = f"Polach '{params.name}' at Q = {normal_force:g} N, V = {speed:g} m/s"
     table_out = out is not None and (
         fmt != "table" or out.suffix.lower() in (".csv", ".json")
