@@ -59,7 +59,9 @@ def _version(value: bool) -> None:
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     """Print a Python warning as one plain line, without the source location."""
-    console.print(f"[yellow]warning:[/yellow] {escape(str(message))}", highlight=False)
+    console.print(
+        f"[yellow]warning:[/yellow] {escape(str(message))}", highlight=False, soft_wrap=True
+    )
 
 
 @app.callback()
@@ -601,7 +603,7 @@ def fit_polach_cmd(
         _fail(f"{csv_file}: {exc}")
     held = [n for n in POLACH_NAMES if n not in result.fitted]
     if fmt == "table" and table is None:
-        console.print(str(result), highlight=False, markup=False)
+        console.print(str(result), highlight=False, markup=False, soft_wrap=True)
     else:
         _emit(
             f"Polach fit to {csv_file.name}",
@@ -703,7 +705,7 @@ def fit_wilac_cmd(
     except OSError as exc:  # the output file cannot be written
         _fail(f"cannot write the parameter file {out}: {exc}")
     if fmt == "table" and table is None:
-        console.print(calibration.summary(), highlight=False, markup=False)
+        console.print(calibration.summary(), highlight=False, markup=False, soft_wrap=True)
     else:
         rows = calibration.curve_table()
         keys = list(rows[0]) if rows else []
