@@ -102,8 +102,8 @@ def _emit(title: str, columns, rows, fmt: str, out: Path | None, note: str = "")
     keys = [c[0] for c in columns]
     if fmt == "table":
         table = Table(title=escape(title))
-        for _, label, _ in columns:
-            table.add_column(escape(label), justify="right")
+        for _, label, spec in columns:
+            table.add_column(escape(label), justify="right" if spec else "left")
         for row in rows:
             table.add_row(*[_cell(v, c[2]) for v, c in zip(row, columns, strict=True)])
         if out is None:
@@ -504,14 +504,16 @@ def _parameter_sets(kind: str):
         cols = [("name", "name", ""), ("normal_force_range_N", "Q range [N]", ""),
                 ("speed_range_m_s", "v range [m/s]", ""),
                 ("reconstruction", "reconstruction", ""), ("source", "source", "")]  # fmt: skip
+        source = str(prov.get("source", ""))
+        first = source.split(" by ")[0].split(". ")[0]  # the first clause, for the table
         rows = [(
-            f"default ({p.name})" if p.name else "default",
+            p.name or "default",
             f"{p.normal_force_range[0]:g}-{p.normal_force_range[1]:g}",
             f"{p.speed_range[0]:g}-{p.speed_range[1]:g}",
             "yes" if prov.get("reconstruction") else "no",
-            prov.get("source", ""),
+            first + (" (...; railadhesion params check FILE)" if first != source else ""),
         )]  # fmt: skip
-        return "WILAC parameter sets (load your own with --params FILE)", cols, rows
+        return "WILAC parameter sets: the built-in default (yours: --params FILE)", cols, rows
     from railadhesion.models.twod import FLETCHER_CONDITIONS
 
     cols = [("test_code", "code", ""), ("lubricant", "lubricant", ""),
