@@ -59,7 +59,9 @@ def _version(value: bool) -> None:
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     """Print a Python warning as one plain line, without the source location."""
-    console.print(f"[yellow]warning:[/yellow] {escape(str(message))}", highlight=False)
+    console.print(
+        f"[yellow]warning:[/yellow] {escape(str(message))}", highlight=False, soft_wrap=True
+    )
 
 
 @app.callback()
@@ -100,14 +102,14 @@ def _emit(title: str, columns, rows, fmt: str, out: Path | None, note: str = "")
     keys = [c[0] for c in columns]
     if fmt == "table":
         table = Table(title=escape(title))
-        for _, label, _ in columns:
-            table.add_column(escape(label), justify="right")
+        for _, label, spec in columns:
+            table.add_column(escape(label), justify="right" if spec else "left")
         for row in rows:
             table.add_row(*[_cell(v, c[2]) for v, c in zip(row, columns, strict=True)])
         if out is None:
             console.print(table)
             if note:
-                console.print(escape(note), highlight=False)
+                console.print(escape(note), highlight=False, soft_wrap=True)
             return
         buffer = Console(file=io.StringIO(), width=200, color_system=None)
         buffer.print(table)
@@ -289,10 +291,9 @@ def polach(
     except ValueError as exc:
         _fail(exc)
     mu = adhesion(fx, fy, normal_force)
-    contact = (
-        f"contact: {geometry_description(geo)}; at Q = {normal_force:g} N: "
-        f"a = {ca * 1e3:.3g} mm, b = {cb * 1e3:.3g} mm"
-    )
+    where = "given semi-axes" if a is not None else geometry_description(geo)
+    contact = f"contact: {where}\nHertz at Q = {normal_force:g} N: a = {ca * 1e3:.3g} mm, " \
+        f"b = {cb * 1e3:.3g} mm"
     title = f"Polach '{params.name}' at Q = {normal_force:g} N, V = {speed:g} m/s"
     table_out = out is not None and (
         fmt != "table" or out.suffix.lower() in (".csv", ".json")
@@ -503,14 +504,16 @@ def _parameter_sets(kind: str):
         cols = [("name", "name", ""), ("normal_force_range_N", "Q range [N]", ""),
                 ("speed_range_m_s", "v range [m/s]", ""),
                 ("reconstruction", "reconstruction", ""), ("source", "source", "")]  # fmt: skip
+        source = str(prov.get("source", ""))
+        first = source.split(" by ")[0].split(". ")[0]  # the first clause, for the table
         rows = [(
-            f"default ({p.name})" if p.name else "default",
+            p.name or "default",
             f"{p.normal_force_range[0]:g}-{p.normal_force_range[1]:g}",
             f"{p.speed_range[0]:g}-{p.speed_range[1]:g}",
             "yes" if prov.get("reconstruction") else "no",
-            prov.get("source", ""),
+            first + (" (...; railadhesion params check FILE)" if first != source else ""),
         )]  # fmt: skip
-        return "WILAC parameter sets (load your own with --params FILE)", cols, rows
+        return "WILAC parameter sets: the built-in default (yours: --params FILE)", cols, rows
     from railadhesion.models.twod import FLETCHER_CONDITIONS
 
     cols = [("test_code", "code", ""), ("lubricant", "lubricant", ""),
@@ -602,7 +605,7 @@ def fit_polach_cmd(
         _fail(f"{csv_file}: {exc}")
     held = [n for n in POLACH_NAMES if n not in result.fitted]
     if fmt == "table" and table is None:
-        console.print(str(result), highlight=False, markup=False)
+        console.print(str(result), highlight=False, markup=False, soft_wrap=True)
     else:
         _emit(
             f"Polach fit to {csv_file.name}",
@@ -704,7 +707,7 @@ def fit_wilac_cmd(
     except OSError as exc:  # the output file cannot be written
         _fail(f"cannot write the parameter file {out}: {exc}")
     if fmt == "table" and table is None:
-        console.print(calibration.summary(), highlight=False, markup=False)
+        console.print(calibration.summary(), highlight=False, markup=False, soft_wrap=True)
     else:
         rows = calibration.curve_table()
         keys = list(rows[0]) if rows else []

@@ -116,6 +116,6 @@ def geometry_description(geometry) -> str:
         flat = [k.replace("_", " ") for k, v in NAMED_GEOMETRIES[geometry].items()
                 if not math.isfinite(v)]  # fmt: skip
         text = f"{geometry}: {', '.join(radii)}"
-        return text + (f" ({', '.join(flat)} infinite)" if flat else "")
+        return text + (f"; {', '.join(flat)} infinite" if flat else "")
     a, b = (float(x) for x in geometry)
     return f"semi-axes a = {a:g} m, b = {b:g} m"

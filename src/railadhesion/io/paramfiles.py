@@ -32,7 +32,10 @@ from typing import TYPE_CHECKING, Any
 import tomli_w
 
 from railadhesion.models.regression import ParameterRegression, canonical_term
-from railadhesion.models.wilac import (
+
+# The parameter classes, not the model: models.wilac loads its default file through this
+# module, so importing models.wilac here would make an import circle.
+from railadhesion.models.wilac_parameters import (
     POLACH_PARAMETER_NAMES,
     PROVENANCE_FIELDS,
     WILAC_CONDITIONS,
