@@ -383,3 +383,8 @@ def fit_wilac_cmd(
 
 if __name__ == "__main__":  # pragma: no cover
     app()
+
+
+from railadhesion.cli_braking import register as _register_braking  # noqa: E402
+
+_register_braking(app)
