@@ -385,6 +385,10 @@ if __name__ == "__main__":  # pragma: no cover
     app()
 
 
+from railadhesion.cli_braking import register as _register_braking  # noqa: E402
+
+_register_braking(app)
+
 from railadhesion import cli_sweeps  # noqa: E402
 
 cli_sweeps.register(app)

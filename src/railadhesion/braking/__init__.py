@@ -1,0 +1,50 @@
+"""Braking under low adhesion: vehicle model, brake cylinders, WSP, simulation, logs.
+
+See ``docs/braking.md``. Sign convention as everywhere in railadhesion (docs/CONVENTIONS.md):
+creepage ξ = (V − ωR)/V, braking positive. Axle 1 is the leading axle.
+"""
+
+from railadhesion.braking._fields import BrakingFileError
+from railadhesion.braking.adhesion import (
+    AdhesionRecovery,
+    AxleAdhesion,
+    CallableAdhesion,
+    ContactGeometry,
+    PolachAdhesion,
+    WaterFlowProfile,
+    WilacAdhesion,
+)
+from railadhesion.braking.cylinders import APPLY, HOLD, VENT, BrakeCylinders
+from railadhesion.braking.log import braking_log_frame, write_braking_log
+from railadhesion.braking.run import BrakeDemand, BrakingResult, simulate
+from railadhesion.braking.simulator import BrakingSimulator, BrakingState, SimulationError
+from railadhesion.braking.vehicle import GRAVITY, Vehicle, load_vehicle
+from railadhesion.braking.wsp import WheelSlideProtection, WSPSettings
+
+__all__ = [
+    "APPLY",
+    "HOLD",
+    "VENT",
+    "GRAVITY",
+    "AdhesionRecovery",
+    "AxleAdhesion",
+    "BrakeCylinders",
+    "BrakeDemand",
+    "BrakingFileError",
+    "BrakingResult",
+    "BrakingSimulator",
+    "BrakingState",
+    "CallableAdhesion",
+    "ContactGeometry",
+    "PolachAdhesion",
+    "SimulationError",
+    "WSPSettings",
+    "WaterFlowProfile",
+    "WheelSlideProtection",
+    "WilacAdhesion",
+    "simulate",
+    "Vehicle",
+    "braking_log_frame",
+    "load_vehicle",
+    "write_braking_log",
+]

@@ -1,0 +1,430 @@
+"""Adhesion seen by each axle of a braking vehicle, from any model of the library.
+
+The simulator needs, for each axle i, the adhesion coefficient ``μ_i(ξ_i)`` (creep force of the
+rail on the wheelset, retarding, divided by the wheelset's normal load; braking creepage
+ξ = (V − ωR)/V > 0 gives μ > 0) and its slope ``dμ/dξ`` for the implicit wheel update. The
+slope is analytic for the Polach family, a central difference for user callables.
+
+An adhesion model is an object with two methods (:class:`AxleAdhesion`):
+
+``prepare(speed, normal_loads, positions, time, dissipation)``
+    Called at the start of a step (or every ``refresh_period``): fix the slowly varying inputs
+    — train speed [m/s], wheel normal loads [N] per axle (one wheel: half the wheelset load),
+    axle positions along the track [m], time [s] and, for the adhesion-recovery model, the
+    frictional energy per metre [J/m] dissipated by the axles ahead of each axle.
+``evaluate(creep, speed) -> (mu, dmu_dcreep)``
+    Arrays over axles. Must be odd in the creepage (μ(−ξ) = −μ(ξ)).
+
+Shipped models:
+
+* :class:`PolachAdhesion` — a named Polach set (e.g. ``"polach2005_dry"``) or any
+  :class:`~railadhesion.models.parameters.PolachParameters`, optionally other sets on track
+  sections.
+* :class:`WilacAdhesion` — WILAC (Trummer et al. 2017) with a water flow rate [µl/s] profile
+  over distance or time (:class:`WaterFlowProfile`), optional adhesion recovery along the
+  train.
+* :class:`CallableAdhesion` — a user function ``mu(creep, speed)`` (e.g. a Fletcher-type
+  2D curve or a measured table).
+
+Polach-family curves (pure longitudinal creep, no spin, no lateral creep) are the closed form
+of :func:`railadhesion.models.polach.polach_forces` (Polach 2005, section 2): with s = |ξ|,
+``μ_k = μ0 [(1 − A) exp(−B s V) + A]``, ``ε = (π/4) G a b C11 s / (Q μ_k)`` and
+``μ = (2/π) μ_k [k_A ε/(1 + (k_A ε)²) + arctan(k_S ε)]``; WILAC blends four such sets with the
+weights of Trummer et al. section 5.3. Tests check it against the library functions.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from railadhesion.contact import hertz_3d, kalker_coefficients
+from railadhesion.models.parameters import PolachParameters, polach_parameters
+from railadhesion.models.wilac import (
+    WILAC_CONDITIONS,
+    WilacParameters,
+    default_wilac_parameters,
+    wilac_weights,
+)
+
+__all__ = [
+    "AxleAdhesion",
+    "PolachAdhesion",
+    "WilacAdhesion",
+    "CallableAdhesion",
+    "WaterFlowProfile",
+    "AdhesionRecovery",
+    "ContactGeometry",
+    "polach_family_curve",
+]
+
+_TWO_OVER_PI = 2.0 / math.pi
+
+
+class ContactGeometry:
+    """Wheel–rail contact of one wheel: Hertz semi-axes scaled with the load.
+
+    Semi-axes are computed once with :func:`railadhesion.hertz_3d` at ``reference_load`` and
+    scaled as ``(Q/Q_ref)^(1/3)`` (exact for Hertz: a/b does not change with the load).
+
+    Parameters
+    ----------
+    wheel_radius : float
+        Rolling radius [m].
+    rail_lateral_radius : float
+        Rail-head crown radius [m] (default 0.3 m, UIC60-like head: an assumption).
+    wheel_lateral_radius : float
+        Tread lateral radius [m] (default inf: conical tread).
+    shear_modulus, poisson : float
+        Combined G [Pa] and ν [-] (steel: 82 GPa, 0.28).
+    """
+
+    def __init__(self, wheel_radius=0.46, rail_lateral_radius=0.3,
+                 wheel_lateral_radius=math.inf, shear_modulus=8.2e10, poisson=0.28,
+                 reference_load=50e3):
+        self.shear_modulus = float(shear_modulus)
+        self.poisson = float(poisson)
+        self.reference_load = float(reference_load)
+        h = hertz_3d(reference_load, wheel_radius, wheel_lateral_radius, rail_lateral_radius)
+        self.a0, self.b0 = float(h.a), float(h.b)
+        c11 = float(kalker_coefficients(self.a0 / self.b0, self.poisson)[0])
+        self.c11 = c11
+        # (π/4) G a b C11 at the reference load [N per unit creepage]
+        self._k0 = math.pi / 4.0 * self.shear_modulus * self.a0 * self.b0 * c11
+
+    def semi_axes(self, load):
+        s = (np.asarray(load, float) / self.reference_load) ** (1.0 / 3.0)
+        return self.a0 * s, self.b0 * s
+
+    def stiffness_over_load(self, load):
+        """(π/4) G a b C11 / Q [-] per unit creepage, at wheel load Q [N]."""
+        q = np.asarray(load, float)
+        return self._k0 * (q / self.reference_load) ** (2.0 / 3.0) / q
+
+
+def polach_family_curve(creep, speed, weights, params, stiffness):
+    """μ(ξ) and dμ/dξ of a weighted sum of Polach sets (pure longitudinal creepage).
+
+    Parameters
+    ----------
+    creep : ndarray (n,)
+        Braking creepage ξ per axle [-].
+    speed : float
+        Rolling speed V [m/s].
+    weights : ndarray (n, K)
+        Weight of each set per axle (sum 1).
+    params : ndarray (n, K, 5)
+        k_A, k_S, mu0, A, B per axle and set.
+    stiffness : ndarray (n,)
+        (π/4) G a b C11 / Q per axle [-].
+
+    Returns
+    -------
+    mu, dmu : ndarray (n,)
+        Adhesion coefficient (retarding, sign of ξ) and its slope with respect to ξ.
+    """
+    xi = np.asarray(creep, float)
+    s = np.abs(xi)[:, None]
+    k_a, k_s, mu0, big_a, big_b = (params[..., j] for j in range(5))
+    e = np.exp(-big_b * s * speed)
+    mu_k = mu0 * ((1.0 - big_a) * e + big_a)
+    dmu_k = -mu0 * (1.0 - big_a) * big_b * speed * e
+    st = stiffness[:, None]
+    eps = np.minimum(st * s / mu_k, 1e50)
+    deps = st / mu_k - st * s * dmu_k / mu_k**2
+    x = k_a * eps
+    y = k_s * eps
+    bracket = x / (1.0 + x * x) + np.arctan(y)
+    dbracket = (k_a * (1.0 - x * x) / (1.0 + x * x) ** 2 + k_s / (1.0 + y * y)) * deps
+    f = _TWO_OVER_PI * mu_k * bracket
+    df = _TWO_OVER_PI * (dmu_k * bracket + mu_k * dbracket)
+    mu = np.sum(weights * f, axis=1)
+    dmu = np.sum(weights * df, axis=1)
+    return np.sign(xi) * mu, dmu
+
+
+def _peak(curve, speed, n):
+    """Largest μ over 64 log-spaced creepages (0.01 % … 100 %): the adhesion available."""
+    grid = np.geomspace(1e-4, 1.0, 64)
+    mu, _ = curve(np.repeat(grid, n), speed)
+    return np.max(np.asarray(mu).reshape(grid.size, n), axis=0)
+
+
+class AxleAdhesion:
+    """Base class of the axle adhesion models (see the module docstring for the interface)."""
+
+    #: name used in results and messages
+    name = "adhesion"
+    n_axles = 0
+
+    def bind(self, n_axles: int, wheel_radius: float) -> None:
+        """Called once by the simulator before the first step."""
+        self.n_axles = int(n_axles)
+
+    def prepare(self, speed, normal_loads, positions, time, dissipation=None) -> None:
+        raise NotImplementedError
+
+    def evaluate(self, creep, speed):
+        raise NotImplementedError
+
+    def available(self, speed) -> np.ndarray:
+        """Peak adhesion coefficient available to each axle at the prepared conditions."""
+        return _peak(self.evaluate, speed, self.n_axles)
+
+    def describe(self) -> dict:
+        return {"model": self.name}
+
+
+class WaterFlowProfile:
+    """Water flow rate w [µl/s] along the track (``over="distance"``, x in m) or in time (s).
+
+    ``kind="linear"`` interpolates the table linearly (held constant beyond its ends);
+    ``kind="step"``: value[k] holds on [x[k], x[k+1]). Build section profiles with
+    :meth:`sections`.
+    """
+
+    def __init__(self, x, values, over: str = "distance", kind: str = "linear"):
+        if over not in ("distance", "time"):
+            raise ValueError(f"over must be 'distance' or 'time', got {over!r}")
+        if kind not in ("linear", "step"):
+            raise ValueError(f"kind must be 'linear' or 'step', got {kind!r}")
+        x = np.asarray(x, float)
+        values = np.asarray(values, float)
+        if x.ndim != 1 or x.size < 1 or x.shape != values.shape:
+            raise ValueError("x and values must be 1-D arrays of the same length >= 1")
+        if not (np.all(np.isfinite(x)) and np.all(np.diff(x) >= 0)):
+            raise ValueError("x must be finite and non-decreasing")
+        if not np.all(np.isfinite(values) & (values >= 0)):
+            raise ValueError("water flow values must be in [0, inf) µl/s")
+        self.x, self.values, self.over, self.kind = x, values, over, kind
+
+    @classmethod
+    def constant(cls, water_flow: float) -> WaterFlowProfile:
+        return cls([0.0], [float(water_flow)], "distance", "step")
+
+    @classmethod
+    def sections(cls, sections: Sequence[tuple[float, float, float]], base: float = 0.0,
+                 over: str = "distance") -> WaterFlowProfile:
+        """Piecewise-constant profile: ``base`` outside, ``w`` on each ``(start, end, w)``."""
+        edges = []
+        for start, end, w in sorted(sections):
+            if not end > start:
+                raise ValueError(f"section end must be > start, got ({start}, {end})")
+            edges.append((start, end, w))
+        x, v = [-1e12], [base]
+        for start, end, w in edges:
+            if start < x[-1]:
+                raise ValueError(f"sections overlap at {start}")
+            x += [start, end]
+            v += [w, base]
+        return cls(x, v, over, "step")
+
+    def __call__(self, position, time):
+        q = np.asarray(position if self.over == "distance" else time, float)
+        if self.kind == "linear":
+            return np.interp(q, self.x, self.values)
+        idx = np.searchsorted(self.x, q, side="right") - 1
+        return self.values[np.clip(idx, 0, self.values.size - 1)] * (idx >= 0) + (
+            self.values[0] * (idx < 0)
+        )
+
+
+class AdhesionRecovery:
+    """Adhesion recovery along the train (an assumption of railadhesion, not from a paper).
+
+    The frictional energy per metre of rail that the axles ahead dissipate,
+    ``E_i = Σ_{j<i} T_j ξ_j`` [J/m] (power T_j ΔV_j divided by V), is assumed to dry the rail
+    for the axles behind: axle i sees the water flow ``w exp(−E_i / energy_scale)``. The delay
+    between axles (their spacing over the speed, a fraction of a second) is neglected. The
+    exponential law and the default scale (5 kJ/m, about one sliding wheelset) are
+    assumptions chosen to give the qualitative effect reported by braking trials (later
+    axles brake better); they are not calibrated. Only models with a water flow (WILAC) use it.
+    """
+
+    def __init__(self, energy_scale: float = 5e3):
+        if not (math.isfinite(energy_scale) and energy_scale > 0):
+            raise ValueError(f"energy_scale must be in (0, inf) J/m, got {energy_scale!r}")
+        self.energy_scale = float(energy_scale)
+
+    def factor(self, dissipation):
+        return np.exp(-np.asarray(dissipation, float) / self.energy_scale)
+
+
+class _PolachFamily(AxleAdhesion):
+    """Shared machinery: a (n, K) weight table and (n, K, 5) parameter table."""
+
+    def __init__(self, contact: ContactGeometry | None = None):
+        self.contact = contact
+        self.weights = None
+        self.params = None
+        self.stiffness = None
+
+    def bind(self, n_axles, wheel_radius):
+        super().bind(n_axles, wheel_radius)
+        if self.contact is None:
+            self.contact = ContactGeometry(wheel_radius=wheel_radius)
+
+    def evaluate(self, creep, speed):
+        from railadhesion.braking._kernels import family_evaluate
+
+        return family_evaluate(np.asarray(creep, float), float(speed), self.weights,
+                               np.ascontiguousarray(self.params), self.stiffness)
+
+    def available(self, speed):
+        from railadhesion.braking._kernels import family_peak
+
+        return family_peak(float(speed), self.weights, np.ascontiguousarray(self.params),
+                           self.stiffness)
+
+
+def _as_polach(p) -> PolachParameters:
+    if isinstance(p, PolachParameters):
+        return p
+    if isinstance(p, str):
+        return polach_parameters(p)
+    raise ValueError(f"expected a Polach set name or PolachParameters, got {p!r}")
+
+
+class PolachAdhesion(_PolachFamily):
+    """Polach's model (2005) with a named set, optionally other sets on track sections.
+
+    Parameters
+    ----------
+    parameters : str or PolachParameters
+        The set used on the whole track (e.g. ``"polach2005_dry"``).
+    sections : sequence of (start_m, end_m, str or PolachParameters), optional
+        Track sections [m] where another set applies (e.g. ``"polach2005_wet"``).
+    contact : ContactGeometry, optional
+        Contact geometry (default: Hertz for the vehicle's wheel radius on a 0.3 m rail crown).
+    """
+
+    name = "polach"
+
+    def __init__(self, parameters="polach2005_dry", sections=(), contact=None):
+        super().__init__(contact)
+        base = _as_polach(parameters)
+        self.sets = [base]
+        self.section_list = []
+        for start, end, p in sections:
+            p = _as_polach(p)
+            if p not in self.sets:
+                self.sets.append(p)
+            self.section_list.append((float(start), float(end), self.sets.index(p)))
+        self._table = np.array([[s.k_A, s.k_S, s.mu0, s.A, s.B] for s in self.sets])
+
+    def prepare(self, speed, normal_loads, positions, time, dissipation=None):
+        n = self.n_axles
+        k = np.zeros(n, dtype=int)
+        pos = np.asarray(positions, float)
+        for start, end, idx in self.section_list:
+            k[(pos >= start) & (pos < end)] = idx
+        w = np.zeros((n, len(self.sets)))
+        w[np.arange(n), k] = 1.0
+        self.weights = w
+        self.params = np.broadcast_to(self._table, (n, *self._table.shape))
+        self.stiffness = self.contact.stiffness_over_load(normal_loads)
+
+    def describe(self):
+        return {"model": "polach", "sets": [s.name for s in self.sets],
+                "sections_m": [(s, e, self.sets[i].name) for s, e, i in self.section_list]}
+
+
+class WilacAdhesion(_PolachFamily):
+    """WILAC (Trummer et al. 2017) with a water flow rate profile, per axle.
+
+    Parameters
+    ----------
+    water_flow : float or WaterFlowProfile or callable
+        Water flow rate [µl/s]: a constant, a profile over distance or time, or a function
+        ``w(position_m, time_s)`` vectorised over positions.
+    parameters : WilacParameters, optional
+        Default: :func:`railadhesion.default_wilac_parameters` (a documented reconstruction).
+    recovery : AdhesionRecovery, optional
+        Adhesion recovery along the train (off by default).
+    """
+
+    name = "wilac"
+
+    def __init__(self, water_flow=0.0, parameters: WilacParameters | None = None,
+                 recovery: AdhesionRecovery | None = None, contact=None):
+        super().__init__(contact)
+        if isinstance(water_flow, int | float):
+            water_flow = WaterFlowProfile.constant(float(water_flow))
+        if not callable(water_flow):
+            raise ValueError("water_flow must be a number, a WaterFlowProfile or a callable")
+        self.water_flow = water_flow
+        self.parameters = parameters if parameters is not None else default_wilac_parameters()
+        self.recovery = recovery
+        self.current_water_flow = None
+
+    def prepare(self, speed, normal_loads, positions, time, dissipation=None):
+        w = np.broadcast_to(np.asarray(self.water_flow(positions, time), float),
+                            (self.n_axles,)).copy()
+        if self.recovery is not None and dissipation is not None:
+            w = w * self.recovery.factor(dissipation)
+        self.current_water_flow = w
+        self.weights = wilac_weights(w, self.parameters.transitions).T
+        q = np.asarray(normal_loads, float)
+        v = max(float(speed), 0.0)
+        table = np.empty((self.n_axles, len(WILAC_CONDITIONS), 5))
+        for k, cond in enumerate(WILAC_CONDITIONS):
+            p = self.parameters.polach_parameters(cond, q, v)
+            for j, key in enumerate(("k_A", "k_S", "mu0", "A", "B")):
+                table[:, k, j] = p[key]
+        self.params = table
+        self.stiffness = self.contact.stiffness_over_load(q)
+
+    def describe(self):
+        return {"model": "wilac", "parameters": self.parameters.name,
+                "recovery": None if self.recovery is None else self.recovery.energy_scale}
+
+
+class CallableAdhesion(AxleAdhesion):
+    """A user adhesion law ``mu(creep, speed)``: arrays over axles in, μ ≥ 0 for ξ > 0 out.
+
+    The function receives the braking creepage of every axle (ndarray, shape (n,)) and the
+    train speed [m/s] (float); it returns the adhesion coefficient (creep force over normal
+    load) per axle. It is made odd in ξ here (μ(−ξ) = −μ(ξ)). With ``needs_load=True`` it is
+    called as ``mu(creep, speed, normal_load)`` (wheel load [N] per axle). The slope is a
+    central difference with step ``h``. Non-finite values stop the simulation with an error
+    naming the time and the axle.
+    """
+
+    name = "callable"
+
+    def __init__(self, function: Callable, needs_load: bool = False, h: float = 1e-6,
+                 label: str = "user function"):
+        if not callable(function):
+            raise ValueError(f"function must be callable, got {function!r}")
+        self.function = function
+        self.needs_load = needs_load
+        self.h = float(h)
+        self.label = label
+        self.loads = None
+
+    def prepare(self, speed, normal_loads, positions, time, dissipation=None):
+        self.loads = np.asarray(normal_loads, float)
+
+    def _mu(self, creep, speed):
+        s = np.abs(creep)
+        if self.needs_load:
+            out = self.function(s, speed, np.resize(self.loads, s.size))
+        else:
+            out = self.function(s, speed)
+        return np.broadcast_to(np.asarray(out, float), s.shape)
+
+    def evaluate(self, creep, speed):
+        xi = np.asarray(creep, float)
+        s = np.abs(xi)
+        h = self.h
+        lo = np.maximum(s - h, 0.0)
+        both = self._mu(np.concatenate([s, lo, s + h]), speed)
+        n = s.size
+        mu, mlo, mhi = both[:n], both[n:2 * n], both[2 * n:]
+        dmu = (mhi - mlo) / (s + h - lo)
+        return np.sign(xi) * mu, dmu
+
+    def describe(self):
+        return {"model": "callable", "function": self.label}

@@ -1,0 +1,273 @@
+"""Whole-stop simulation: :func:`simulate` and its result object :class:`BrakingResult`."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from railadhesion.braking.adhesion import AxleAdhesion
+from railadhesion.braking.cylinders import ATMOSPHERIC_PRESSURE, BrakeCylinders
+from railadhesion.braking.simulator import BrakingSimulator
+from railadhesion.braking.vehicle import Vehicle
+from railadhesion.braking.wsp import WheelSlideProtection, as_controller
+
+__all__ = ["BrakeDemand", "BrakingResult", "simulate", "LOCK_CREEP", "summarise"]
+
+#: An axle counts as locked while its creepage is at least this (wheel below 5 % of v).
+LOCK_CREEP = 0.95
+
+
+@dataclass(frozen=True)
+class BrakeDemand:
+    """Commanded brake-cylinder pressure over time: 0 before ``start_time``, then a linear
+    ramp over ``ramp_time`` [s] up to ``pressure`` [Pa] (a step when ``ramp_time`` is 0)."""
+
+    pressure: float = 3.0e5
+    start_time: float = 0.0
+    ramp_time: float = 0.0
+
+    def __post_init__(self):
+        for name in ("pressure", "start_time", "ramp_time"):
+            x = getattr(self, name)
+            if not (isinstance(x, int | float) and math.isfinite(x) and x >= 0):
+                raise ValueError(f"{name} must be a finite number >= 0, got {x!r}")
+
+    def __call__(self, time: float) -> float:
+        if time < self.start_time:
+            return 0.0
+        if self.ramp_time <= 0:
+            return self.pressure
+        return self.pressure * min(1.0, (time - self.start_time) / self.ramp_time)
+
+
+@dataclass
+class BrakingResult:
+    """Result of :func:`simulate`, shaped like SciPy's ``OdeResult``.
+
+    Attributes
+    ----------
+    histories : pandas.DataFrame
+        One row per step (and t = 0): time [s], distance [m], train_speed [m/s],
+        deceleration [m/s²], per axle i = 1 … n: wheel_speed_i [rad/s], brake_pressure_i
+        [Pa], valve_i (0 apply, 1 hold, 2 vent), creep_i [-], creep_force_i [N] (retarding),
+        normal_load_i [N] (wheelset), adhesion_used_i and adhesion_available_i [-];
+        pressure_command [Pa], kinetic_energy, brake_work, creep_work, resistance_work [J].
+    status : int
+        0: the train stopped; 1: ``max_time`` reached first.
+    message : str
+    success : bool
+    summary : dict
+        Stopping distance and time, per-axle maximum slip and longest lock, adhesion
+        utilisation, air consumption, energy balance (see :func:`summarise`).
+    settings : dict
+        What was simulated (vehicle, adhesion model, step, WSP).
+    """
+
+    histories: pd.DataFrame
+    status: int
+    message: str
+    summary: dict
+    settings: dict = field(default_factory=dict)
+
+    @property
+    def success(self) -> bool:
+        return self.status == 0
+
+    @property
+    def t(self) -> np.ndarray:
+        return self.histories["time"].to_numpy()
+
+    @property
+    def stopping_distance(self) -> float:
+        return self.summary["stopping_distance_m"]
+
+    @property
+    def stopping_time(self) -> float:
+        return self.summary["stopping_time_s"]
+
+    def to_xarray(self):
+        """Histories as an xarray Dataset indexed by time, per-axle channels on an ``axle`` dim."""
+        import xarray as xr
+
+        h = self.histories
+        n = self.settings.get("n_axles", sum(c.startswith("wheel_speed_") for c in h.columns))
+        data = {}
+        per_axle = {c.rsplit("_", 1)[0] for c in h.columns if c.endswith(f"_{n}")
+                    and c.rsplit("_", 1)[0] + "_1" in h.columns}
+        for name in sorted(per_axle):
+            data[name] = (("time", "axle"), h[[f"{name}_{i}" for i in range(1, n + 1)]].to_numpy())
+        for c in h.columns:
+            if c != "time" and c.rsplit("_", 1)[0] not in per_axle:
+                data[c] = ("time", h[c].to_numpy())
+        return xr.Dataset(data, coords={"time": h["time"].to_numpy(),
+                                        "axle": np.arange(1, n + 1)},
+                          attrs={"status": self.status, "message": self.message})
+
+    def compare_dry(self, dry: BrakingResult) -> None:
+        """Add the extension of the stop against ``dry`` (same stop on a dry rail) to summary."""
+        d, d0 = self.stopping_distance, dry.stopping_distance
+        self.summary["dry_stopping_distance_m"] = d0
+        self.summary["dry_stopping_time_s"] = dry.stopping_time
+        self.summary["extension_m"] = d - d0
+        self.summary["extension_percent"] = 100.0 * (d - d0) / d0
+
+    def __repr__(self) -> str:
+        s = self.summary
+        return (f"BrakingResult(status={self.status}, message={self.message!r}, "
+                f"stopping_distance={s.get('stopping_distance_m'):.6g} m, "
+                f"stopping_time={s.get('stopping_time_s'):.6g} s, rows={len(self.histories)})")
+
+
+def _longest_run(mask: np.ndarray, dt: np.ndarray) -> float:
+    best = cur = 0.0
+    for m, d in zip(mask, dt, strict=True):
+        cur = cur + d if m else 0.0
+        best = max(best, cur)
+    return best
+
+
+def summarise(sim: BrakingSimulator, h: pd.DataFrame) -> dict:
+    """Summary numbers of a finished run (see :class:`BrakingResult`)."""
+    veh = sim.vehicle
+    n = veh.n_axles
+    dt = np.diff(h["time"].to_numpy(), prepend=0.0)
+    moving = h["train_speed"].to_numpy() > sim.stop_speed
+    braking = (h["pressure_command"].to_numpy() > 0) & moving
+    axles = []
+    used_sum = np.zeros(len(h))
+    avail_sum = np.zeros(len(h))
+    for i in range(1, n + 1):
+        creep = h[f"creep_{i}"].to_numpy()
+        used = h[f"adhesion_used_{i}"].to_numpy()
+        avail = h[f"adhesion_available_{i}"].to_numpy()
+        load = h[f"normal_load_{i}"].to_numpy()
+        ok = braking & np.isfinite(avail) & (avail > 0)
+        util = float(np.sum((used / np.where(ok, avail, 1.0) * dt)[ok]) / np.sum(dt[ok])) \
+            if np.any(ok) else math.nan
+        used_sum += np.where(ok, used * load, 0.0)
+        avail_sum += np.where(ok, avail * load, 0.0)
+        axles.append({
+            "axle": i,
+            "max_slip": float(np.max(creep)),
+            "longest_lock_s": _longest_run((creep >= LOCK_CREEP) & moving, dt),
+            "total_lock_s": float(np.sum(dt[(creep >= LOCK_CREEP) & moving])),
+            "mean_adhesion_utilisation": util,
+            "vent_actions": int(sim.vent_actions[i - 1]),
+            "vented_air_l": float(sim.vented_pressure[i - 1] * sim.cylinders.cylinder_volume
+                                  / ATMOSPHERIC_PRESSURE * 1e3),
+        })
+    ok = avail_sum > 0
+    total_util = float(np.sum((used_sum[ok] / avail_sum[ok]) * dt[ok]) / np.sum(dt[ok])) \
+        if np.any(ok) else math.nan
+    ke0 = float(h["kinetic_energy"].iloc[0])
+    ke1 = sim.kinetic_energy
+    work = sim.brake_work + sim.creep_work + sim.resistance_work + sim.gradient_work
+    return {
+        "stopped": bool(sim.stopped),
+        "stopping_distance_m": float(sim.stop_distance),
+        "stopping_time_s": float(sim.stop_time),
+        "initial_speed_m_s": sim.initial_speed,
+        "mean_deceleration_m_s2": sim.initial_speed / sim.stop_time if sim.stopped else math.nan,
+        "mean_adhesion_utilisation": total_util,
+        "max_slip": max(a["max_slip"] for a in axles),
+        "longest_lock_s": max(a["longest_lock_s"] for a in axles),
+        "vent_actions": int(np.sum(sim.vent_actions)),
+        "vented_air_l": float(sum(a["vented_air_l"] for a in axles)),
+        "axles": axles,
+        "energy": {
+            "kinetic_energy_lost_J": ke0 - ke1,
+            "brake_work_J": sim.brake_work,
+            "creep_work_J": sim.creep_work,
+            "resistance_and_gradient_work_J": sim.resistance_work + sim.gradient_work,
+            "balance_error": (ke0 - ke1 - work) / (ke0 - ke1) if ke0 > ke1 else math.nan,
+        },
+    }
+
+
+def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
+             brake=3.0e5, *, cylinders: BrakeCylinders | None = None, wsp=None,
+             control_period: float | None = None, dt: float = 1e-3, max_time: float = 600.0,
+             gradient: float = 0.0, refresh_period: float = 0.01, stop_speed: float = 0.05,
+             progress: Callable[[float], None] | None = None) -> BrakingResult:
+    """Simulate a stop from ``initial_speed`` [m/s] to standstill (or ``max_time`` [s]).
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+    adhesion : AxleAdhesion
+        E.g. ``PolachAdhesion("polach2005_wet")`` or ``WilacAdhesion(profile)``.
+    initial_speed : float
+        [m/s].
+    brake : float or callable
+        Commanded brake-cylinder pressure [Pa]: a constant applied at t = 0, a
+        :class:`BrakeDemand`, or a function of time.
+    cylinders : BrakeCylinders, optional
+    wsp : None, True, WheelSlideProtection, or controller
+        ``None``: no WSP (valves always apply); ``True``: the default
+        :class:`~railadhesion.braking.wsp.WheelSlideProtection`; otherwise a controller
+        (see :mod:`railadhesion.braking.wsp` for the interface).
+    control_period : float, optional
+        Period of a plain-function controller [s] (objects carry their own ``period``).
+    dt : float
+        Simulation step [s]; the control period must be a whole multiple of it.
+    progress : callable, optional
+        Called now and then with the fraction of the initial speed lost (0 … 1).
+
+    Returns
+    -------
+    BrakingResult
+    """
+    sim = BrakingSimulator(vehicle, adhesion, initial_speed, cylinders=cylinders,
+                           gradient=gradient, refresh_period=refresh_period,
+                           stop_speed=stop_speed, max_step=dt, record=True)
+    demand = BrakeDemand(float(brake)) if isinstance(brake, int | float) else brake
+    if not callable(demand):
+        raise ValueError(f"brake must be a pressure [Pa] or a function of time, got {brake!r}")
+    if wsp is True:
+        wsp = WheelSlideProtection()
+    controller = as_controller(wsp, control_period)
+    ratio = 1
+    if controller is not None:
+        ratio = int(round(controller.period / dt))
+        if ratio < 1 or abs(ratio * dt - controller.period) > 1e-9 * controller.period:
+            raise ValueError(f"the control period ({controller.period} s) must be a whole "
+                             f"multiple of dt ({dt} s)")
+        controller.reset(vehicle.n_axles, vehicle.wheel_radius)
+    if not (math.isfinite(max_time) and max_time > 0):
+        raise ValueError(f"max_time must be in (0, inf) s, got {max_time!r}")
+    nmax = int(math.ceil(max_time / dt))
+    n = vehicle.n_axles
+    valves = np.zeros(n, dtype=np.int64)
+    report_every = max(1, int(round(1.0 / dt)))
+    for k in range(nmax):
+        t = k * dt
+        cmd = float(demand(t))
+        if not (math.isfinite(cmd) and cmd >= 0):
+            raise ValueError(f"brake demand at t = {t:.6g} s must be in [0, inf) Pa, got {cmd!r}")
+        if controller is not None and k % ratio == 0:
+            out = np.asarray(controller(t, sim.omega.copy(), cmd), dtype=np.int64)
+            valves = sim.cylinders.group_valves(out, n)
+            if np.any((valves < 0) | (valves > 2)):
+                raise ValueError(f"the controller returned valve states {out} at t = {t:.6g} s;"
+                                 " allowed: 0 (apply), 1 (hold), 2 (vent)")
+        sim.pressure_command = cmd
+        sim._run(dt, valves)
+        if progress is not None and k % report_every == 0:
+            progress(1.0 - sim.speed / initial_speed)
+        if sim.stopped:
+            break
+    h = sim.histories()
+    status = 0 if sim.stopped else 1
+    message = ("the train stopped" if sim.stopped
+               else f"max_time = {max_time} s reached before the train stopped")
+    settings = {"n_axles": vehicle.n_axles, "vehicle": vehicle.name, "dt_s": dt,
+                "wheel_radius_m": vehicle.wheel_radius,
+                "adhesion": adhesion.describe(), "wsp": None if controller is None
+                else type(controller).__name__, "initial_speed_m_s": initial_speed}
+    if progress is not None:
+        progress(1.0)
+    return BrakingResult(h, status, message, summarise(sim, h), settings)

@@ -1,0 +1,173 @@
+"""Braking simulator: closed forms, energy balance, lock logic, errors, both code paths."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from railadhesion.braking import (
+    BrakeCylinders,
+    BrakingSimulator,
+    CallableAdhesion,
+    PolachAdhesion,
+    SimulationError,
+    Vehicle,
+    WaterFlowProfile,
+    WilacAdhesion,
+    simulate,
+)
+from railadhesion.braking.adhesion import polach_family_curve
+from railadhesion.models import polach_forces, wilac_forces
+from railadhesion.models.wilac import default_wilac_parameters
+
+VEHICLE = Vehicle(name="test coach")  # no running resistance, level track
+
+
+def ample(creep, speed):
+    """Ample adhesion: a steep, smooth curve saturating at 0.6."""
+    return 0.6 * np.tanh(300.0 * creep)
+
+
+def test_closed_form_step_pressure():
+    # step pressure (instant fill), ample adhesion: d = n c p / (R M_eff) (seed 002 eq. 8)
+    p = 2.5e5
+    cyl = BrakeCylinders(fill_time_constant=1e-9)
+    v0 = 12.0
+    res = simulate(VEHICLE, CallableAdhesion(ample), v0, p, cylinders=cyl, dt=4e-3)
+    d = VEHICLE.n_axles * VEHICLE.brake_coefficient * p / (
+        VEHICLE.wheel_radius * VEHICLE.effective_mass)
+    assert res.success
+    assert res.stopping_distance == pytest.approx(v0**2 / (2 * d), rel=5e-3)
+    assert res.stopping_time == pytest.approx(v0 / d, rel=5e-3)
+
+
+def test_first_order_pressure_build_up_against_independent_integral():
+    p, tau, v0 = 3.0e5, 0.8, 20.0
+    cyl = BrakeCylinders(fill_time_constant=tau)
+    res = simulate(VEHICLE, PolachAdhesion("polach2005_dry"), v0, p, cylinders=cyl, dt=2e-3)
+    k = VEHICLE.n_axles * VEHICLE.brake_coefficient / (
+        VEHICLE.wheel_radius * VEHICLE.effective_mass)
+
+    def speed(t):  # v0 - k ∫ p (1 - exp(-s/tau)) ds
+        return v0 - k * p * (t - tau * (1 - math.exp(-t / tau)))
+
+    t_stop = brentq(speed, 0.0, 100.0)
+    inner = t_stop - tau * (1 - math.exp(-t_stop / tau))
+    dist = v0 * t_stop - k * p * (t_stop**2 / 2 - tau * inner)
+    assert res.stopping_time == pytest.approx(t_stop, rel=5e-3)
+    assert res.stopping_distance == pytest.approx(dist, rel=5e-3)
+
+
+def test_energy_balance_from_histories_damp_with_wsp():
+    profile = WaterFlowProfile.sections([(20.0, 200.0, 25.0)])
+    res = simulate(VEHICLE, WilacAdhesion(profile), 20.0, 5.5e5,
+                   cylinders=BrakeCylinders(max_pressure=6e5), wsp=True, dt=1e-3)
+    h = res.histories
+    n = VEHICLE.n_axles
+    omega = h[[f"wheel_speed_{i}" for i in range(1, n + 1)]].to_numpy()
+    ke = 0.5 * VEHICLE.total_mass * h["train_speed"] ** 2 + 0.5 * VEHICLE.wheelset_inertia * (
+        omega**2).sum(axis=1)
+    lost = ke.iloc[0] - ke.iloc[-1]
+    t = h["time"].to_numpy()
+    pres = h[[f"brake_pressure_{i}" for i in range(1, n + 1)]].to_numpy()
+    force = h[[f"creep_force_{i}" for i in range(1, n + 1)]].to_numpy()
+    slip = h["train_speed"].to_numpy()[:, None] - omega * VEHICLE.wheel_radius
+    brake = np.trapezoid((VEHICLE.brake_coefficient * pres * omega).sum(axis=1), t)
+    creep = np.trapezoid((force * slip).sum(axis=1), t)
+    assert res.summary["vent_actions"] > 0  # WSP was active
+    assert creep > 0.001 * lost  # the creep work matters here
+    assert brake + creep == pytest.approx(lost, rel=5e-3)
+    assert abs(res.summary["energy"]["balance_error"]) < 5e-3
+
+
+def test_python_path_matches_compiled_path():
+    # the same Polach curve through the generic (NumPy) path and the compiled kernel
+    family = PolachAdhesion("polach2005_wet")
+
+    class Wrapped(CallableAdhesion):
+        def prepare(self, speed, normal_loads, positions, time, dissipation=None):
+            family.prepare(speed, normal_loads, positions, time, dissipation)
+
+        def evaluate(self, creep, speed):
+            return polach_family_curve(creep, speed, family.weights, family.params,
+                                       family.stiffness)
+
+        def available(self, speed):
+            return family.available(speed)
+
+    wrapped = Wrapped(lambda c, v: c)
+    family.bind(4, VEHICLE.wheel_radius)
+    kwargs = dict(cylinders=BrakeCylinders(max_pressure=9e5), dt=4e-3)
+    a = simulate(VEHICLE, PolachAdhesion("polach2005_wet"), 8.0, 9e5, **kwargs)
+    b = simulate(VEHICLE, wrapped, 8.0, 9e5, **kwargs)
+    assert a.summary["max_slip"] > 0.9  # axles lock: the hard case
+    assert b.stopping_distance == pytest.approx(a.stopping_distance, rel=1e-9)
+    np.testing.assert_allclose(b.histories["wheel_speed_3"], a.histories["wheel_speed_3"],
+                               atol=1e-7)
+
+
+def test_family_curve_matches_library_models():
+    q = np.array([40e3, 55e3, 60e3, 70e3])
+    xi = np.array([1e-4, 0.01, 0.3, 1.0])
+    pol = PolachAdhesion("polach2005_dry")
+    pol.bind(4, 0.46)
+    pol.prepare(30.0, q, np.zeros(4), 0.0)
+    a, b = pol.contact.semi_axes(q)
+    fx, _ = polach_forces(xi, 0.0, 0.0, q, 30.0, a, b, mu0=0.55, k_A=1.0, k_S=0.4, A=0.4, B=0.6)
+    np.testing.assert_allclose(pol.evaluate(xi, 30.0)[0], -fx / q, rtol=1e-12)
+    wil = WilacAdhesion(25.0)
+    wil.bind(4, 0.46)
+    wil.prepare(30.0, q, np.zeros(4), 0.0)
+    fx, _ = wilac_forces(xi, 0.0, 0.0, q, 30.0, a, b, 25.0, default_wilac_parameters())
+    np.testing.assert_allclose(wil.evaluate(xi, 30.0)[0], -fx / q, rtol=1e-12)
+    mu, dmu = wil.evaluate(xi, 30.0)
+    mu2, _ = wil.evaluate(xi + 1e-7, 30.0)
+    np.testing.assert_allclose(dmu, (mu2 - mu) / 1e-7, rtol=1e-4, atol=1e-6)
+
+
+def test_nan_from_user_callable_names_time_and_axle():
+    def bad(creep, speed):
+        out = 0.4 * np.tanh(100 * creep)
+        if speed < 5.5:
+            out = out.copy()
+            out[2] = np.nan
+        return out
+
+    with pytest.raises(SimulationError, match=r"axle 3 at t = [0-9.]+ s") as info:
+        simulate(VEHICLE, CallableAdhesion(bad), 6.0, 3e5, dt=4e-3)
+    assert "distance" in str(info.value)
+
+
+def test_stepping_api_is_fmi_like_and_deterministic():
+    def run():
+        sim = BrakingSimulator(VEHICLE, PolachAdhesion("polach2005_wet"), 20.0)
+        states = [sim.step(1e-3, {"pressure_command": 3e5, "valves": [0, 0, 2, 2]})
+                  for _ in range(500)]
+        return sim, states
+
+    sim, states = run()
+    _, again = run()
+    assert states[-1].train_speed == again[-1].train_speed
+    # vent valves on axles 3-4: their cylinders stay empty, axles 1-2 fill
+    assert states[-1].brake_pressures[2] == 0.0 and states[-1].brake_pressures[0] > 2e5
+    with pytest.raises(AttributeError, match="parameter"):
+        sim.vehicle = Vehicle()
+    with pytest.raises(ValueError, match="valves"):
+        sim.step(1e-3, {"valves": [0, 5, 0, 0]})
+    with pytest.raises(ValueError, match="unknown input"):
+        sim.step(1e-3, {"pressure": 1.0})
+    # one long step is split into sub-steps no longer than max_step
+    s2 = BrakingSimulator(VEHICLE, PolachAdhesion("polach2005_wet"), 20.0, max_step=1e-3)
+    st = s2.step(0.5, {"pressure_command": 3e5, "valves": [0, 0, 2, 2]})
+    assert st.time == pytest.approx(0.5)
+    assert st.train_speed == pytest.approx(states[-1].train_speed, rel=1e-9)
+
+
+def test_locked_wheel_stays_locked_without_wsp_and_static_brake_holds():
+    # low adhesion at high creep: once locked, R T < c p keeps the wheel at rest
+    res = simulate(VEHICLE, WilacAdhesion(25.0), 15.0, 6e5,
+                   cylinders=BrakeCylinders(max_pressure=6e5), dt=4e-3)
+    h = res.histories
+    assert res.summary["longest_lock_s"] > 0.8 * res.stopping_time
+    assert (h["wheel_speed_1"] >= 0).all()
