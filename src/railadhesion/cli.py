@@ -731,6 +731,10 @@ from railadhesion.cli_identification import register as _register_identification
 _register_identification(app)
 
 
+from railadhesion.cli_braking import register as _register_braking  # noqa: E402
+
+_register_braking(app)
+
 from railadhesion import cli_sweeps  # noqa: E402
 
 cli_sweeps.register(app)

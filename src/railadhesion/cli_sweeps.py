@@ -88,6 +88,71 @@ def sweep(
     console.print(f"map written to {escape(str(out))}")
 
 
+def study(
+    spec: Path = typer.Argument(..., help="Study spec file (TOML; see "
+                                "examples/braking_study.toml)."),
+    out: Path = typer.Option(..., "--out", help="Output folder: study.zarr (resumable), "
+                             "study.csv, extension.png."),
+    scheduler: str | None = typer.Option(
+        None, help="Dask cluster address (tcp://HOST:PORT), or a local scheduler: threads "
+        "(default), processes, synchronous."),
+    overwrite: bool = typer.Option(False, "--overwrite", help="Replace an existing study."),
+) -> None:
+    """Run many braking stops over a scenario design (factorial or Monte Carlo) with Dask.
+
+    Each stop is one task; a re-run with the same spec and --out resumes.
+    """
+    from rich.table import Table
+
+    from railadhesion.sweeps.study import load_study_spec, run_study
+
+    try:
+        study_spec = load_study_spec(spec)
+        plan = study_spec.plan()
+    except ValueError as exc:
+        _fail(exc)
+    dims = " x ".join(f"{d} {n}" for d, n in zip(plan.dims, plan.shape, strict=True))
+    console.print(f"braking study over {escape(dims)} = {plan.size:,} stops", highlight=False)
+    progress = Progress(TextColumn("stops"), BarColumn(), MofNCompleteColumn(),
+                        TimeRemainingColumn(), console=console)  # fmt: skip
+    task = {"id": None}
+
+    def on_start(result):
+        if result.dashboard_link:
+            console.print(f"Dask cluster dashboard: {escape(result.dashboard_link)}")
+        task["id"] = progress.add_task("study", total=result.chunks_computed)
+        progress.start()
+
+    try:
+        result = run_study(study_spec, out, scheduler=scheduler, overwrite=overwrite,
+                           on_start=on_start,
+                           on_chunk=lambda done, total: progress.update(task["id"],
+                                                                        completed=done))
+    except ValueError as exc:
+        progress.stop()
+        _fail(exc)
+    except OSError as exc:
+        progress.stop()
+        _fail(f"cannot write to {out}: {exc}")
+    progress.stop()
+    ds = result.dataset
+    if "water_flow" in ds.dims:
+        ext = ds["extension_percent"].where(ds["error"] == 0)
+        others = [d for d in ext.dims if d != "water_flow"]
+        table = Table(title="Stopping-distance extension against dry [%]")
+        for col in ("w [µl/s]", "median", "min", "max"):
+            table.add_column(escape(col), justify="right")
+        for w in ds["water_flow"].values:
+            e = ext.sel(water_flow=w)
+            table.add_row(f"{w:g}", *(f"{float(f(e, others)):.2f}" for f in (
+                lambda x, d: x.median(d), lambda x, d: x.min(d), lambda x, d: x.max(d))))
+        console.print(table)
+    console.print(f"{result.chunks_computed} chunks computed, {result.chunks_skipped} already "
+                  f"written; failed stops: {result.failed_points}", highlight=False)
+    console.print(f"study written to {escape(str(out))} (study.zarr, study.csv, extension.png)")
+
+
 def register(app: typer.Typer) -> None:
-    """Add the sweep commands to the ``railadhesion`` app."""
+    """Add the sweep and study commands to the ``railadhesion`` app."""
     app.command("sweep")(sweep)
+    app.command("study")(study)

@@ -265,6 +265,7 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
     message = ("the train stopped" if sim.stopped
                else f"max_time = {max_time} s reached before the train stopped")
     settings = {"n_axles": vehicle.n_axles, "vehicle": vehicle.name, "dt_s": dt,
+                "wheel_radius_m": vehicle.wheel_radius,
                 "adhesion": adhesion.describe(), "wsp": None if controller is None
                 else type(controller).__name__, "initial_speed_m_s": initial_speed}
     if progress is not None:

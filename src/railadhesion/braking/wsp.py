@@ -29,7 +29,7 @@ deceleration thresholds, the three valve states and a watchdog.
 
 * Reference speed: ``v_ref = max(max_i ω_i R, v_ref_prev − a_ref · period)``: the fastest
   wheel, but not falling faster than the plausible train deceleration ``a_ref`` (default
-  2 m/s²; it must exceed the deceleration the brakes can give on a good rail, else the
+  2.5 m/s²; it must exceed the deceleration the brakes can give on a good rail, else the
   reference lags the train and fakes slip; too large and a slide of all axles at once is seen
   late).
 * Per axle: slip speed ``s_i = v_ref − ω_i R``; wheel deceleration ``a_i`` from the
@@ -63,7 +63,7 @@ class WSPSettings:
     """Thresholds of :class:`WheelSlideProtection` (SI units; defaults are assumptions)."""
 
     period: float = 5e-3
-    reference_deceleration: float = 2.0
+    reference_deceleration: float = 2.5
     hold_slip_ratio: float = 0.05
     hold_slip_min: float = 0.3
     vent_slip_ratio: float = 0.10

@@ -9,6 +9,8 @@
 * :mod:`~railadhesion.sweeps.derived`: maximum adhesion and its creep, adhesion at a creep,
   the water flow rate of minimum adhesion.
 * :mod:`~railadhesion.sweeps.spec`: TOML spec files (``railadhesion sweep SPEC.toml``).
+* :mod:`~railadhesion.sweeps.study`: braking studies, many stops of the braking simulator over
+  a factorial or Monte Carlo design (``railadhesion study SPEC.toml --out DIR``).
 """
 
 from railadhesion.sweeps.derived import adhesion_at_creep, max_adhesion, min_adhesion_water_flow
@@ -31,8 +33,15 @@ from railadhesion.sweeps.run import (
     sweep_errors,
 )
 from railadhesion.sweeps.spec import SpecError, SweepSpec, load_sweep_spec
+from railadhesion.sweeps.study import (
+    BrakingStudy,
+    load_study_spec,
+    plot_extension_distribution,
+    run_study,
+)
 
 __all__ = [
+    "BrakingStudy",
     "DIMENSIONS",
     "SWEEP_MODELS",
     "FunctionSweep",
@@ -46,12 +55,15 @@ __all__ = [
     "WilacSweep",
     "adhesion_at_creep",
     "full_factorial",
+    "load_study_spec",
     "load_sweep_spec",
     "max_adhesion",
     "min_adhesion_water_flow",
     "monte_carlo",
     "open_sweep",
     "plan_sweep",
+    "plot_extension_distribution",
+    "run_study",
     "run_sweep",
     "sweep_dataset",
     "sweep_errors",

@@ -6,6 +6,7 @@ chunk is a pure function of the plan and its index: recomputing it gives identic
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import itertools
 import json
@@ -74,6 +75,10 @@ class SweepPlan:
     fixed: dict
     chunk_shape: tuple[int, ...]
     along: dict = field(default_factory=dict)
+    #: Threads for the model's compiled kernels within one chunk (numba), or None for
+    #: numba's default. Dask parallelises over chunks, so run_sweep sets 1 under its
+    #: parallel schedulers (no oversubscription). Does not change the values.
+    kernel_threads: int | None = None
 
     @property
     def variables(self) -> dict[str, tuple[str, str, str]]:
@@ -151,6 +156,10 @@ class SweepPlan:
         is bisected until the failing points are isolated, each recorded with its message
         (``[flat index within the chunk, "ExceptionType: message"]``).
         """
+        with _kernel_threads(self.kernel_threads):
+            return self._evaluate_chunk(index)
+
+    def _evaluate_chunk(self, index):
         sl = self.chunk_slices(index)
         block = {d: c[s] for d, c, s in zip(self.dims, self.coords, sl, strict=True)}
         shape = tuple(len(v) for v in block.values())
@@ -218,6 +227,25 @@ class SweepPlan:
             return
         for name, value in zip(self.model.outputs, results, strict=True):
             out[name][target] = np.broadcast_to(value, rshape)
+
+
+@contextlib.contextmanager
+def _kernel_threads(n: int | None):
+    """Limit numba's threads for this thread (numba's setting is thread-local)."""
+    if n is None:
+        yield
+        return
+    try:
+        import numba
+    except ImportError:  # pragma: no cover - numba is a dependency
+        yield
+        return
+    before = numba.get_num_threads()
+    numba.set_num_threads(min(n, numba.config.NUMBA_NUM_THREADS))
+    try:
+        yield
+    finally:
+        numba.set_num_threads(before)
 
 
 def _plain(x):

@@ -16,6 +16,7 @@ and a re-run after an interruption computes only the chunks without a marker.
 
 from __future__ import annotations
 
+import dataclasses
 import datetime
 import json
 import os
@@ -353,7 +354,7 @@ def _run_distributed(plan, path, missing, client, on_chunk):
 
 def run_sweep(model, grid=None, out=None, *, fixed=None, chunks=None, chunk_points=None,
               client=None, scheduler=None, overwrite=False, on_chunk=None, on_start=None,
-              attrs=None) -> SweepResult:  # fmt: skip
+              attrs=None, kernel_threads="auto") -> SweepResult:  # fmt: skip
     """Evaluate a model over a labelled grid with Dask; optionally write the map as computed.
 
     Parameters
@@ -385,6 +386,10 @@ def run_sweep(model, grid=None, out=None, *, fixed=None, chunks=None, chunk_poin
         :class:`SweepResult` so far (chunks to do, dashboard link).
     attrs : mapping, optional
         Extra global attributes (e.g. the spec file's title).
+    kernel_threads : int, None or "auto", optional
+        Threads of the model's compiled (numba) kernels within a chunk. ``"auto"``: 1 under
+        Dask's parallel schedulers and clusters (Dask already runs one chunk per core), numba's
+        default with ``"synchronous"``; ``None``: numba's default.
 
     Returns
     -------
@@ -408,6 +413,9 @@ def run_sweep(model, grid=None, out=None, *, fixed=None, chunks=None, chunk_poin
         plan = plan_sweep(model, grid, fixed=fixed, chunks=chunks, **kwargs)
     client, owned = _client_for(client, scheduler)
     local = None if client is not None else _local_scheduler(scheduler)
+    if kernel_threads == "auto":  # Dask parallelises over chunks: one kernel thread each
+        kernel_threads = None if local in ("synchronous", "sync", "single-threaded") else 1
+    plan = dataclasses.replace(plan, kernel_threads=kernel_threads)
     link = getattr(client, "dashboard_link", None) if client is not None else None
     try:
         if str(out).endswith(".nc") and local == "processes":
