@@ -188,3 +188,43 @@ def advance_family(v0, decel0, dt, omega0, p0, valves, command, static_load, tra
         creep_work += mu[i] * loads[i] * (v - omega[i] * radius) * dt
     return (v, omega, p1, mu, loads, vented, brake_work, creep_work, resistance * v * dt + 0.0,
             0)
+
+
+@njit(cache=True)
+def wilac_table(packed, loads, speed, water, weights, params):
+    """Fill WILAC's blending weights (n, 4) and Polach parameters (n, 4, 5) per axle.
+
+    ``packed`` is :func:`railadhesion.models.kernels.pack_wilac` (layout documented there):
+    the erf transitions of Trummer et al. §5.3 for the weights, and per condition and
+    parameter the regression on Q' = Q/Q_ref, v' = v/v_ref (clamped into the calibrated
+    ranges, clipped to the physical bounds), §5.2.
+    """
+    header = 22
+    nterm = int(packed[header])
+    vn = min(max(speed, packed[4]), packed[5]) / packed[1]
+    for a in range(loads.shape[0]):
+        w = water[a]
+        e1 = 0.5 * (math.erf((w - packed[6]) / packed[7]) + 1.0)
+        e2 = 0.5 * (math.erf((w - packed[8]) / packed[9]) + 1.0)
+        e3 = 0.5 * (math.erf((w - packed[10]) / packed[11]) + 1.0)
+        weights[a, 0] = 1.0 - e1
+        weights[a, 1] = e1 - e2
+        weights[a, 2] = e2 - e3
+        weights[a, 3] = e3
+        qn = min(max(loads[a], packed[2]), packed[3]) / packed[0]
+        fac = (qn, vn, 1.0 / qn, 1.0 / vn, math.exp(qn), math.exp(vn))
+        for i in range(4):
+            for j in range(5):
+                total = 0.0
+                base = header + 1 + (i * 5 + j) * nterm * 4
+                for k in range(nterm):
+                    p = base + 4 * k
+                    value = packed[p]
+                    if value == 0.0:
+                        continue
+                    for m in range(3):
+                        f = int(packed[p + 1 + m])
+                        if f >= 0:
+                            value = value * fac[f]
+                    total += value
+                params[a, i, j] = min(max(total, packed[12 + 2 * j]), packed[13 + 2 * j])
