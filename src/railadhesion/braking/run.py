@@ -9,7 +9,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from railadhesion.braking.adhesion import AxleAdhesion
+from railadhesion.braking.adhesion import (
+    AxleAdhesion,
+    PolachAdhesion,
+    WaterFlowProfile,
+    WilacAdhesion,
+)
 from railadhesion.braking.cylinders import ATMOSPHERIC_PRESSURE, BrakeCylinders
 from railadhesion.braking.simulator import BrakingSimulator
 from railadhesion.braking.vehicle import Vehicle
@@ -192,7 +197,8 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
              brake=3.0e5, *, cylinders: BrakeCylinders | None = None, wsp=None,
              control_period: float | None = None, dt: float = 1e-3, max_time: float = 600.0,
              gradient: float = 0.0, refresh_period: float = 0.01, stop_speed: float = 0.05,
-             progress: Callable[[float], None] | None = None) -> BrakingResult:
+             progress: Callable[[float], None] | None = None,
+             compiled: bool = True) -> BrakingResult:
     """Simulate a stop from ``initial_speed`` [m/s] to standstill (or ``max_time`` [s]).
 
     Parameters
@@ -216,6 +222,11 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
         Simulation step [s]; the control period must be a whole multiple of it.
     progress : callable, optional
         Called now and then with the fraction of the initial speed lost (0 … 1).
+    compiled : bool
+        Use the compiled whole-run loop when possible (Polach or WILAC with a
+        :class:`WaterFlowProfile`, a :class:`BrakeDemand`, no WSP or the default
+        :class:`WheelSlideProtection`); otherwise, or with ``False``, the same steps run in
+        Python (any adhesion model, any controller). Both give the same results.
 
     Returns
     -------
@@ -240,7 +251,25 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
     if not (math.isfinite(max_time) and max_time > 0):
         raise ValueError(f"max_time must be in (0, inf) s, got {max_time!r}")
     nmax = int(math.ceil(max_time / dt))
-    n = vehicle.n_axles
+    if compiled and _fast_path_possible(adhesion, demand, controller):
+        _run_compiled(sim, demand, controller, ratio, nmax, dt, progress, initial_speed)
+    else:
+        _run_python(sim, demand, controller, ratio, nmax, dt, progress, initial_speed)
+    h = sim.histories()
+    status = 0 if sim.stopped else 1
+    message = ("the train stopped" if sim.stopped
+               else f"max_time = {max_time} s reached before the train stopped")
+    settings = {"n_axles": vehicle.n_axles, "vehicle": vehicle.name, "dt_s": dt,
+                "wheel_radius_m": vehicle.wheel_radius,
+                "adhesion": adhesion.describe(), "wsp": None if controller is None
+                else type(controller).__name__, "initial_speed_m_s": initial_speed}
+    if progress is not None:
+        progress(1.0)
+    return BrakingResult(h, status, message, summarise(sim, h), settings)
+
+
+def _run_python(sim, demand, controller, ratio, nmax, dt, progress, initial_speed):
+    n = sim.vehicle.n_axles
     valves = np.zeros(n, dtype=np.int64)
     report_every = max(1, int(round(1.0 / dt)))
     for k in range(nmax):
@@ -260,14 +289,120 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
             progress(1.0 - sim.speed / initial_speed)
         if sim.stopped:
             break
-    h = sim.histories()
-    status = 0 if sim.stopped else 1
-    message = ("the train stopped" if sim.stopped
-               else f"max_time = {max_time} s reached before the train stopped")
-    settings = {"n_axles": vehicle.n_axles, "vehicle": vehicle.name, "dt_s": dt,
-                "wheel_radius_m": vehicle.wheel_radius,
-                "adhesion": adhesion.describe(), "wsp": None if controller is None
-                else type(controller).__name__, "initial_speed_m_s": initial_speed}
-    if progress is not None:
-        progress(1.0)
-    return BrakingResult(h, status, message, summarise(sim, h), settings)
+
+
+def _fast_path_possible(adhesion, demand, controller) -> bool:
+    kind = type(adhesion)
+    if kind is WilacAdhesion:
+        ok = isinstance(adhesion.water_flow, WaterFlowProfile)
+    else:
+        ok = kind is PolachAdhesion
+    return (ok and type(demand) is BrakeDemand
+            and (controller is None or type(controller) is WheelSlideProtection))
+
+
+def _run_compiled(sim, demand, controller, ratio, nmax, dt, progress, initial_speed):
+    """The loop of _run_python in one compiled kernel (same operations, same results)."""
+    from railadhesion.braking import _kernels as kern
+
+    veh = sim.vehicle
+    n = veh.n_axles
+    a = sim.adhesion
+    cyl = sim.cylinders
+    sc = np.zeros(15)
+    sc[kern.V_] = sim.speed
+    vp = np.array([veh.wheel_radius, veh.wheelset_inertia, veh.brake_coefficient,
+                   veh.total_mass, veh.davis_a, veh.davis_b, veh.davis_c, sim._grade_force,
+                   sim.stop_speed, sim.refresh_period])
+    empty = np.zeros(1)
+    if type(a) is PolachAdhesion:
+        kind = 0
+        table = np.ascontiguousarray(a._table)
+        sec = a.section_list
+        sec_start = np.array([x[0] for x in sec], float)
+        sec_end = np.array([x[1] for x in sec], float)
+        sec_idx = np.array([x[2] for x in sec], dtype=np.int64)
+        packed, prof_x, prof_v, over_time, linear, recovery = empty, empty, empty, False, False, 0.0
+        k_sets = len(a.sets)
+    else:
+        from railadhesion.models.kernels import pack_wilac
+
+        kind = 1
+        table = np.zeros((1, 5))
+        sec_start = sec_end = np.zeros(0)
+        sec_idx = np.zeros(0, dtype=np.int64)
+        if a._packed is None:
+            a._packed = pack_wilac(a.parameters)
+        packed = a._packed
+        prof = a.water_flow
+        prof_x, prof_v = prof.x, prof.values
+        over_time, linear = prof.over == "time", prof.kind == "linear"
+        recovery = 0.0 if a.recovery is None else a.recovery.energy_scale
+        k_sets = 4
+    weights = np.zeros((n, k_sets))
+    params = np.zeros((n, k_sets, 5))
+    stiffness = np.zeros(n)
+    wsp_on = controller is not None
+    if wsp_on:
+        st = controller.settings
+        ws = np.array([st.period, st.reference_deceleration, st.hold_slip_ratio,
+                       st.hold_slip_min, st.vent_slip_ratio, st.vent_slip_min,
+                       st.reapply_slip_ratio, st.reapply_slip_min, st.hold_deceleration,
+                       st.vent_deceleration, st.recovery_acceleration, st.deceleration_filter,
+                       st.watchdog_time, st.watchdog_refill_time])
+    else:
+        ws = np.zeros(14)
+    wst = np.zeros(n, dtype=np.int64)
+    released = np.full(n, np.nan)
+    forced = np.full(n, -np.inf)
+    prev = np.zeros(n)
+    wdec = np.zeros(n)
+    omega = sim.omega.copy()
+    pressure = sim.pressure.copy()
+    valves = np.zeros(n, dtype=np.int64)
+    forces = np.zeros(n)
+    mu = np.zeros(n)
+    creep = np.zeros(n)
+    loads = sim.loads.copy()
+    available = np.full(n, np.nan)
+    vented = np.zeros(n)
+    vent_actions = np.zeros(n, dtype=np.int64)
+    demand_arr = np.array([demand.pressure, demand.start_time, demand.ramp_time])
+    cyl_arr = np.array([cyl.fill_time_constant, cyl.vent_time_constant, cyl.max_pressure])
+    chunk = int(min(nmax, max(1000, round(5.0 / dt))))
+    ncols = len(sim.history_columns())
+    blocks = []
+    status = 0
+    while True:
+        rows = np.empty((chunk, ncols))
+        k_end = min(nmax, int(sc[kern.K_]) + chunk)
+        nrow, status = kern.run_family(
+            k_end, dt, sc, vp, sim._static_load, sim._transfer, sim._offsets, cyl_arr,
+            demand_arr, kind, table, sec_start, sec_end, sec_idx, packed, prof_x, prof_v,
+            over_time, linear, recovery, a.contact._k0, a.contact.reference_load, wsp_on,
+            ratio, cyl.valves == "bogie", ws, wst, released, forced, prev, wdec, omega,
+            pressure, valves, forces, mu, creep, loads, available, vented, vent_actions,
+            weights, params, stiffness, rows, 1e-10)
+        blocks.append(rows[:nrow])
+        if progress is not None:
+            progress(1.0 - sc[kern.V_] / initial_speed)
+        if status == 2:
+            sim.time, sim.distance, sim.speed = sc[kern.T_], sc[kern.X_], sc[kern.V_]
+            sim._fail(0, " in the compiled loop")
+        if status == 1 or int(sc[kern.K_]) >= nmax:
+            break
+    # hand the final state back to the simulator object (for summaries and further use)
+    sim.time, sim.distance, sim.speed = sc[kern.T_], sc[kern.X_], sc[kern.V_]
+    sim.deceleration = sc[kern.D_]
+    sim.omega, sim.pressure, sim.valves = omega, pressure, valves
+    sim.forces, sim.mu, sim.creep, sim.loads = forces, mu, creep, loads
+    sim.available = available
+    sim.brake_work, sim.creep_work = sc[kern.WB_], sc[kern.WC_]
+    sim.resistance_work, sim.gradient_work = sc[kern.WR_], sc[kern.WG_]
+    sim.vented_pressure = vented
+    sim.vent_actions = vent_actions
+    sim.stopped = bool(sc[kern.STOPPED_])
+    if sim.stopped:
+        sim.stop_time, sim.stop_distance = sc[kern.STOP_T_], sc[kern.STOP_X_]
+    sim._started = True
+    sim._row_array = np.concatenate(blocks) if blocks else np.empty((0, ncols))

@@ -414,8 +414,12 @@ class BrakingSimulator:
         """Time histories of every recorded step as a pandas DataFrame (first row: t = 0)."""
         import pandas as pd
 
-        rows = [self.initial_row(), *self._rows]
-        frame = pd.DataFrame(rows, columns=self.history_columns())
+        cols = self.history_columns()
+        if getattr(self, "_row_array", None) is not None:
+            data = np.vstack([np.asarray(self.initial_row(), float)[None, :], self._row_array])
+            frame = pd.DataFrame(data, columns=cols)
+        else:
+            frame = pd.DataFrame([self.initial_row(), *self._rows], columns=cols)
         n = self.vehicle.n_axles
         for i in range(1, n + 1):
             frame[f"valve_{i}"] = frame[f"valve_{i}"].astype(np.int64)
