@@ -193,3 +193,21 @@ def test_compiled_loop_matches_python_loop(case):
     assert a.shape == b.shape
     assert runs[0].summary["vent_actions"] == runs[1].summary["vent_actions"]
     np.testing.assert_allclose(a.to_numpy(), b.to_numpy(), rtol=1e-9, atol=1e-9)
+
+
+def test_stepping_api_compiled_matches_python():
+    def run(compiled):
+        sim = BrakingSimulator(VEHICLE, WilacAdhesion(WaterFlowProfile.sections([(5, 50, 25.0)])),
+                               15.0, compiled=compiled)
+        for k in range(400):
+            valves = [0, 0, 0, 0] if (k // 100) % 2 == 0 else [2, 1, 0, 2]
+            state = sim.step(2e-3, {"pressure_command": [5e5, 5e5, 4e5, 4e5], "valves": valves})
+        return sim, state
+
+    (fast, a), (slow, b) = run(True), run(False)
+    assert fast.compiled and fast._use_compiled and not slow._use_compiled
+    np.testing.assert_allclose(a.wheel_speeds, b.wheel_speeds, rtol=1e-10)
+    assert a.distance == pytest.approx(b.distance, rel=1e-12)
+    np.testing.assert_allclose(fast.histories().to_numpy(), slow.histories().to_numpy(),
+                               rtol=1e-9, atol=1e-9)
+    np.testing.assert_array_equal(fast.vent_actions, slow.vent_actions)

@@ -342,10 +342,13 @@ def run_family(k_end, dt, sc, vp, static_load, transfer, offsets, cyl, demand, k
                polach_table, sec_start, sec_end, sec_idx, packed, prof_x, prof_v, over_time,
                linear, recovery, k0, qref, wsp_on, ratio, bogie, ws, wst, released, forced,
                prev, wdec, omega, pressure, valves, forces, mu, creep, loads, available,
-               vented_total, vent_actions, weights, params, stiffness, rows, tol):
+               vented_total, vent_actions, weights, params, stiffness, rows, tol,
+               cmd_axle):
     """Steps k = sc[K_] … k_end - 1 of simulate(); returns (rows written, status).
 
-    status: 0 buffer full or k_end reached, 1 stopped, 2 non-finite adhesion.
+    ``cmd_axle``: per-axle commanded pressures that replace ``demand`` when its first element
+    is >= 0 (the stepping API). status: 0 buffer full or k_end reached, 1 stopped,
+    2 non-finite adhesion.
     """
     n = omega.shape[0]
     radius = vp[0]
@@ -396,6 +399,11 @@ def run_family(k_end, dt, sc, vp, static_load, transfer, offsets, cyl, demand, k
             sc[NEXT_] = (math.floor(sc[T_] / period + 1e-9) + 1) * period
         for i in range(n):
             cmd_arr[i] = cmd
+        if cmd_axle[0] >= 0.0:
+            cmd = 0.0
+            for i in range(n):
+                cmd_arr[i] = cmd_axle[i]
+                cmd = max(cmd, cmd_axle[i])
         v0 = sc[V_]
         (v, om, p1, m, ld, vent, wb, wc, wr, status) = advance_family(
             v0, sc[D_], dt, omega, pressure, valves, cmd_arr, static_load, transfer, radius,

@@ -234,7 +234,8 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
     """
     sim = BrakingSimulator(vehicle, adhesion, initial_speed, cylinders=cylinders,
                            gradient=gradient, refresh_period=refresh_period,
-                           stop_speed=stop_speed, max_step=dt, record=True)
+                           stop_speed=stop_speed, max_step=dt, record=True,
+                           compiled=compiled)
     demand = BrakeDemand(float(brake)) if isinstance(brake, int | float) else brake
     if not callable(demand):
         raise ValueError(f"brake must be a pressure [Pa] or a function of time, got {brake!r}")
@@ -305,70 +306,10 @@ def _run_compiled(sim, demand, controller, ratio, nmax, dt, progress, initial_sp
     """The loop of _run_python in one compiled kernel (same operations, same results)."""
     from railadhesion.braking import _kernels as kern
 
-    veh = sim.vehicle
-    n = veh.n_axles
-    a = sim.adhesion
-    cyl = sim.cylinders
-    sc = np.zeros(15)
-    sc[kern.V_] = sim.speed
-    vp = np.array([veh.wheel_radius, veh.wheelset_inertia, veh.brake_coefficient,
-                   veh.total_mass, veh.davis_a, veh.davis_b, veh.davis_c, sim._grade_force,
-                   sim.stop_speed, sim.refresh_period])
-    empty = np.zeros(1)
-    if type(a) is PolachAdhesion:
-        kind = 0
-        table = np.ascontiguousarray(a._table)
-        sec = a.section_list
-        sec_start = np.array([x[0] for x in sec], float)
-        sec_end = np.array([x[1] for x in sec], float)
-        sec_idx = np.array([x[2] for x in sec], dtype=np.int64)
-        packed, prof_x, prof_v, over_time, linear, recovery = empty, empty, empty, False, False, 0.0
-        k_sets = len(a.sets)
-    else:
-        from railadhesion.models.kernels import pack_wilac
-
-        kind = 1
-        table = np.zeros((1, 5))
-        sec_start = sec_end = np.zeros(0)
-        sec_idx = np.zeros(0, dtype=np.int64)
-        if a._packed is None:
-            a._packed = pack_wilac(a.parameters)
-        packed = a._packed
-        prof = a.water_flow
-        prof_x, prof_v = prof.x, prof.values
-        over_time, linear = prof.over == "time", prof.kind == "linear"
-        recovery = 0.0 if a.recovery is None else a.recovery.energy_scale
-        k_sets = 4
-    weights = np.zeros((n, k_sets))
-    params = np.zeros((n, k_sets, 5))
-    stiffness = np.zeros(n)
-    wsp_on = controller is not None
-    if wsp_on:
-        st = controller.settings
-        ws = np.array([st.period, st.reference_deceleration, st.hold_slip_ratio,
-                       st.hold_slip_min, st.vent_slip_ratio, st.vent_slip_min,
-                       st.reapply_slip_ratio, st.reapply_slip_min, st.hold_deceleration,
-                       st.vent_deceleration, st.recovery_acceleration, st.deceleration_filter,
-                       st.watchdog_time, st.watchdog_refill_time])
-    else:
-        ws = np.zeros(14)
-    wst = np.zeros(n, dtype=np.int64)
-    released = np.full(n, np.nan)
-    forced = np.full(n, -np.inf)
-    prev = np.zeros(n)
-    wdec = np.zeros(n)
-    omega = sim.omega.copy()
-    pressure = sim.pressure.copy()
-    valves = np.zeros(n, dtype=np.int64)
-    forces = np.zeros(n)
-    mu = np.zeros(n)
-    creep = np.zeros(n)
-    loads = sim.loads.copy()
-    available = np.full(n, np.nan)
-    vented = np.zeros(n)
-    vent_actions = np.zeros(n, dtype=np.int64)
-    demand_arr = np.array([demand.pressure, demand.start_time, demand.ramp_time])
-    cyl_arr = np.array([cyl.fill_time_constant, cyl.vent_time_constant, cyl.max_pressure])
+    c = sim._compiled_state(controller)
+    sc = c.sc
+    c.demand[:] = (demand.pressure, demand.start_time, demand.ramp_time)
+    c.cmd_axle[0] = -1.0
     chunk = int(min(nmax, max(1000, round(5.0 / dt))))
     ncols = len(sim.history_columns())
     blocks = []
@@ -376,33 +317,14 @@ def _run_compiled(sim, demand, controller, ratio, nmax, dt, progress, initial_sp
     while True:
         rows = np.empty((chunk, ncols))
         k_end = min(nmax, int(sc[kern.K_]) + chunk)
-        nrow, status = kern.run_family(
-            k_end, dt, sc, vp, sim._static_load, sim._transfer, sim._offsets, cyl_arr,
-            demand_arr, kind, table, sec_start, sec_end, sec_idx, packed, prof_x, prof_v,
-            over_time, linear, recovery, a.contact._k0, a.contact.reference_load, wsp_on,
-            ratio, cyl.valves == "bogie", ws, wst, released, forced, prev, wdec, omega,
-            pressure, valves, forces, mu, creep, loads, available, vented, vent_actions,
-            weights, params, stiffness, rows, 1e-10)
+        nrow, status = kern.run_family(k_end, dt, *c.args(ratio), rows, 1e-10, c.cmd_axle)
         blocks.append(rows[:nrow])
         if progress is not None:
             progress(1.0 - sc[kern.V_] / initial_speed)
         if status == 2:
-            sim.time, sim.distance, sim.speed = sc[kern.T_], sc[kern.X_], sc[kern.V_]
+            sim._sync_from_compiled()
             sim._fail(0, " in the compiled loop")
         if status == 1 or int(sc[kern.K_]) >= nmax:
             break
-    # hand the final state back to the simulator object (for summaries and further use)
-    sim.time, sim.distance, sim.speed = sc[kern.T_], sc[kern.X_], sc[kern.V_]
-    sim.deceleration = sc[kern.D_]
-    sim.omega, sim.pressure, sim.valves = omega, pressure, valves
-    sim.forces, sim.mu, sim.creep, sim.loads = forces, mu, creep, loads
-    sim.available = available
-    sim.brake_work, sim.creep_work = sc[kern.WB_], sc[kern.WC_]
-    sim.resistance_work, sim.gradient_work = sc[kern.WR_], sc[kern.WG_]
-    sim.vented_pressure = vented
-    sim.vent_actions = vent_actions
-    sim.stopped = bool(sc[kern.STOPPED_])
-    if sim.stopped:
-        sim.stop_time, sim.stop_distance = sc[kern.STOP_T_], sc[kern.STOP_X_]
-    sim._started = True
+    sim._sync_from_compiled()
     sim._row_array = np.concatenate(blocks) if blocks else np.empty((0, ncols))

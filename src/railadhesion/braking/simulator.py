@@ -106,12 +106,16 @@ class BrakingSimulator:
         (default 2e-3 s).
     record : bool
         Keep the history of every step (for :meth:`histories`).
+    compiled : bool
+        Run the steps in the compiled kernel when the adhesion model allows it (Polach, or
+        WILAC with a :class:`~railadhesion.braking.adhesion.WaterFlowProfile`); the Python
+        path gives the same numbers and accepts any model.
     """
 
     def __init__(self, vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float, *,
                  cylinders: BrakeCylinders | None = None, gradient: float = 0.0,
                  refresh_period: float = 0.01, stop_speed: float = 0.05,
-                 max_step: float = 2e-3, record: bool = True):
+                 max_step: float = 2e-3, record: bool = True, compiled: bool = True):
         if not isinstance(vehicle, Vehicle):
             raise ValueError(f"vehicle must be a Vehicle, got {type(vehicle).__name__}")
         if not isinstance(adhesion, AxleAdhesion):
@@ -172,6 +176,10 @@ class BrakingSimulator:
         self.vented_pressure = np.zeros(n)
         self.vent_actions = np.zeros(n, dtype=np.int64)
         self._rows: list = []
+        self._row_blocks: list = []
+        self._row_array = None
+        self._compiled = None
+        self._use_compiled = bool(compiled) and self.compiled
 
     # -- FMI-like guard -------------------------------------------------------------------
     def __setattr__(self, name, value):
@@ -232,6 +240,11 @@ class BrakingSimulator:
 
     def _run(self, dt, valves):
         """Advance with checked inputs (``valves`` per axle, int64)."""
+        if self._use_compiled:
+            if not self.stopped:
+                nsub = max(1, int(math.ceil(dt / self.max_step - 1e-9)))
+                self._step_compiled(nsub, dt / nsub, valves)
+            return
         self.vent_actions += (valves == VENT) & (self.valves != VENT)
         self.valves = valves
         if not self._started:
@@ -389,6 +402,61 @@ class BrakingSimulator:
         mu, _ = self._evaluate((v - w * radius) / vr, v)
         return w, mu
 
+
+    # -- compiled path ----------------------------------------------------------------------
+    @property
+    def compiled(self) -> bool:
+        """True if steps run in the compiled kernel (Polach, or WILAC with a WaterFlowProfile)."""
+        from railadhesion.braking.adhesion import PolachAdhesion, WaterFlowProfile, WilacAdhesion
+
+        kind = type(self.adhesion)
+        if kind is WilacAdhesion:
+            return isinstance(self.adhesion.water_flow, WaterFlowProfile)
+        return kind is PolachAdhesion
+
+    def _compiled_state(self, controller=None):
+        """Arrays of the compiled loop, built from the current state (kept on the object)."""
+        if getattr(self, "_compiled", None) is not None:
+            return self._compiled
+        self._compiled = _CompiledState(self, controller)
+        return self._compiled
+
+    def _sync_from_compiled(self):
+        from railadhesion.braking import _kernels as kern
+
+        c = self._compiled
+        sc = c.sc
+        self.time, self.distance, self.speed = sc[kern.T_], sc[kern.X_], sc[kern.V_]
+        self.deceleration = sc[kern.D_]
+        self.omega, self.pressure, self.valves = c.omega, c.pressure, c.valves
+        self.forces, self.mu, self.creep, self.loads = c.forces, c.mu, c.creep, c.loads
+        self.available = c.available
+        self.brake_work, self.creep_work = sc[kern.WB_], sc[kern.WC_]
+        self.resistance_work, self.gradient_work = sc[kern.WR_], sc[kern.WG_]
+        self.vented_pressure = c.vented
+        self.vent_actions = c.vent_actions
+        self.stopped = bool(sc[kern.STOPPED_])
+        if self.stopped:
+            self.stop_time, self.stop_distance = sc[kern.STOP_T_], sc[kern.STOP_X_]
+        if not self._started:
+            self._started = True
+
+    def _step_compiled(self, nsub, h, valves):
+        from railadhesion.braking import _kernels as kern
+
+        c = self._compiled_state(None)
+        c.vent_actions += (valves == VENT) & (c.valves != VENT)
+        c.valves[:] = valves
+        c.cmd_axle[:] = self.pressure_command
+        k_end = int(c.sc[kern.K_]) + nsub
+        rows = np.empty((nsub, c.ncols)) if self.record else c.scratch(nsub)
+        nrow, status = kern.run_family(k_end, h, *c.args(1), rows, _TOL, c.cmd_axle)
+        if self.record:
+            self._row_blocks.append(rows[:nrow])
+        self._sync_from_compiled()
+        if status == 2:
+            self._fail(0, " in the compiled step")
+
     # -- results --------------------------------------------------------------------------
     def history_columns(self) -> list[str]:
         n = self.vehicle.n_axles
@@ -415,8 +483,9 @@ class BrakingSimulator:
         import pandas as pd
 
         cols = self.history_columns()
-        if getattr(self, "_row_array", None) is not None:
-            data = np.vstack([np.asarray(self.initial_row(), float)[None, :], self._row_array])
+        blocks = self._row_blocks if self._row_array is None else [self._row_array]
+        if blocks:
+            data = np.vstack([np.asarray(self.initial_row(), float)[None, :], *blocks])
             frame = pd.DataFrame(data, columns=cols)
         else:
             frame = pd.DataFrame([self.initial_row(), *self._rows], columns=cols)
@@ -434,3 +503,102 @@ class BrakingSimulator:
         kwargs.update(changes)
         return BrakingSimulator(**kwargs)
 
+
+
+class _CompiledState:
+    """State and constant arrays of the compiled loop (``_kernels.run_family``)."""
+
+    def __init__(self, sim: BrakingSimulator, controller=None):
+        from railadhesion.braking import _kernels as kern
+        from railadhesion.braking.adhesion import PolachAdhesion
+
+        veh = sim.vehicle
+        n = veh.n_axles
+        a = sim.adhesion
+        cyl = sim.cylinders
+        sc = np.zeros(15)
+        sc[kern.T_], sc[kern.X_], sc[kern.V_] = sim.time, sim.distance, sim.speed
+        sc[kern.D_] = sim.deceleration
+        sc[kern.NEXT_] = sim._next_refresh
+        self.sc = sc
+        self.vp = np.array([veh.wheel_radius, veh.wheelset_inertia, veh.brake_coefficient,
+                            veh.total_mass, veh.davis_a, veh.davis_b, veh.davis_c,
+                            sim._grade_force, sim.stop_speed, sim.refresh_period])
+        empty = np.zeros(1)
+        if type(a) is PolachAdhesion:
+            self.kind = 0
+            self.table = np.ascontiguousarray(a._table)
+            sec = a.section_list
+            self.sec_start = np.array([x[0] for x in sec], float)
+            self.sec_end = np.array([x[1] for x in sec], float)
+            self.sec_idx = np.array([x[2] for x in sec], dtype=np.int64)
+            self.packed, self.prof_x, self.prof_v = empty, empty, empty
+            self.over_time, self.linear, self.recovery = False, False, 0.0
+            k_sets = len(a.sets)
+        else:
+            from railadhesion.models.kernels import pack_wilac
+
+            self.kind = 1
+            self.table = np.zeros((1, 5))
+            self.sec_start = self.sec_end = np.zeros(0)
+            self.sec_idx = np.zeros(0, dtype=np.int64)
+            if a._packed is None:
+                a._packed = pack_wilac(a.parameters)
+            self.packed = a._packed
+            prof = a.water_flow
+            self.prof_x, self.prof_v = prof.x, prof.values
+            self.over_time, self.linear = prof.over == "time", prof.kind == "linear"
+            self.recovery = 0.0 if a.recovery is None else a.recovery.energy_scale
+            k_sets = 4
+        self.weights = np.zeros((n, k_sets))
+        self.params = np.zeros((n, k_sets, 5))
+        self.stiffness = np.zeros(n)
+        self.wsp_on = controller is not None
+        if self.wsp_on:
+            st = controller.settings
+            self.ws = np.array([st.period, st.reference_deceleration, st.hold_slip_ratio,
+                                st.hold_slip_min, st.vent_slip_ratio, st.vent_slip_min,
+                                st.reapply_slip_ratio, st.reapply_slip_min,
+                                st.hold_deceleration, st.vent_deceleration,
+                                st.recovery_acceleration, st.deceleration_filter,
+                                st.watchdog_time, st.watchdog_refill_time])
+        else:
+            self.ws = np.zeros(14)
+        self.wst = np.zeros(n, dtype=np.int64)
+        self.released = np.full(n, np.nan)
+        self.forced = np.full(n, -np.inf)
+        self.prev = np.zeros(n)
+        self.wdec = np.zeros(n)
+        self.omega = np.array(sim.omega, float)
+        self.pressure = np.array(sim.pressure, float)
+        self.valves = np.array(sim.valves, dtype=np.int64)
+        self.forces = np.array(sim.forces, float)
+        self.mu = np.array(sim.mu, float)
+        self.creep = np.array(sim.creep, float)
+        self.loads = np.array(sim.loads, float)
+        self.available = np.array(sim.available, float)
+        self.vented = np.array(sim.vented_pressure, float)
+        self.vent_actions = np.array(sim.vent_actions, dtype=np.int64)
+        self.demand = np.zeros(3)
+        self.cyl = np.array([cyl.fill_time_constant, cyl.vent_time_constant, cyl.max_pressure])
+        self.bogie = cyl.valves == "bogie"
+        self.cmd_axle = np.full(n, -1.0)
+        self.k0, self.qref = a.contact._k0, a.contact.reference_load
+        self.ncols = len(sim.history_columns())
+        self._scratch = np.empty((0, self.ncols))
+        self.sim = sim
+
+    def scratch(self, rows):
+        if self._scratch.shape[0] < rows:
+            self._scratch = np.empty((rows, self.ncols))
+        return self._scratch
+
+    def args(self, ratio):
+        return (self.sc, self.vp, self.sim._static_load, self.sim._transfer, self.sim._offsets,
+                self.cyl, self.demand, self.kind, self.table, self.sec_start, self.sec_end,
+                self.sec_idx, self.packed, self.prof_x, self.prof_v, self.over_time,
+                self.linear, self.recovery, self.k0, self.qref, self.wsp_on, ratio, self.bogie,
+                self.ws, self.wst, self.released, self.forced, self.prev, self.wdec,
+                self.omega, self.pressure, self.valves, self.forces, self.mu, self.creep,
+                self.loads, self.available, self.vented, self.vent_actions, self.weights,
+                self.params, self.stiffness)
