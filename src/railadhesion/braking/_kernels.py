@@ -301,7 +301,11 @@ def _wsp(t, omega, radius, ws, wst, released, forced, prev, wdec, sc, out):
         raw = (prev[i] - u[i]) / period
         wdec[i] += alpha * (raw - wdec[i])
         prev[i] = u[i]
-    v_ref = max(u.max(), sc[REF_] - ws[1] * period)
+    ref = sc[REF_]
+    rate = ws[1]
+    if u.max() < ref - max(ws[2] * ref, ws[3]):
+        rate = ws[14]
+    v_ref = max(u.max(), ref - rate * period)
     sc[REF_] = v_ref
     hold = max(ws[2] * v_ref, ws[3])
     vent = max(ws[4] * v_ref, ws[5])
@@ -316,12 +320,13 @@ def _wsp(t, omega, radius, ws, wst, released, forced, prev, wdec, sc, out):
         if st == 0:
             new = 2 if want_vent else (1 if want_hold else 0)
         elif st == 2:
-            if -a > ws[10] or slip < hold:
+            if -a > ws[10]:
                 new = 1
         else:
-            if want_vent and -a <= ws[10]:
+            accelerating = -a > ws[10]
+            if want_vent and not accelerating:
                 new = 2
-            elif slip < reapply and a < ws[8]:
+            elif slip < reapply and not accelerating and a < ws[8]:
                 new = 0
         if t < forced[i]:
             new = 0

@@ -561,9 +561,10 @@ class _CompiledState:
                                 st.reapply_slip_ratio, st.reapply_slip_min,
                                 st.hold_deceleration, st.vent_deceleration,
                                 st.recovery_acceleration, st.deceleration_filter,
-                                st.watchdog_time, st.watchdog_refill_time])
+                                st.watchdog_time, st.watchdog_refill_time,
+                                st.sliding_reference_deceleration])
         else:
-            self.ws = np.zeros(14)
+            self.ws = np.zeros(15)
         self.wst = np.zeros(n, dtype=np.int64)
         self.released = np.full(n, np.nan)
         self.forced = np.full(n, -np.inf)
