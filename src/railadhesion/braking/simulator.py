@@ -224,16 +224,20 @@ class BrakingSimulator:
                              "valves")
         n = self.vehicle.n_axles
         if "pressure_command" in inputs:
-            cmd = np.asarray(inputs["pressure_command"], float)
-            if cmd.shape not in ((), (n,)) or not np.all(np.isfinite(cmd) & (cmd >= 0)):
-                raise ValueError(f"pressure_command must be a number or {n} numbers in "
-                                 f"[0, inf) Pa, got {inputs['pressure_command']!r}")
-            self.pressure_command = cmd
+            cmd = inputs["pressure_command"]
+            if type(cmd) is float and 0.0 <= cmd < math.inf:  # fast path for HIL loops
+                self.__dict__["pressure_command"] = cmd
+            else:
+                cmd = np.asarray(cmd, float)
+                if cmd.shape not in ((), (n,)) or not np.all(np.isfinite(cmd) & (cmd >= 0)):
+                    raise ValueError(f"pressure_command must be a number or {n} numbers in "
+                                     f"[0, inf) Pa, got {inputs['pressure_command']!r}")
+                self.pressure_command = cmd
         valves = inputs.get("valves")
         if valves is None:
             valves = np.full(n, APPLY, dtype=np.int64)
         valves = self.cylinders.group_valves(valves, n)
-        if np.any((valves < 0) | (valves > 2)):
+        if valves.min() < 0 or valves.max() > 2:
             raise ValueError(f"valves must be 0 (apply), 1 (hold) or 2 (vent), got {valves}")
         self._run(dt, valves)
         return self.state()
@@ -426,20 +430,20 @@ class BrakingSimulator:
 
         c = self._compiled
         sc = c.sc
-        self.time, self.distance, self.speed = sc[kern.T_], sc[kern.X_], sc[kern.V_]
-        self.deceleration = sc[kern.D_]
-        self.omega, self.pressure, self.valves = c.omega, c.pressure, c.valves
-        self.forces, self.mu, self.creep, self.loads = c.forces, c.mu, c.creep, c.loads
-        self.available = c.available
-        self.brake_work, self.creep_work = sc[kern.WB_], sc[kern.WC_]
-        self.resistance_work, self.gradient_work = sc[kern.WR_], sc[kern.WG_]
-        self.vented_pressure = c.vented
-        self.vent_actions = c.vent_actions
-        self.stopped = bool(sc[kern.STOPPED_])
-        if self.stopped:
-            self.stop_time, self.stop_distance = sc[kern.STOP_T_], sc[kern.STOP_X_]
-        if not self._started:
-            self._started = True
+        d = self.__dict__  # state, not parameters: bypass the parameter guard (hot path)
+        d["time"], d["distance"], d["speed"] = sc[kern.T_], sc[kern.X_], sc[kern.V_]
+        d["deceleration"] = sc[kern.D_]
+        d["brake_work"], d["creep_work"] = sc[kern.WB_], sc[kern.WC_]
+        d["resistance_work"], d["gradient_work"] = sc[kern.WR_], sc[kern.WG_]
+        if d["omega"] is not c.omega:  # the arrays are shared from now on, updated in place
+            d["omega"], d["pressure"], d["valves"] = c.omega, c.pressure, c.valves
+            d["forces"], d["mu"], d["creep"], d["loads"] = c.forces, c.mu, c.creep, c.loads
+            d["available"], d["vented_pressure"] = c.available, c.vented
+            d["vent_actions"] = c.vent_actions
+            d["_started"] = True
+        if sc[kern.STOPPED_]:
+            d["stopped"] = True
+            d["stop_time"], d["stop_distance"] = sc[kern.STOP_T_], sc[kern.STOP_X_]
 
     def _step_compiled(self, nsub, h, valves):
         from railadhesion.braking import _kernels as kern
