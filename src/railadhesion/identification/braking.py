@@ -31,6 +31,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 
 from railadhesion._validate import check_choice, check_nonnegative, check_positive
 from railadhesion.identification.logs import BAR, BrakingLog
@@ -348,31 +349,30 @@ def identification_windows(time, speed, slip_rate, use, segment, *, speed_tolera
     if n == 0:
         z = np.zeros(0, np.int64)
         return z, z, np.zeros(0, np.int8)
-    change = np.ones(n, bool)
-    change[1:] = (key[1:] != key[:-1]) | (segment[1:] != segment[:-1])
-    run_id = np.cumsum(change) - 1
-    starts = np.flatnonzero(change)
-    v0 = speed[starts][run_id]
-    chunk = np.floor(np.abs(speed - v0) / speed_tolerance).astype(np.int64)
-    change2 = change.copy()
-    change2[1:] |= chunk[1:] != chunk[:-1]
-    # a chunk boundary restarts the reference speed: iterate until stable (few passes)
-    for _ in range(50):
-        run_id = np.cumsum(change2) - 1
-        starts = np.flatnonzero(change2)
-        v0 = speed[starts][run_id]
-        chunk = np.floor(np.abs(speed - v0) / speed_tolerance).astype(np.int64)
-        extra = np.zeros(n, bool)
-        extra[1:] = (chunk[1:] != chunk[:-1]) & ~change2[1:]
-        if not extra.any():
-            break
-        change2 |= extra
+    change2 = _window_starts(key, np.ascontiguousarray(segment, dtype=np.int64),
+                             np.ascontiguousarray(speed, dtype=float), float(speed_tolerance))
     starts = np.flatnonzero(change2)
     stops = np.concatenate((starts[1:], [n]))
     sign = key[starts]
     dur = time[stops - 1] - time[starts]
     keep = (sign != 0) & (dur >= min_duration)
     return starts[keep], stops[keep], sign[keep]
+
+
+@njit(cache=True)
+def _window_starts(key, segment, speed, tolerance):  # pragma: no cover - compiled
+    """Start flags of the runs: a new run where the key or the segment changes, or where the
+    speed has moved ``tolerance`` from its value at the current run's start."""
+    n = key.size
+    start = np.zeros(n, np.bool_)
+    start[0] = True
+    v0 = speed[0]
+    for k in range(1, n):
+        if key[k] != key[k - 1] or segment[k] != segment[k - 1] or \
+                abs(speed[k] - v0) >= tolerance:
+            start[k] = True
+            v0 = speed[k]
+    return start
 
 
 def identify_adhesion(
