@@ -100,11 +100,13 @@ def main() -> None:
         print(f"log: {n} samples x 4 axles ({n * PERIOD / 3600:g} h at 2.4 ms), ready in "
               f"{time.perf_counter() - t0:.1f} s")
         times: dict[str, list[float]] = {}
+        cpu: dict[str, list[float]] = {}
 
         def timed(name, fn):
-            t = time.perf_counter()
+            t, c = time.perf_counter(), time.process_time()
             out = fn()
             times.setdefault(name, []).append(time.perf_counter() - t)
+            cpu.setdefault(name, []).append(time.process_time() - c)
             return out
 
         for _ in range(args.repeat):
@@ -118,13 +120,18 @@ def main() -> None:
             timed("surface 40 x 40 x 3 phases", lambda: adhesion_surface(ident))  # noqa: B023
             timed("fit mu(slip), 4 bands + all", lambda: fit_adhesion_curves(ident))  # noqa: B023
         med = {k: statistics.median(v) for k, v in times.items()}
-        print(f"median of {args.repeat} runs [s] (machine shared with other jobs: noisy)")
-        for k, v in med.items():
-            print(f"  {k:<42} {v:7.3f}")
+        mcpu = {k: statistics.median(v) for k, v in cpu.items()}
+        print(f"median of {args.repeat} runs, wall and process CPU time [s] "
+              "(machine shared with other jobs: noisy)")
+        for k in med:
+            print(f"  {k:<42} {med[k]:7.3f} {mcpu[k]:7.3f}")
         core = sum(med[k] for k in med if not k.startswith("read"))
-        print(f"  {'processing (identify + surface + fit)':<42} {core:7.3f}")
-        print(f"  {'end to end from Parquet':<42} {core + med['read Parquet']:7.3f}")
-        print(f"  {'end to end from CSV':<42} {core + med['read CSV']:7.3f}")
+        ccore = sum(mcpu[k] for k in mcpu if not k.startswith("read"))
+        print(f"  {'processing (identify + surface + fit)':<42} {core:7.3f} {ccore:7.3f}")
+        print(f"  {'end to end from Parquet':<42} {core + med['read Parquet']:7.3f} "
+              f"{ccore + mcpu['read Parquet']:7.3f}")
+        print(f"  {'end to end from CSV':<42} {core + med['read CSV']:7.3f} "
+              f"{ccore + mcpu['read CSV']:7.3f}")
 
 
 if __name__ == "__main__":

@@ -31,6 +31,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 
 from railadhesion._validate import check_choice, check_nonnegative, check_positive
 from railadhesion.identification.logs import BAR, BrakingLog
@@ -348,31 +349,52 @@ def identification_windows(time, speed, slip_rate, use, segment, *, speed_tolera
     if n == 0:
         z = np.zeros(0, np.int64)
         return z, z, np.zeros(0, np.int8)
-    change = np.ones(n, bool)
-    change[1:] = (key[1:] != key[:-1]) | (segment[1:] != segment[:-1])
-    run_id = np.cumsum(change) - 1
-    starts = np.flatnonzero(change)
-    v0 = speed[starts][run_id]
-    chunk = np.floor(np.abs(speed - v0) / speed_tolerance).astype(np.int64)
-    change2 = change.copy()
-    change2[1:] |= chunk[1:] != chunk[:-1]
-    # a chunk boundary restarts the reference speed: iterate until stable (few passes)
-    for _ in range(50):
-        run_id = np.cumsum(change2) - 1
-        starts = np.flatnonzero(change2)
-        v0 = speed[starts][run_id]
-        chunk = np.floor(np.abs(speed - v0) / speed_tolerance).astype(np.int64)
-        extra = np.zeros(n, bool)
-        extra[1:] = (chunk[1:] != chunk[:-1]) & ~change2[1:]
-        if not extra.any():
-            break
-        change2 |= extra
+    change2 = _window_starts(key, np.ascontiguousarray(segment, dtype=np.int64),
+                             np.ascontiguousarray(speed, dtype=float), float(speed_tolerance))
     starts = np.flatnonzero(change2)
     stops = np.concatenate((starts[1:], [n]))
     sign = key[starts]
     dur = time[stops - 1] - time[starts]
     keep = (sign != 0) & (dur >= min_duration)
     return starts[keep], stops[keep], sign[keep]
+
+
+@njit(cache=True)
+def _adhesion(wd, p, loads, slip, v, wheel, train, valid, sub, edge, j, c, r,
+              min_speed):  # pragma: no cover - compiled
+    """Eq. 10 per axle and sample, the relative slip and the usable-sample mask, in one pass:
+    mu = (J w_dot + c p) / (R N); usable = valid, v >= min_speed, wheel turning
+    (R w > 0.05 v), finite mu, not in a filter start-up zone, axle not substituted."""
+    n, m = wd.shape
+    mu = np.empty((n, m))
+    rel = np.empty((n, m))
+    use = np.empty((n, m), np.bool_)
+    for k in range(n):
+        fast = v[k] >= min_speed
+        vr = max(train[k], 1e-9)
+        for a in range(m):
+            x = (j * wd[k, a] + c * p[k, a]) / (r * loads[k, a])
+            mu[k, a] = x
+            rel[k, a] = slip[k, a] / v[k] if fast else np.nan
+            use[k, a] = (valid[k, a] and not sub[a] and fast and wheel[k, a] * r > 0.05 * vr
+                         and np.isfinite(x) and not edge[k])
+    return mu, rel, use
+
+
+@njit(cache=True)
+def _window_starts(key, segment, speed, tolerance):  # pragma: no cover - compiled
+    """Start flags of the runs: a new run where the key or the segment changes, or where the
+    speed has moved ``tolerance`` from its value at the current run's start."""
+    n = key.size
+    start = np.zeros(n, np.bool_)
+    start[0] = True
+    v0 = speed[0]
+    for k in range(1, n):
+        if key[k] != key[k - 1] or segment[k] != segment[k - 1] or \
+                abs(speed[k] - v0) >= tolerance:
+            start[k] = True
+            v0 = speed[k]
+    return start
 
 
 def identify_adhesion(
@@ -491,25 +513,28 @@ def identify_adhesion(
     step("brake coefficient (eq. 14)")
     turning = np.all(log.wheel_speed * r > 0.05 * np.maximum(log.train_speed, 1e-9)[:, None],
                      axis=1)
-    sub = np.asarray(getattr(log, "substituted", np.zeros(n_ax, bool)))
+    sub = getattr(log, "substituted", None)
+    sub = np.ascontiguousarray(np.zeros(n_ax, bool) if sub is None else sub, dtype=np.bool_)
     c_ok = np.all(log.valid | sub[None, :], axis=1) & ~edge & turning & (v_f >= min_speed)
     brake = brake_coefficient(t, d_f, wd05, p05, vehicle, speed=v_f, mask=c_ok,
                               min_pressure=min_pressure)
     c = brake.mean if brake_coefficient_value is None else float(
         check_positive(brake_coefficient_value, "brake_coefficient_value"))
     step("normal loads and adhesion (eqs. 10-13)")
-    loads = np.asarray(vehicle.axle_normal_loads(d_f))
-    mu = (j * wd2 + c * p2) / (r * loads)
+    loads = np.ascontiguousarray(vehicle.axle_normal_loads(d_f), dtype=float)
+    mu, rel, use = _adhesion(
+        wd2, p2, loads, slip, v_f, np.ascontiguousarray(log.wheel_speed),
+        np.ascontiguousarray(log.train_speed), np.ascontiguousarray(log.valid), sub,
+        edge_fast, j, c, r, float(min_speed),
+    )
     fast_ok = v_f >= min_speed
-    rel = np.where(fast_ok[:, None], slip / np.where(fast_ok, v_f, 1.0)[:, None], np.nan)
-    rel_rate = np.full((n, n_ax), np.nan)
+    rel_rate = np.empty((n, n_ax))
     for a, b in _segments(log.segment):
         if b - a >= 2:
             rel_rate[a:b] = derivative(np.nan_to_num(rel[a:b]), t[a:b])
+        else:
+            rel_rate[a:b] = 0.0
     rel_rate[~fast_ok] = np.nan
-    wheel_turning = log.wheel_speed * r > 0.05 * np.maximum(log.train_speed, 1e-9)[:, None]
-    use = (log.valid & ~sub[None, :] & fast_ok[:, None] & wheel_turning & np.isfinite(mu)
-           & ~edge_fast[:, None])
     step("identification windows")
     phase = np.zeros((n, n_ax), np.int8)
     rows = []

@@ -11,6 +11,7 @@ surface is available), :func:`save_surface` writes NetCDF.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from railadhesion._validate import check_choice
 
@@ -27,11 +28,63 @@ def _edges(edges, name):
     return e
 
 
-def _bin(x, edges):
-    """Cell index of each x (-1 outside the edges; the last edge belongs to the last cell)."""
+@njit(cache=True)
+def _cell(x, edges):  # pragma: no cover - compiled
+    """Cell of x for increasing edges (-1 outside; the last edge belongs to the last cell)."""
+    m = edges.size - 1
+    if not (x >= edges[0] and x <= edges[m]):  # also False for NaN
+        return -1
     k = np.searchsorted(edges, x, side="right") - 1
-    k = np.where(x == edges[-1], edges.size - 2, k)
-    return np.where((x >= edges[0]) & (x <= edges[-1]) & np.isfinite(x), k, -1)
+    return min(k, m - 1)
+
+
+@njit(cache=True)
+def _accumulate(speed, slip, mu, use, phase, se, le):  # pragma: no cover - compiled
+    """Counts, sums and sums of squared deviations of mu per (phase, speed, slip) cell.
+
+    Phase 0 = all usable samples, 1 = loss windows (phase +1), 2 = recovery (phase -1).
+    Two passes: the sums give the means, the second pass the squared deviations from them
+    (numerically safe).
+    """
+    n, na = mu.shape
+    ns, nl = se.size - 1, le.size - 1
+    counts = np.zeros((3, ns, nl), np.int64)
+    sums = np.zeros((3, ns, nl))
+    sq = np.zeros((3, ns, nl))
+    cells = np.full((n, na), -1, np.int64)
+    for k in range(n):
+        i = _cell(speed[k], se)
+        if i < 0:
+            continue
+        for a in range(na):
+            if not use[k, a]:
+                continue
+            j = _cell(slip[k, a], le)
+            if j < 0:
+                continue
+            cells[k, a] = i * nl + j
+            counts[0, i, j] += 1
+            sums[0, i, j] += mu[k, a]
+            p = phase[k, a]
+            if p != 0:
+                q = 1 if p > 0 else 2
+                counts[q, i, j] += 1
+                sums[q, i, j] += mu[k, a]
+    for k in range(n):
+        for a in range(na):
+            c = cells[k, a]
+            if c < 0:
+                continue
+            i = c // nl
+            j = c - i * nl
+            d = mu[k, a] - sums[0, i, j] / counts[0, i, j]
+            sq[0, i, j] += d * d
+            p = phase[k, a]
+            if p != 0:
+                q = 1 if p > 0 else 2
+                d = mu[k, a] - sums[q, i, j] / counts[q, i, j]
+                sq[q, i, j] += d * d
+    return counts, sums, sq
 
 
 def adhesion_surface(ident, *, speed_edges=None, slip_edges=None, slip: str = "absolute"):
@@ -65,29 +118,15 @@ def adhesion_surface(ident, *, speed_edges=None, slip_edges=None, slip: str = "a
     if slip_edges is None:
         slip_edges = np.linspace(0.0, 10.0, 41) if slip == "absolute" else np.linspace(0, 1, 41)
     le = _edges(slip_edges, "slip_edges")
-    ns, nl = se.size - 1, le.size - 1
-    means = np.full((3, ns, nl), np.nan)
-    vars_ = np.full((3, ns, nl), np.nan)
-    counts = np.zeros((3, ns, nl), np.int64)
-    for k, phase in enumerate(PHASES):
-        v, dv, rel, mu, _ax = ident.samples(phase)
-        x = dv if slip == "absolute" else rel
-        i = _bin(v, se)
-        j = _bin(x, le)
-        ok = (i >= 0) & (j >= 0)
-        cell = i[ok] * nl + j[ok]
-        m = mu[ok]
-        cnt = np.bincount(cell, minlength=ns * nl)
-        s1 = np.bincount(cell, weights=m, minlength=ns * nl)
-        # variance about a provisional centre: numerically safe sums of squares
-        with np.errstate(invalid="ignore", divide="ignore"):
-            mean = s1 / cnt
-            dev = m - mean[cell]
-            s2 = np.bincount(cell, weights=dev * dev, minlength=ns * nl)
-            var = np.where(cnt > 1, s2 / (cnt - 1), np.nan)
-        means[k] = np.where(cnt > 0, mean, np.nan).reshape(ns, nl)
-        vars_[k] = var.reshape(ns, nl)
-        counts[k] = cnt.reshape(ns, nl)
+    x = ident.slip if slip == "absolute" else ident.relative_slip
+    counts, sums, sq = _accumulate(
+        np.ascontiguousarray(ident.speed, dtype=float), np.ascontiguousarray(x, dtype=float),
+        np.ascontiguousarray(ident.mu, dtype=float), np.ascontiguousarray(ident.use),
+        np.ascontiguousarray(ident.phase, dtype=np.int8), se, le,
+    )
+    with np.errstate(invalid="ignore", divide="ignore"):
+        means = np.where(counts > 0, sums / np.maximum(counts, 1), np.nan)
+        vars_ = np.where(counts > 1, sq / np.maximum(counts - 1, 1), np.nan)
     slip_unit = "m/s" if slip == "absolute" else "1"
     slip_name = (
         "absolute slip v - R omega" if slip == "absolute" else "relative slip (v - R omega)/v"
