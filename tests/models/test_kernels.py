@@ -187,12 +187,16 @@ def test_pack_wilac_layout():
     params = _params()
     packed = kernels.pack_wilac(params)
     nterm = int(packed[kernels.HEADER_SIZE])
-    assert nterm == 3 and packed.size == kernels.HEADER_SIZE + 1 + 4 * 5 * nterm * 4
+    assert nterm == 3 and packed.size == kernels.HEADER_SIZE + 21 + 4 * 5 * nterm * 4
     assert packed[:6].tolist() == [1e5, 40.0, 4e3, 1e5, 1.0, 40.0]
-    reg = packed[kernels.HEADER_SIZE + 1 :].reshape(4, 5, nterm, 4)
+    counts = packed[kernels.HEADER_SIZE + 1 : kernels.HEADER_SIZE + 21].reshape(4, 5)
+    reg = packed[kernels.HEADER_SIZE + 21 :].reshape(4, 5, nterm, 4)
     damp2 = WILAC_CONDITIONS.index("damp2")
-    # mu0 of damp2: 0.1 + 0.05 Q' + 0.01 (1/v') exp(Q'): factor indices Q=0, 1/v=3, exp(Q)=4
-    assert reg[damp2, 2].tolist() == [[0.1, -1, -1, -1], [0.05, 0, -1, -1], [0.01, 3, 4, -1]]
+    assert counts[damp2].tolist() == [1, 1, 3, 1, 1]
+    # mu0 of damp2: 0.1 + 0.05 Q' + 0.01 (1/v') exp(Q'): factor indices Q=0, 1/v=3, exp(Q)=4,
+    # 6 for none (the factor 1)
+    assert reg[damp2, 2].tolist() == [[0.1, 6, 6, 6], [0.05, 0, 6, 6], [0.01, 3, 4, 6]]
+    assert reg[damp2, 0].tolist() == [[0.2, 6, 6, 6], [0, 0, 0, 0], [0, 0, 0, 0]]
 
 
 def test_jitted_api_is_callable_from_user_numba_code():

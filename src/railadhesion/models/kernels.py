@@ -87,7 +87,7 @@ _EPS_MAX = 1e50
 _LOG4 = math.log(4.0)
 _LOG2 = math.log(2.0)
 
-#: Length of the ``header`` array of :func:`pack_wilac`.
+#: Number of header values of a packed WILAC set (:func:`pack_wilac`).
 HEADER_SIZE = 22
 #: Number of contacts a thread processes in sequence (the Kalker lookup is reused within it
 #: while a/b and nu do not change).
@@ -688,28 +688,34 @@ def polach_many(args, n):
 # --- WILAC ----------------------------------------------------------------------------------
 
 
+#: Offset of the term counts, and of the regressions, in a packed WILAC set.
+_COUNTS = HEADER_SIZE + 1
+_TERMS = _COUNTS + 20
+
+
 def pack_wilac(params):
     """Pack a :class:`~railadhesion.models.wilac.WilacParameters` into one float64 array.
 
     Returns
     -------
-    numpy.ndarray, shape (23 + 80 T,)
+    numpy.ndarray, shape (43 + 80 T,)
         ``packed[0:22]``: ``[Q_ref, v_ref, Q_low, Q_high, v_low, v_high, m1, s1, m2, s2,
         m3, s3, k_A_low, k_A_high, k_S_low, k_S_high, mu0_low, mu0_high, A_low, A_high,
         B_low, B_high]``, i.e. the normalisation, the calibrated ranges (Q and v are clamped
         into them), the three erf transitions (midpoint, width) [µl/s] and the clipping bounds
         of the five Polach parameters; ``packed[22]``: T, the largest number of terms of any
-        regression; ``packed[23:]``: the regressions, an array of shape (4, 5, T, 4) in C
-        order: for condition i (dry, damp2, damp1, wet), parameter j (k_A, k_S, mu0, A, B)
-        and term k, ``(coefficient, f1, f2, f3)`` with the factor indices f into
-        ``(Q', v', 1/Q', 1/v', exp(Q'), exp(v'))`` stored as floats, -1 for none; unused terms
-        have coefficient 0.
+        regression; ``packed[23:43]``: the number of terms of each regression, (4, 5) in C
+        order; ``packed[43:]``: the regressions, an array of shape (4, 5, T, 4) in C order:
+        for condition i (dry, damp2, damp1, wet), parameter j (k_A, k_S, mu0, A, B) and term
+        k, ``(coefficient, f1, f2, f3)`` with the factor indices f into
+        ``(Q', v', 1/Q', 1/v', exp(Q'), exp(v'), 1)`` stored as floats (6, the factor 1, for
+        none); unused terms are zero.
 
     Examples
     --------
     >>> from railadhesion.models.wilac import default_wilac_parameters
     >>> packed = pack_wilac(default_wilac_parameters())
-    >>> packed.dtype, (packed.size - 23) % 80, packed[6:12].tolist()
+    >>> packed.dtype, (packed.size - 43) % 80, packed[6:12].tolist()
     (dtype('float64'), 0, [15.0, 5.0, 30.0, 3.0, 50.0, 7.0])
     """
     from railadhesion.models.wilac import PHYSICAL_BOUNDS, POLACH_PARAMETER_NAMES, WILAC_CONDITIONS
@@ -717,11 +723,12 @@ def pack_wilac(params):
     plan = params._scalar_plan
     nterm = max(len(plan[c][j][0]) for c in WILAC_CONDITIONS for j in range(5))
     regression = np.zeros((4, 5, nterm, 4))
-    regression[..., 1:] = -1.0
+    counts = np.zeros((4, 5))
     for i, cond in enumerate(WILAC_CONDITIONS):
         for j in range(5):
+            counts[i, j] = len(plan[cond][j][0])
             for k, (idx, coef) in enumerate(plan[cond][j][0]):
-                regression[i, j, k, 0] = coef
+                regression[i, j, k] = (coef, 6.0, 6.0, 6.0)
                 for m, f in enumerate(idx):
                     regression[i, j, k, 1 + m] = f
     header = np.empty(HEADER_SIZE + 1)
@@ -732,52 +739,59 @@ def pack_wilac(params):
     header[6:12] = np.ravel([(t.midpoint, t.width) for t in params.transitions])
     header[12:22] = np.ravel([PHYSICAL_BOUNDS[p] for p in POLACH_PARAMETER_NAMES])
     header[22] = nterm
-    return np.concatenate([header, regression.ravel()])
+    return np.concatenate([header, counts.ravel(), regression.ravel()])
 
 
 @njit(cache=True, error_model="numpy")
-def _regression_value(packed, nterm, i, j, fac, lo, hi):
-    """Value of regression (condition i, parameter j) of a packed set, clipped to [lo, hi]."""
-    total = 0.0
-    base = HEADER_SIZE + 1 + (i * 5 + j) * nterm * 4
-    for k in range(nterm):
-        p = base + 4 * k
-        value = packed[p]
-        if value == 0.0:
-            continue
-        for m in range(3):
-            f = int(packed[p + 1 + m])
-            if f >= 0:
-                value = value * fac[f]
-        total = total + value
-    return min(max(total, lo), hi)
+def _factors(q, v, packed, fac):
+    """Fill ``fac`` (7) with Q', v', 1/Q', 1/v', exp(Q'), exp(v'), 1 (inputs clamped)."""
+    qn = min(max(q, packed[2]), packed[3]) / packed[0]
+    vn = min(max(v, packed[4]), packed[5]) / packed[1]
+    fac[0] = qn
+    fac[1] = vn
+    fac[2] = 1.0 / qn
+    fac[3] = 1.0 / vn
+    fac[4] = math.exp(qn)
+    fac[5] = math.exp(vn)
+    fac[6] = 1.0
 
 
 @njit(cache=True, error_model="numpy")
-def _wilac_contact(sx, sy, psi, q, v, a, b, w, g, c11, c22, c23, header):
-    """WILAC forces of one validated contact with known Kalker coefficients."""
-    e1 = 0.5 * (math.erf((w - header[6]) / header[7]) + 1.0)
-    e2 = 0.5 * (math.erf((w - header[8]) / header[9]) + 1.0)
-    e3 = 0.5 * (math.erf((w - header[10]) / header[11]) + 1.0)
-    weights = (1.0 - e1, e1 - e2, e2 - e3, e3)
-    qn = min(max(q, header[2]), header[3]) / header[0]
-    vn = min(max(v, header[4]), header[5]) / header[1]
-    fac = (qn, vn, 1.0 / qn, 1.0 / vn, math.exp(qn), math.exp(vn))
-    nterm = int(header[HEADER_SIZE])
-    t = _contact_terms(sx, sy, psi, a, b, g, c11, c22, c23)
+def _condition_parameters(packed, i, fac, out):
+    """The five clipped Polach parameters of condition i into out[5 i : 5 i + 5]."""
+    nterm = int(packed[HEADER_SIZE])
+    for j in range(5):
+        base = _TERMS + (i * 5 + j) * nterm * 4
+        total = 0.0
+        for k in range(int(packed[_COUNTS + i * 5 + j])):
+            p = base + 4 * k
+            total = total + packed[p] * fac[int(packed[p + 1])] * fac[int(packed[p + 2])] * fac[
+                int(packed[p + 3])]  # fmt: skip
+        out[5 * i + j] = min(max(total, packed[12 + 2 * j]), packed[13 + 2 * j])
+
+
+@njit(cache=True, error_model="numpy")
+def _weights(w, packed):
+    e1 = 0.5 * (math.erf((w - packed[6]) / packed[7]) + 1.0)
+    e2 = 0.5 * (math.erf((w - packed[8]) / packed[9]) + 1.0)
+    e3 = 0.5 * (math.erf((w - packed[10]) / packed[11]) + 1.0)
+    return 1.0 - e1, e1 - e2, e2 - e3, e3
+
+
+@njit(cache=True, error_model="numpy")
+def _wilac_blend(sx, sy, q, v, t, weights, pars):
+    """Blend of the Polach forces of the conditions with non-zero weight (``pars`` holds
+    their parameters, (k_A, k_S, mu0, A, B) per condition)."""
     fx = 0.0
     fy = 0.0
     for i in range(4):
         f = weights[i]
         if f == 0.0:
             continue
-        k_a = _regression_value(header, nterm, i, 0, fac, header[12], header[13])
-        k_s = _regression_value(header, nterm, i, 1, fac, header[14], header[15])
-        mu0 = _regression_value(header, nterm, i, 2, fac, header[16], header[17])
-        big_a = _regression_value(header, nterm, i, 3, fac, header[18], header[19])
-        big_b = _regression_value(header, nterm, i, 4, fac, header[20], header[21])
+        b = 5 * i
         fxi, fyi = _polach_terms(sx, sy, q, v, t[0], t[1], t[2], t[3], t[4], t[5], t[6],
-                                 k_a, k_s, mu0, big_a, big_b)  # fmt: skip
+                                 pars[b], pars[b + 1], pars[b + 2], pars[b + 3],
+                                 pars[b + 4])  # fmt: skip
         fx = fx + f * fxi
         fy = fy + f * fyi
     return fx, fy
@@ -793,8 +807,15 @@ def wilac_scalar(creep_x, creep_y, spin, normal_force, speed, a, b, water_flow, 
     """
     if not c11 > 0.0:
         c11, c22, c23 = _kalker3(a / b, nu)
-    return _wilac_contact(creep_x, creep_y, spin, normal_force, speed, a, b, water_flow, G,
-                          c11, c22, c23, packed)  # fmt: skip
+    weights = _weights(water_flow, packed)
+    fac = np.empty(7)
+    pars = np.empty(20)
+    _factors(normal_force, speed, packed, fac)
+    for i in range(4):
+        if weights[i] != 0.0:
+            _condition_parameters(packed, i, fac, pars)
+    t = _contact_terms(creep_x, creep_y, spin, a, b, G, c11, c22, c23)
+    return _wilac_blend(creep_x, creep_y, normal_force, speed, t, weights, pars)
 
 
 @njit(cache=True, error_model="numpy")
@@ -812,7 +833,11 @@ def wilac_checked(creep_x, creep_y, spin, normal_force, speed, a, b, water_flow,
 
 
 def _wilac_many_py(sx, sy, psi, q, v, a, b, w, g, nu, packed, n):
-    """WILAC over n contacts (1-d float64 arrays of length n or 1); returns (fx, fy, ok)."""
+    """WILAC over n contacts (1-d float64 arrays of length n or 1); returns (fx, fy, ok).
+
+    Per chunk of contacts, the Kalker coefficients are reused while a/b and nu repeat and a
+    condition's Polach parameters while the (clamped) Q and v repeat.
+    """
     fx = np.empty(n)
     fy = np.empty(n)
     s0 = 1 if sx.size > 1 else 0
@@ -833,6 +858,12 @@ def _wilac_many_py(sx, sy, psi, q, v, a, b, w, g, nu, packed, n):
         last_r = -1.0
         last_nu = -1.0
         c11 = c22 = c23 = 0.0
+        fac = np.empty(7)
+        pars = np.empty(20)
+        key_q = np.full(4, math.nan)
+        key_v = np.full(4, math.nan)
+        last_q = math.nan
+        last_v = math.nan
         for i in range(lo, hi):
             xa = a[i * s5]
             xb = b[i * s6]
@@ -855,8 +886,18 @@ def _wilac_many_py(sx, sy, psi, q, v, a, b, w, g, nu, packed, n):
                 c11, c22, c23 = _kalker3(r, xnu)
                 last_r = r
                 last_nu = xnu
-            fxi, fyi = _wilac_contact(xsx, xsy, xpsi, xq, xv, xa, xb, xw, xg, c11, c22, c23,
-                                      packed)  # fmt: skip
+            weights = _weights(xw, packed)
+            if xq != last_q or xv != last_v:
+                _factors(xq, xv, packed, fac)
+                last_q = xq
+                last_v = xv
+            for k in range(4):
+                if weights[k] != 0.0 and (key_q[k] != xq or key_v[k] != xv):
+                    _condition_parameters(packed, k, fac, pars)
+                    key_q[k] = xq
+                    key_v[k] = xv
+            t = _contact_terms(xsx, xsy, xpsi, xa, xb, xg, c11, c22, c23)
+            fxi, fyi = _wilac_blend(xsx, xsy, xq, xv, t, weights, pars)
             fx[i] = fxi
             fy[i] = fyi
     return fx, fy, bad.sum() == 0
