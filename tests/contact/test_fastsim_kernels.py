@@ -28,9 +28,12 @@ def _agree(ours, ref, mu_fz, a):
 @pytest.mark.parametrize("grid", ["strips", "rectangular"])
 @pytest.mark.parametrize("flexibility", ["original", "blended"])
 @pytest.mark.parametrize("bound", ["parabolic", "elliptic"])
-def test_batched_kernel_equals_numpy_march(grid, flexibility, bound):
+def test_batched_kernel_equals_numpy_march(grid, flexibility, bound, monkeypatch):
+    from railadhesion.contact import _fastsim_kernels
+
+    monkeypatch.setattr(_fastsim_kernels, "_PARALLEL_MIN", 50)  # run the parallel kernel too
     rng = np.random.default_rng(11)
-    n = 80  # above the parallel threshold
+    n = 80
     xi = rng.uniform(-3e-3, 3e-3, n)
     xi[:3] = (0.0, 1e150, -1e-320)
     args = (xi, rng.uniform(-3e-3, 3e-3, n), rng.uniform(-2, 2, n), rng.uniform(0, 1e5, n),

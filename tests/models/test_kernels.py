@@ -74,7 +74,7 @@ def test_polach_kernel_equals_numpy_reference(sx, sy, psi, q, v, a, ratio, mu0, 
         _close(s, (ours[0][i], ours[1][i]), scale)
 
 
-def test_polach_kernel_edge_cases():
+def test_polach_kernel_edge_cases(monkeypatch):
     """Zero creep, pure spin, huge creep, the spin cap (active), subnormal loads, A = 0 with
     friction gone, large and parallel arrays (the parallel kernel from 8192 contacts)."""
     sx = np.array([0.0, 0.0, 1e300, 0.0, 1e-3, 0.5, 0.0, 1e-320])
@@ -92,6 +92,7 @@ def test_polach_kernel_edge_cases():
     assert ours[0][5] == 0.0  # friction gone
     rng = np.random.default_rng(3)
     n = 20_000
+    monkeypatch.setattr(kernels, "_PARALLEL_MIN", 5000)  # run the parallel kernel too
     big = [rng.uniform(-0.3, 0.3, n), rng.uniform(-0.01, 0.01, n), rng.uniform(-2, 2, n),
            rng.uniform(2e4, 1.2e5, n), rng.uniform(0, 40, n), rng.uniform(3e-3, 8e-3, n),
            rng.uniform(3e-3, 8e-3, n), 0.55, 1.0, 0.4, 0.4, 0.6, 8.2e10, 0.28]  # fmt: skip
@@ -139,9 +140,10 @@ def _params():
 
 @pytest.mark.parametrize("params", [_params(), default_wilac_parameters()],
                          ids=["fixture", "default"])  # fmt: skip
-def test_wilac_kernel_equals_numpy_reference(params):
+def test_wilac_kernel_equals_numpy_reference(params, monkeypatch):
     rng = np.random.default_rng(7)
-    n = 9000  # above the parallel threshold
+    n = 9000
+    monkeypatch.setattr(kernels, "_PARALLEL_MIN_WILAC", 5000)  # run the parallel kernel
     args = [rng.uniform(-0.6, 0.6, n), rng.uniform(-0.01, 0.01, n), rng.uniform(-2, 2, n),
             rng.uniform(1e3, 1.5e5, n), rng.uniform(0, 50, n), rng.uniform(1e-3, 9e-3, n),
             rng.uniform(1e-3, 9e-3, n), rng.uniform(0, 120, n)]  # fmt: skip
@@ -185,12 +187,16 @@ def test_pack_wilac_layout():
     params = _params()
     packed = kernels.pack_wilac(params)
     nterm = int(packed[kernels.HEADER_SIZE])
-    assert nterm == 3 and packed.size == kernels.HEADER_SIZE + 1 + 4 * 5 * nterm * 4
+    assert nterm == 3 and packed.size == kernels.HEADER_SIZE + 21 + 4 * 5 * nterm * 4
     assert packed[:6].tolist() == [1e5, 40.0, 4e3, 1e5, 1.0, 40.0]
-    reg = packed[kernels.HEADER_SIZE + 1 :].reshape(4, 5, nterm, 4)
+    counts = packed[kernels.HEADER_SIZE + 1 : kernels.HEADER_SIZE + 21].reshape(4, 5)
+    reg = packed[kernels.HEADER_SIZE + 21 :].reshape(4, 5, nterm, 4)
     damp2 = WILAC_CONDITIONS.index("damp2")
-    # mu0 of damp2: 0.1 + 0.05 Q' + 0.01 (1/v') exp(Q'): factor indices Q=0, 1/v=3, exp(Q)=4
-    assert reg[damp2, 2].tolist() == [[0.1, -1, -1, -1], [0.05, 0, -1, -1], [0.01, 3, 4, -1]]
+    assert counts[damp2].tolist() == [1, 1, 3, 1, 1]
+    # mu0 of damp2: 0.1 + 0.05 Q' + 0.01 (1/v') exp(Q'): factor indices Q=0, 1/v=3, exp(Q)=4,
+    # 6 for none (the factor 1)
+    assert reg[damp2, 2].tolist() == [[0.1, 6, 6, 6], [0.05, 0, 6, 6], [0.01, 3, 4, 6]]
+    assert reg[damp2, 0].tolist() == [[0.2, 6, 6, 6], [0, 0, 0, 0], [0, 0, 0, 0]]
 
 
 def test_jitted_api_is_callable_from_user_numba_code():

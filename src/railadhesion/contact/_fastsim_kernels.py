@@ -16,8 +16,9 @@ from numba import njit, prange
 
 _TINY_TRACTION = 1e-30
 _FACPHI = 1.0 / 6.0
-#: Below this many contacts the serial kernels run (thread start-up costs more).
-_PARALLEL_MIN = 64
+#: Below this many contacts the serial kernels run (thread start-up, and on a busy machine
+#: waiting for a descheduled thread, cost more than the work).
+_PARALLEL_MIN = 500
 
 
 @njit(cache=True, error_model="numpy")

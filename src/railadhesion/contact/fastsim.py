@@ -11,8 +11,13 @@ Two grid layouts are offered: Kalker's strips (each lateral strip split into ele
 its own length; the default, converging fast) and CONTACT's rectangular grid (reproduces the
 numbers of Vollebregt's CONTACT program, e.g. its ``fastsim`` example).
 
-This module solves many contacts at once: every input broadcasts to a *contact shape*, the
-contacts and the grid rows are vectorised, and the only Python loop is the march along x.
+This module solves many contacts at once: every input broadcasts to a *contact shape*. The
+march runs in compiled code (numba, :mod:`railadhesion.contact._fastsim_kernels`): the strips
+advance side by side in the inner loop, and large batches of contacts run in parallel; one
+contact given as scalars takes a short path with ``math`` around the compiled march. The
+NumPy march (contacts and grid rows vectorised, a Python loop along x) is kept as the readable
+reference; it runs when ``return_tractions=True`` and the tests hold the compiled march to it
+at 1e-12.
 
 Sign convention (``docs/CONVENTIONS.md``): the returned forces are exerted by the rail on the
 wheel and oppose the creepage (Kalker's, as CONTACT); at small creepage
@@ -290,6 +295,10 @@ def fastsim(
     in its ``fastsim`` example (FLX1..3 = 0.4937, 0.5152, 0.4090 e-4 mm^3/N) implies a weight
     w = 0.0799, i.e. ``f_crp`` without the spin terms (this formula gives 0.110); both agree
     on the forces of that example to 0.35 %.
+
+    Creepages beyond 1e50 in magnitude (max of |xi|, |eta|, |phi| a) are scaled down to
+    1e50, all three by the same factor: the contact is then in full slip, where the result
+    does not depend on the magnitude (|F| = mu Fz), and the march cannot overflow.
 
     *Algorithm* (Kalker 1982). Rigid slip ``w = (xi - phi y, eta + phi x)``. Along each
     row, from the leading edge, the trial traction is

@@ -87,13 +87,17 @@ _EPS_MAX = 1e50
 _LOG4 = math.log(4.0)
 _LOG2 = math.log(2.0)
 
-#: Length of the ``header`` array of :func:`pack_wilac`.
+#: Number of header values of a packed WILAC set (:func:`pack_wilac`).
 HEADER_SIZE = 22
 #: Number of contacts a thread processes in sequence (the Kalker lookup is reused within it
 #: while a/b and nu do not change).
 _CHUNK = 2048
-#: Below this many contacts the serial kernels are used (thread start-up costs more).
-_PARALLEL_MIN = 8192
+#: Below this many contacts the serial kernels are used: thread start-up and, on a busy
+#: machine, waiting for a descheduled thread at the end of the parallel loop cost more than
+#: the work (measured: 10^4 contacts took 60 ms with 2 threads on a loaded machine, 0.3 ms
+#: serially).
+_PARALLEL_MIN = 100_000
+_PARALLEL_MIN_WILAC = 20_000
 
 
 # --- Kalker ---------------------------------------------------------------------------------
@@ -379,67 +383,295 @@ def _bad_polach(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu):
     return not (_AOB_MIN <= r <= _AOB_MAX)
 
 
+# Rational approximation of arctan on [0, 0.66] after range reduction (coefficients of
+# S. L. Moshier's Cephes library, ``atan.c``): within 1 ulp of libm's atan, and free of calls
+# and branches so that loops over it vectorise.
+_AT_P = (-8.750608600031904122785e-1, -1.615753718733365076637e1, -7.500855792314704667340e1,
+         -1.228866684490136173410e2, -6.485021904942025371773e1)  # fmt: skip
+_AT_Q = (2.485846490142306297962e1, 1.650270098316988542046e2, 4.328810604912902668951e2,
+         4.853903996359136964868e2, 1.945506571482613964425e2)  # fmt: skip
+_AT_MOREBITS = 6.123233995736765886130e-17
+_AT_T3P8 = 2.41421356237309504880  # tan(3 pi/8)
+
+
+# exp(x) = 2^n exp(r), n = round(x/ln 2), r = x - n ln 2 (ln 2 split in two: fdlibm's
+# constants, exact products for |n| < 2^11), exp(r) by its Taylor series to r^13 (|r| <= 0.35:
+# truncation below 1e-17 relative): within an ulp of libm's exp, vectorisable.
+_LN2_HI = 6.93147180369123816490e-01
+_LN2_LO = 1.90821492927058770002e-10
+_LOG2E = 1.4426950408889634
+_EXP_C = tuple(1.0 / math.factorial(k) for k in range(14))
+
+
+@njit(cache=True, error_model="numpy")
+def _atan_nonneg(x):
+    """arctan(x) for x >= 0 (within an ulp of ``math.atan``), vectorisable."""
+    big = x > _AT_T3P8
+    mid = x > 0.66
+    xr = -1.0 / x if big else ((x - 1.0) / (x + 1.0) if mid else x)
+    y0 = _PI / 2.0 if big else (_PI / 4.0 if mid else 0.0)
+    extra = _AT_MOREBITS if big else (0.5 * _AT_MOREBITS if mid else 0.0)
+    z = xr * xr
+    pz = (((_AT_P[0] * z + _AT_P[1]) * z + _AT_P[2]) * z + _AT_P[3]) * z + _AT_P[4]
+    qz = ((((z + _AT_Q[0]) * z + _AT_Q[1]) * z + _AT_Q[2]) * z + _AT_Q[3]) * z + _AT_Q[4]
+    return y0 + ((xr * (z * pz / qz) + xr) + extra)
+
+
+@njit(cache=True, error_model="numpy")
+def _chunk(arr, const, lo, hi):
+    """arr[lo:hi], or the first hi - lo values of ``const`` (arr repeated) if arr has one."""
+    if arr.size == 1:
+        return const[: hi - lo]
+    return arr[lo:hi]
+
+
 def _polach_many_py(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu, n):
     """Polach over n contacts; every argument a 1-d float64 array of length n or 1.
 
     Returns (fx, fy, ok); ``ok`` False if an argument is out of range (the caller then runs
-    the reference validation to raise the error naming it).
+    the reference validation to raise the error naming it). Contacts are processed in
+    chunks; within a chunk the common case runs in call-free, branch-free loops that the
+    compiler vectorises, and contacts needing care (zero creepage, magnitudes beyond
+    1e+-150, no friction left) are recomputed by the scalar code of :func:`polach_scalar`.
     """
     fx = np.empty(n)
     fy = np.empty(n)
-    s0 = 1 if sx.size > 1 else 0
-    s1 = 1 if sy.size > 1 else 0
-    s2 = 1 if psi.size > 1 else 0
-    s3 = 1 if q.size > 1 else 0
-    s4 = 1 if v.size > 1 else 0
-    s5 = 1 if a.size > 1 else 0
-    s6 = 1 if b.size > 1 else 0
-    s7 = 1 if mu0.size > 1 else 0
-    s8 = 1 if k_a.size > 1 else 0
-    s9 = 1 if k_s.size > 1 else 0
-    s10 = 1 if big_a.size > 1 else 0
-    s11 = 1 if big_b.size > 1 else 0
-    s12 = 1 if g.size > 1 else 0
-    s13 = 1 if nu.size > 1 else 0
+    m0 = max(min(_CHUNK, n), 1)
+    k_sx = np.full(m0, sx[0])
+    k_sy = np.full(m0, sy[0])
+    k_psi_ = np.full(m0, psi[0])
+    k_q = np.full(m0, q[0])
+    k_v = np.full(m0, v[0])
+    k_a_ = np.full(m0, a[0])
+    k_b = np.full(m0, b[0])
+    k_mu0 = np.full(m0, mu0[0])
+    k_ka = np.full(m0, k_a[0])
+    k_ks = np.full(m0, k_s[0])
+    k_ba = np.full(m0, big_a[0])
+    k_bb = np.full(m0, big_b[0])
+    k_g = np.full(m0, g[0])
+    k_nu = np.full(m0, nu[0])
+    const_shape = a.size == 1 and b.size == 1 and nu.size == 1
+    c11_0 = c22_0 = c23_0 = 0.0
+    kpsi_0 = 1.0
+    if const_shape and 0.0 < a[0] < math.inf and 0.0 < b[0] < math.inf and 0.0 <= nu[0] <= 0.5:
+        r0 = a[0] / b[0]
+        if _AOB_MIN <= r0 <= _AOB_MAX:
+            c11_0, c22_0, c23_0 = _kalker3(r0, nu[0])
+            kpsi_0 = 1.0 + 6.3 * (1.0 - math.exp(-r0))
+    shape_ok = not const_shape or c11_0 > 0.0
+    const_mu = big_a.size == 1 and big_b.size == 1 and (big_b[0] == 0.0 or big_a[0] == 1.0)
+    spin_free = psi.size == 1 and psi[0] == 0.0
     nchunk = (n + _CHUNK - 1) // _CHUNK
     bad = np.zeros(nchunk, dtype=np.uint8)
     for c in prange(nchunk):
         lo = c * _CHUNK
         hi = min(lo + _CHUNK, n)
-        last_r = -1.0
-        last_nu = -1.0
-        c11 = c22 = c23 = 0.0
-        for i in range(lo, hi):
-            xa = a[i * s5]
-            xb = b[i * s6]
-            xnu = nu[i * s13]
-            xq = q[i * s3]
-            xv = v[i * s4]
-            xsx = sx[i * s0]
-            xsy = sy[i * s1]
-            xpsi = psi[i * s2]
-            xg = g[i * s12]
-            p_mu0 = mu0[i * s7]
-            p_ka = k_a[i * s8]
-            p_ks = k_s[i * s9]
-            p_a = big_a[i * s10]
-            p_b = big_b[i * s11]
-            if _bad_polach(xsx, xsy, xpsi, xq, xv, xa, xb, p_mu0, p_ka, p_ks, p_a, p_b, xg,
-                           xnu):  # fmt: skip
-                bad[c] = 1
-                fx[i] = math.nan
-                fy[i] = math.nan
-                continue
-            r = xa / xb
-            if r != last_r or xnu != last_nu:
-                c11, c22, c23 = _kalker3(r, xnu)
-                last_r = r
-                last_nu = xnu
-            t = _contact_terms(xsx, xsy, xpsi, xa, xb, xg, c11, c22, c23)
-            fxi, fyi = _polach_terms(xsx, xsy, xq, xv, t[0], t[1], t[2], t[3], t[4], t[5],
-                                     t[6], p_ka, p_ks, p_mu0, p_a, p_b)  # fmt: skip
-            fx[i] = fxi
-            fy[i] = fyi
+        m = hi - lo
+        xs = _chunk(sx, k_sx, lo, hi)
+        ys = _chunk(sy, k_sy, lo, hi)
+        ps = _chunk(psi, k_psi_, lo, hi)
+        qs = _chunk(q, k_q, lo, hi)
+        vs = _chunk(v, k_v, lo, hi)
+        as_ = _chunk(a, k_a_, lo, hi)
+        bs = _chunk(b, k_b, lo, hi)
+        mus = _chunk(mu0, k_mu0, lo, hi)
+        kas = _chunk(k_a, k_ka, lo, hi)
+        kss = _chunk(k_s, k_ks, lo, hi)
+        bas = _chunk(big_a, k_ba, lo, hi)
+        bbs = _chunk(big_b, k_bb, lo, hi)
+        gs = _chunk(g, k_g, lo, hi)
+        nus = _chunk(nu, k_nu, lo, hi)
+        # validation (vectorised count of out-of-range values)
+        nbad = 0
+        for k in range(m):
+            ok = (
+                (xs[k] - xs[k] == 0.0) & (ys[k] - ys[k] == 0.0) & (ps[k] - ps[k] == 0.0)
+                & (qs[k] > 0.0) & (qs[k] < math.inf) & (vs[k] >= 0.0) & (vs[k] < math.inf)
+                & (as_[k] > 0.0) & (as_[k] < math.inf) & (bs[k] > 0.0) & (bs[k] < math.inf)
+                & (mus[k] > 0.0) & (mus[k] < math.inf) & (kas[k] > 0.0) & (kas[k] <= 1.0)
+                & (kss[k] > 0.0) & (kss[k] <= 1.0) & (bas[k] >= 0.0) & (bas[k] < math.inf)
+                & (bbs[k] >= 0.0) & (bbs[k] < math.inf) & (gs[k] > 0.0) & (gs[k] < math.inf)
+                & (nus[k] >= 0.0) & (nus[k] <= 0.5)
+            )  # fmt: skip
+            nbad += 0 if ok else 1
+        if nbad > 0 or not shape_ok:
+            bad[c] = 1
+            for k in range(m):
+                fx[lo + k] = math.nan
+                fy[lo + k] = math.nan
+            continue
+        # Kalker's coefficients and K_psi per contact (once per call if a/b is constant)
+        c11 = np.empty(m)
+        c22 = np.empty(m)
+        c23 = np.empty(m)
+        kpsi = np.empty(m)
+        if const_shape:
+            c11[:] = c11_0
+            c22[:] = c22_0
+            c23[:] = c23_0
+            kpsi[:] = kpsi_0
+        else:  # vectorised table lookup; the asymptotic range (g < 0.1) by the scalar code
+            kbits = np.empty(m, dtype=np.int64)
+            k_two_n = kbits.view(np.float64)
+            for k in range(m):
+                r = as_[k] / bs[k]
+                nu_k = nus[k]
+                le = r <= 1.0
+                gk = r if le else 1.0 / r
+                t = gk if le else 2.0 - gk
+                sidx = (min(max(t, 0.1), 1.9) - 0.1) * 10.0
+                sr = math.floor(sidx + 0.5)
+                sidx = sr if abs(sidx - sr) < 1e-9 else sidx
+                i = min(int(sidx), _KNROW - 2)
+                f = sidx - i
+                e = 1.0 - f
+                w0 = 8.0 * (nu_k - 0.25) * (nu_k - 0.5)
+                w1 = -16.0 * (nu_k - 0.5) * nu_k
+                w2 = 8.0 * nu_k * (nu_k - 0.25)
+                c11[k] = _nu_blend(w0, w1, w2, _KROWS[i, 0, 0] * e + _KROWS[i + 1, 0, 0] * f,
+                                   _KROWS[i, 0, 1] * e + _KROWS[i + 1, 0, 1] * f,
+                                   _KROWS[i, 0, 2] * e + _KROWS[i + 1, 0, 2] * f)  # fmt: skip
+                c22[k] = _nu_blend(w0, w1, w2, _KROWS[i, 1, 0] * e + _KROWS[i + 1, 1, 0] * f,
+                                   _KROWS[i, 1, 1] * e + _KROWS[i + 1, 1, 1] * f,
+                                   _KROWS[i, 1, 2] * e + _KROWS[i + 1, 1, 2] * f)  # fmt: skip
+                c23[k] = _nu_blend(w0, w1, w2, _KROWS[i, 2, 0] * e + _KROWS[i + 1, 2, 0] * f,
+                                   _KROWS[i, 2, 1] * e + _KROWS[i + 1, 2, 1] * f,
+                                   _KROWS[i, 2, 2] * e + _KROWS[i + 1, 2, 2] * f)  # fmt: skip
+                # K_psi = 1 + 6.3 (1 - exp(-a/b)), exp as in the friction loop below
+                arg = max(-r, -700.0)
+                nn = math.floor(arg * _LOG2E + 0.5)
+                rr = (arg - nn * _LN2_HI) - nn * _LN2_LO
+                ex = _EXP_C[13]
+                for j in range(12, -1, -1):
+                    ex = ex * rr + _EXP_C[j]
+                kpsi[k] = ex
+                kbits[k] = (np.int64(nn) + 1023) << 52
+            for k in range(m):
+                kpsi[k] = 1.0 + 6.3 * (1.0 - kpsi[k] * k_two_n[k])
+            for k in range(m):
+                r = as_[k] / bs[k]
+                if not (r >= _KG_MIN and r <= 1.0 / _KG_MIN):  # asymptotes, or out of range
+                    if not _AOB_MIN <= r <= _AOB_MAX:
+                        bad[c] = 1
+                        r = 1.0
+                    c11[k], c22[k], c23[k] = _kalker3(r, nus[k])
+        # Creepage geometry, friction, force and spin in short loops that the compiler
+        # vectorises (each loop touches few arrays, so that its aliasing checks stay few);
+        # contacts needing care are flagged for the scalar code below.
+        scs = np.empty(m)
+        absyc = np.empty(m)
+        ss = np.empty(m)
+        cjj = np.empty(m)
+        epsn = np.empty(m)
+        flag = np.empty(m, dtype=np.uint8)
+        for k in range(m):
+            y = ys[k]
+            syc = y + ps[k] * as_[k]
+            syc = syc if abs(syc) > abs(y) else y
+            absyc[k] = abs(syc)
+            scs[k] = math.sqrt(xs[k] * xs[k] + syc * syc)
+        for k in range(m):
+            ss[k] = math.sqrt(xs[k] * xs[k] + ys[k] * ys[k])
+        for k in range(m):
+            u = c11[k] * xs[k]
+            w = c22[k] * ys[k]
+            cjj[k] = math.sqrt(u * u + w * w) / ss[k] if ss[k] > 0.0 else c22[k]
+        for k in range(m):
+            epsn[k] = _PI_OVER_4 * gs[k] * as_[k] * bs[k] * cjj[k] * scs[k]
+        for k in range(m):
+            m1 = max(abs(xs[k]), absyc[k])
+            m2 = max(abs(xs[k]), abs(ys[k]))
+            m3 = max(abs(c11[k] * xs[k]), abs(c22[k] * ys[k]))
+            fine = (
+                ((m1 > 1e-150) & (m1 < 1e150))
+                & ((m2 == 0.0) | ((m2 > 1e-150) & (m2 < 1e150)))
+                & ((m3 == 0.0) | ((m3 > 1e-150) & (m3 < 1e150)))
+            )
+            flag[k] = 0 if fine else 1
+        # friction coefficient
+        qmus = np.empty(m)
+        if const_mu:
+            for k in range(m):
+                qmus[k] = qs[k] * mus[k]
+        else:  # exp(-B w) without calls: 2^n from its bits, exp(r) by its Taylor series
+            expo = np.empty(m)
+            bits = np.empty(m, dtype=np.int64)
+            two_n = bits.view(np.float64)
+            for k in range(m):
+                arg = -bbs[k] * (scs[k] * vs[k])
+                expo[k] = arg
+            for k in range(m):
+                arg = expo[k]
+                flag[k] = flag[k] | (0 if arg >= -700.0 else 1)  # NaN (0 * inf) included
+                arg = max(arg, -700.0)
+                nn = math.floor(arg * _LOG2E + 0.5)
+                r = (arg - nn * _LN2_HI) - nn * _LN2_LO
+                e = _EXP_C[13]
+                for j in range(12, -1, -1):
+                    e = e * r + _EXP_C[j]
+                expo[k] = e
+                bits[k] = (np.int64(nn) + 1023) << 52
+            for k in range(m):
+                expo[k] = expo[k] * two_n[k]
+            for k in range(m):
+                ba = bas[k]
+                mu = mus[k] * ((1.0 - ba) * expo[k] + ba)
+                qmus[k] = qs[k] * (mus[k] if (bbs[k] == 0.0) | (ba == 1.0) else mu)
+        for k in range(m):
+            flag[k] = flag[k] | (0 if qmus[k] > 1e-300 else 1)
+        # Polach's force (arctan without calls)
+        fos = np.empty(m)
+        for k in range(m):
+            qmu = qmus[k]
+            eps = min(epsn[k] / qmu, _EPS_MAX)
+            x = kas[k] * eps
+            fos[k] = _TWO_OVER_PI * qmu * (x / (1.0 + x * x) + _atan_nonneg(kss[k] * eps)) / scs[k]
+        ox = fx[lo:hi]
+        oy = fy[lo:hi]
+        for k in range(m):
+            ox[k] = -fos[k] * xs[k]
+        for k in range(m):
+            oy[k] = -fos[k] * ys[k]
+        # spin
+        if not spin_free:
+            gc3 = np.empty(m)
+            fys = np.empty(m)
+            for k in range(m):
+                aa = as_[k]
+                gc3[k] = gs[k] * aa * bs[k] * math.sqrt(aa * bs[k]) * c23[k]
+            for k in range(m):
+                eps_psi = 8.0 / 3.0 * gc3[k] / as_[k] * absyc[k] / (kpsi[k] * qmus[k])
+                fys[k] = 1.0 + eps_psi * eps_psi  # e2
+            for k in range(m):
+                e2 = fys[k]
+                value = gc3[k] * (ps[k] / scs[k]) * (absyc[k] / e2) / e2
+                fys[k] = value if ps[k] != 0.0 else 0.0
+            for k in range(m):
+                oy[k] = oy[k] - fys[k]
+            for k in range(m):
+                fxk = ox[k]
+                fyk = oy[k]
+                limit = max(qmus[k], fos[k] * ss[k])
+                total = math.sqrt(fxk * fxk + fyk * fyk)
+                cap = (fys[k] != 0.0) & (total > limit)
+                scale = limit / total if cap else 1.0
+                ox[k] = fxk * scale
+                oy[k] = fyk * scale
+            for k in range(m):
+                mf = max(abs(ox[k]), abs(oy[k]))
+                fine = (fys[k] == 0.0) | ((mf > 1e-150) & (mf < 1e150))
+                flag[k] = flag[k] | (0 if fine else 1)
+        # the careful scalar code where flagged
+        for k in range(m):
+            if flag[k] != 0:
+                t = _contact_terms(xs[k], ys[k], ps[k], as_[k], bs[k], gs[k], c11[k], c22[k],
+                                   c23[k])  # fmt: skip
+                fxi, fyi = _polach_terms(xs[k], ys[k], qs[k], vs[k], t[0], t[1], t[2], t[3],
+                                         t[4], t[5], t[6], kas[k], kss[k], mus[k], bas[k],
+                                         bbs[k])  # fmt: skip
+                fx[lo + k] = fxi
+                fy[lo + k] = fyi
     return fx, fy, bad.sum() == 0
 
 
@@ -456,28 +688,34 @@ def polach_many(args, n):
 # --- WILAC ----------------------------------------------------------------------------------
 
 
+#: Offset of the term counts, and of the regressions, in a packed WILAC set.
+_COUNTS = HEADER_SIZE + 1
+_TERMS = _COUNTS + 20
+
+
 def pack_wilac(params):
     """Pack a :class:`~railadhesion.models.wilac.WilacParameters` into one float64 array.
 
     Returns
     -------
-    numpy.ndarray, shape (23 + 80 T,)
+    numpy.ndarray, shape (43 + 80 T,)
         ``packed[0:22]``: ``[Q_ref, v_ref, Q_low, Q_high, v_low, v_high, m1, s1, m2, s2,
         m3, s3, k_A_low, k_A_high, k_S_low, k_S_high, mu0_low, mu0_high, A_low, A_high,
         B_low, B_high]``, i.e. the normalisation, the calibrated ranges (Q and v are clamped
         into them), the three erf transitions (midpoint, width) [µl/s] and the clipping bounds
         of the five Polach parameters; ``packed[22]``: T, the largest number of terms of any
-        regression; ``packed[23:]``: the regressions, an array of shape (4, 5, T, 4) in C
-        order: for condition i (dry, damp2, damp1, wet), parameter j (k_A, k_S, mu0, A, B)
-        and term k, ``(coefficient, f1, f2, f3)`` with the factor indices f into
-        ``(Q', v', 1/Q', 1/v', exp(Q'), exp(v'))`` stored as floats, -1 for none; unused terms
-        have coefficient 0.
+        regression; ``packed[23:43]``: the number of terms of each regression, (4, 5) in C
+        order; ``packed[43:]``: the regressions, an array of shape (4, 5, T, 4) in C order:
+        for condition i (dry, damp2, damp1, wet), parameter j (k_A, k_S, mu0, A, B) and term
+        k, ``(coefficient, f1, f2, f3)`` with the factor indices f into
+        ``(Q', v', 1/Q', 1/v', exp(Q'), exp(v'), 1)`` stored as floats (6, the factor 1, for
+        none); unused terms are zero.
 
     Examples
     --------
     >>> from railadhesion.models.wilac import default_wilac_parameters
     >>> packed = pack_wilac(default_wilac_parameters())
-    >>> packed.dtype, (packed.size - 23) % 80, packed[6:12].tolist()
+    >>> packed.dtype, (packed.size - 43) % 80, packed[6:12].tolist()
     (dtype('float64'), 0, [15.0, 5.0, 30.0, 3.0, 50.0, 7.0])
     """
     from railadhesion.models.wilac import PHYSICAL_BOUNDS, POLACH_PARAMETER_NAMES, WILAC_CONDITIONS
@@ -485,11 +723,12 @@ def pack_wilac(params):
     plan = params._scalar_plan
     nterm = max(len(plan[c][j][0]) for c in WILAC_CONDITIONS for j in range(5))
     regression = np.zeros((4, 5, nterm, 4))
-    regression[..., 1:] = -1.0
+    counts = np.zeros((4, 5))
     for i, cond in enumerate(WILAC_CONDITIONS):
         for j in range(5):
+            counts[i, j] = len(plan[cond][j][0])
             for k, (idx, coef) in enumerate(plan[cond][j][0]):
-                regression[i, j, k, 0] = coef
+                regression[i, j, k] = (coef, 6.0, 6.0, 6.0)
                 for m, f in enumerate(idx):
                     regression[i, j, k, 1 + m] = f
     header = np.empty(HEADER_SIZE + 1)
@@ -500,52 +739,59 @@ def pack_wilac(params):
     header[6:12] = np.ravel([(t.midpoint, t.width) for t in params.transitions])
     header[12:22] = np.ravel([PHYSICAL_BOUNDS[p] for p in POLACH_PARAMETER_NAMES])
     header[22] = nterm
-    return np.concatenate([header, regression.ravel()])
+    return np.concatenate([header, counts.ravel(), regression.ravel()])
 
 
 @njit(cache=True, error_model="numpy")
-def _regression_value(packed, nterm, i, j, fac, lo, hi):
-    """Value of regression (condition i, parameter j) of a packed set, clipped to [lo, hi]."""
-    total = 0.0
-    base = HEADER_SIZE + 1 + (i * 5 + j) * nterm * 4
-    for k in range(nterm):
-        p = base + 4 * k
-        value = packed[p]
-        if value == 0.0:
-            continue
-        for m in range(3):
-            f = int(packed[p + 1 + m])
-            if f >= 0:
-                value = value * fac[f]
-        total = total + value
-    return min(max(total, lo), hi)
+def _factors(q, v, packed, fac):
+    """Fill ``fac`` (7) with Q', v', 1/Q', 1/v', exp(Q'), exp(v'), 1 (inputs clamped)."""
+    qn = min(max(q, packed[2]), packed[3]) / packed[0]
+    vn = min(max(v, packed[4]), packed[5]) / packed[1]
+    fac[0] = qn
+    fac[1] = vn
+    fac[2] = 1.0 / qn
+    fac[3] = 1.0 / vn
+    fac[4] = math.exp(qn)
+    fac[5] = math.exp(vn)
+    fac[6] = 1.0
 
 
 @njit(cache=True, error_model="numpy")
-def _wilac_contact(sx, sy, psi, q, v, a, b, w, g, c11, c22, c23, header):
-    """WILAC forces of one validated contact with known Kalker coefficients."""
-    e1 = 0.5 * (math.erf((w - header[6]) / header[7]) + 1.0)
-    e2 = 0.5 * (math.erf((w - header[8]) / header[9]) + 1.0)
-    e3 = 0.5 * (math.erf((w - header[10]) / header[11]) + 1.0)
-    weights = (1.0 - e1, e1 - e2, e2 - e3, e3)
-    qn = min(max(q, header[2]), header[3]) / header[0]
-    vn = min(max(v, header[4]), header[5]) / header[1]
-    fac = (qn, vn, 1.0 / qn, 1.0 / vn, math.exp(qn), math.exp(vn))
-    nterm = int(header[HEADER_SIZE])
-    t = _contact_terms(sx, sy, psi, a, b, g, c11, c22, c23)
+def _condition_parameters(packed, i, fac, out):
+    """The five clipped Polach parameters of condition i into out[5 i : 5 i + 5]."""
+    nterm = int(packed[HEADER_SIZE])
+    for j in range(5):
+        base = _TERMS + (i * 5 + j) * nterm * 4
+        total = 0.0
+        for k in range(int(packed[_COUNTS + i * 5 + j])):
+            p = base + 4 * k
+            total = total + packed[p] * fac[int(packed[p + 1])] * fac[int(packed[p + 2])] * fac[
+                int(packed[p + 3])]  # fmt: skip
+        out[5 * i + j] = min(max(total, packed[12 + 2 * j]), packed[13 + 2 * j])
+
+
+@njit(cache=True, error_model="numpy")
+def _weights(w, packed):
+    e1 = 0.5 * (math.erf((w - packed[6]) / packed[7]) + 1.0)
+    e2 = 0.5 * (math.erf((w - packed[8]) / packed[9]) + 1.0)
+    e3 = 0.5 * (math.erf((w - packed[10]) / packed[11]) + 1.0)
+    return 1.0 - e1, e1 - e2, e2 - e3, e3
+
+
+@njit(cache=True, error_model="numpy")
+def _wilac_blend(sx, sy, q, v, t, weights, pars):
+    """Blend of the Polach forces of the conditions with non-zero weight (``pars`` holds
+    their parameters, (k_A, k_S, mu0, A, B) per condition)."""
     fx = 0.0
     fy = 0.0
     for i in range(4):
         f = weights[i]
         if f == 0.0:
             continue
-        k_a = _regression_value(header, nterm, i, 0, fac, header[12], header[13])
-        k_s = _regression_value(header, nterm, i, 1, fac, header[14], header[15])
-        mu0 = _regression_value(header, nterm, i, 2, fac, header[16], header[17])
-        big_a = _regression_value(header, nterm, i, 3, fac, header[18], header[19])
-        big_b = _regression_value(header, nterm, i, 4, fac, header[20], header[21])
+        b = 5 * i
         fxi, fyi = _polach_terms(sx, sy, q, v, t[0], t[1], t[2], t[3], t[4], t[5], t[6],
-                                 k_a, k_s, mu0, big_a, big_b)  # fmt: skip
+                                 pars[b], pars[b + 1], pars[b + 2], pars[b + 3],
+                                 pars[b + 4])  # fmt: skip
         fx = fx + f * fxi
         fy = fy + f * fyi
     return fx, fy
@@ -561,8 +807,15 @@ def wilac_scalar(creep_x, creep_y, spin, normal_force, speed, a, b, water_flow, 
     """
     if not c11 > 0.0:
         c11, c22, c23 = _kalker3(a / b, nu)
-    return _wilac_contact(creep_x, creep_y, spin, normal_force, speed, a, b, water_flow, G,
-                          c11, c22, c23, packed)  # fmt: skip
+    weights = _weights(water_flow, packed)
+    fac = np.empty(7)
+    pars = np.empty(20)
+    _factors(normal_force, speed, packed, fac)
+    for i in range(4):
+        if weights[i] != 0.0:
+            _condition_parameters(packed, i, fac, pars)
+    t = _contact_terms(creep_x, creep_y, spin, a, b, G, c11, c22, c23)
+    return _wilac_blend(creep_x, creep_y, normal_force, speed, t, weights, pars)
 
 
 @njit(cache=True, error_model="numpy")
@@ -580,7 +833,11 @@ def wilac_checked(creep_x, creep_y, spin, normal_force, speed, a, b, water_flow,
 
 
 def _wilac_many_py(sx, sy, psi, q, v, a, b, w, g, nu, packed, n):
-    """WILAC over n contacts (1-d float64 arrays of length n or 1); returns (fx, fy, ok)."""
+    """WILAC over n contacts (1-d float64 arrays of length n or 1); returns (fx, fy, ok).
+
+    Per chunk of contacts, the Kalker coefficients are reused while a/b and nu repeat and a
+    condition's Polach parameters while the (clamped) Q and v repeat.
+    """
     fx = np.empty(n)
     fy = np.empty(n)
     s0 = 1 if sx.size > 1 else 0
@@ -601,6 +858,12 @@ def _wilac_many_py(sx, sy, psi, q, v, a, b, w, g, nu, packed, n):
         last_r = -1.0
         last_nu = -1.0
         c11 = c22 = c23 = 0.0
+        fac = np.empty(7)
+        pars = np.empty(20)
+        key_q = np.full(4, math.nan)
+        key_v = np.full(4, math.nan)
+        last_q = math.nan
+        last_v = math.nan
         for i in range(lo, hi):
             xa = a[i * s5]
             xb = b[i * s6]
@@ -623,8 +886,18 @@ def _wilac_many_py(sx, sy, psi, q, v, a, b, w, g, nu, packed, n):
                 c11, c22, c23 = _kalker3(r, xnu)
                 last_r = r
                 last_nu = xnu
-            fxi, fyi = _wilac_contact(xsx, xsy, xpsi, xq, xv, xa, xb, xw, xg, c11, c22, c23,
-                                      packed)  # fmt: skip
+            weights = _weights(xw, packed)
+            if xq != last_q or xv != last_v:
+                _factors(xq, xv, packed, fac)
+                last_q = xq
+                last_v = xv
+            for k in range(4):
+                if weights[k] != 0.0 and (key_q[k] != xq or key_v[k] != xv):
+                    _condition_parameters(packed, k, fac, pars)
+                    key_q[k] = xq
+                    key_v[k] = xv
+            t = _contact_terms(xsx, xsy, xpsi, xa, xb, xg, c11, c22, c23)
+            fxi, fyi = _wilac_blend(xsx, xsy, xq, xv, t, weights, pars)
             fx[i] = fxi
             fy[i] = fyi
     return fx, fy, bad.sum() == 0
@@ -636,7 +909,7 @@ _wilac_many_ser = njit(cache=True, error_model="numpy")(_wilac_many_py)
 
 def wilac_many(args, packed, n):
     """Run the WILAC kernel on 1-d float64 arrays (length n or 1); serial for small n."""
-    kernel = _wilac_many_par if n >= _PARALLEL_MIN else _wilac_many_ser
+    kernel = _wilac_many_par if n >= _PARALLEL_MIN_WILAC else _wilac_many_ser
     return kernel(*args, packed, n)
 
 

@@ -152,6 +152,14 @@ def polach_forces(
 
     C11, C22, C23 come from :func:`railadhesion.contact.kalker.kalker_coefficients` at a/b.
 
+    Implementation: compiled kernels (:mod:`railadhesion.models.kernels`, numba, compiled on
+    first use and cached on disk) evaluate the model, validating in the same pass; the
+    Kalker lookup is done once per call when a/b and nu are constant. The NumPy reference
+    (``_polach_reference`` for arrays, ``_polach_scalar`` for scalars) is the readable
+    implementation the tests hold the kernels to (1e-12 relative); it also raises the errors
+    naming the argument. For repeated calls on one contact see :class:`PolachContact`; from
+    numba code, :func:`railadhesion.models.kernels.polach_scalar`.
+
     Implementation detail [derived here]: substituting delta, Polach's K_M simplifies
     exactly to K_M = -(2/3) eps_psi / (1 + eps_psi^2)^2, hence
     F_yS = G c^3 C23 psi (abs(s_yC) / s_C) / (1 + eps_psi^2)^2 with c = sqrt(ab). This form is

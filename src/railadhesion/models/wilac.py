@@ -139,11 +139,17 @@ def wilac_forces(
     with that condition's parameters (:meth:`WilacParameters.polach_parameters`), blended by
     the weighted sum of section 5.3,
     T = f_Dry T_Dry + f_Damp2 T_Damp2 + f_Damp1 T_Damp1 + f_Wet T_Wet, with the weights of
-    :func:`wilac_weights`. Conditions whose weight is exactly zero for every element are not
-    evaluated; the others go through a single call of
-    :func:`railadhesion.models.polach.polach_forces` (stacked on an extra axis). Scalar
-    arguments take a fast path (about 10–50 µs a call, depending on how many conditions have
-    non-zero weight).
+    :func:`wilac_weights`.
+
+    Implementation: one fused compiled kernel (:mod:`railadhesion.models.kernels`, numba)
+    computes, per contact, the weights, the regressions, the Polach forces of the conditions
+    whose weight is not exactly zero and the blend; the contact's Kalker coefficients and
+    creepage terms are computed once and shared by the conditions. Inputs are validated in the
+    same pass; on a bad input the NumPy reference (``_wilac_reference``: stacked conditions,
+    one Polach call) runs and raises the error naming the argument. The kernel is held to the
+    reference at 1e-12 by the tests. Every argument broadcasts, ``shear_modulus`` and
+    ``poisson`` included. For compiled inner loops see
+    :func:`railadhesion.models.kernels.wilac_scalar`.
 
     References
     ----------
