@@ -14,6 +14,7 @@ import xarray as xr
 
 import railadhesion as ra
 from railadhesion.contact import (
+    combined_elastic_constants,
     contact_semi_axes,
     hertz_3d_from_curvatures,
     line_contact_from_pressure,
@@ -61,6 +62,8 @@ CASES = {
     "line_contact": (lambda x: ra.line_contact(x, 0.0235), np.array([1e5, 2e5, 3e5, 4e5])),
     "line_contact_from_pressure": (lambda x: line_contact_from_pressure(x, 0.0235),
                                    np.array([5e8, 8e8, 1e9, 1.3e9])),
+    "combined_elastic_constants": (lambda x: combined_elastic_constants(x, 0.28, 2.0e11, 0.3),
+                                   np.array([1.9e11, 2.0e11, 2.1e11, 2.2e11])),
     "fastsim": (lambda x: ra.fastsim(x, 0.0, 0.0, 8e4, 8e-3, 4e-3, 0.3, nx=10, ny=10),
                 CREEP / 100),
 }  # fmt: skip

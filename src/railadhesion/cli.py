@@ -622,12 +622,13 @@ def fit_polach_cmd(
         if given:
             parts.append(", ".join(f"{n} = {result.params[n]:g}" for n in given) + " (--fixed)")
         if default:
+            example = ",".join(f"{n}=..." for n in default)
             parts.append(
                 ", ".join(f"{n} = {result.params[n]:g}" for n in default)
-                + " (model defaults; set them with --fixed, e.g. --fixed A=0.4,B=0.3)"
+                + f" (model defaults; set them with --fixed {example})"
             )
         console.print("note: not fitted, held at " + "; ".join(parts), markup=False,
-                      highlight=False)  # fmt: skip
+                      highlight=False, soft_wrap=True)  # fmt: skip
     if figure is not None:
         from railadhesion.plotting import plot_fit
 

@@ -502,7 +502,10 @@ def plot_fit(result, *, title: str = "", n_points: int = 200, ax=None):
     else:
         sign = -1.0 if np.mean(creep) < 0 else 1.0
         mags = np.abs(creep)
-        c = sign * np.linspace(0.0, float(mags.max()), int(n_points))
+        top = float(mags.max())
+        c = sign * np.unique(np.concatenate(
+            [np.linspace(0.0, top, int(n_points)), np.geomspace(top * 1e-4, top, int(n_points))]
+        ))  # fmt: skip
         model = np.asarray(result.predict(c))
     fitted = ", ".join(result.fitted)
     ax.plot(100 * np.abs(c), model, color="C0",

@@ -115,6 +115,7 @@ class LineContact:
     effective_modulus: float | np.ndarray
 
 
+@labelled(units=("Pa", "Pa", "1"))
 def combined_elastic_constants(young, poisson, young_rail=None, poisson_rail=None):
     """Effective modulus E*, combined shear modulus G and Poisson's ratio nu of two bodies.
 
