@@ -22,7 +22,7 @@ from railadhesion.cli import app
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
-# A shorter version of examples/brake_damp.toml (90 km/h, damp 20-300 m), to keep tests quick.
+# A shorter version of examples/brake_damp.toml (90 km/h, damp from 20 m on), to keep tests quick.
 DAMP = """
 format = "railadhesion-brake-scenario"
 version = 1
@@ -39,7 +39,7 @@ max_pressure_Pa = 6.0e5
 model = "wilac"
 [[adhesion.sections]]
 start_m = 20.0
-end_m = 300.0
+end_m = 2000.0
 water_flow_ul_s = 25.0
 [wsp]
 period_s = 0.005
@@ -54,9 +54,11 @@ def damp_runs(tmp_path_factory):
     sc = load_scenario(path)
     with_wsp, dry = run_scenario(sc)
     halved = sc.simulate(dt=sc.dt / 2)
+    watchdog = sc.wsp.watchdog_time
     sc.wsp = None
     without = sc.simulate()
-    return {"sc": sc, "wsp": with_wsp, "dry": dry, "halved": halved, "without": without}
+    return {"watchdog": watchdog, "wsp": with_wsp, "dry": dry, "halved": halved,
+            "without": without}
 
 
 def test_step_halving_converges_on_damp_scenario_with_wsp(damp_runs):
@@ -72,12 +74,14 @@ def test_damp_rail_without_wsp_axles_lock_and_stay_locked(damp_runs):
     # every axle locks and stays locked to the stop (WILAC's low adhesion at full slide)
     for ax in res.summary["axles"]:
         assert ax["longest_lock_s"] > 0.8 * res.stopping_time
-    assert (h["creep_1"].iloc[-10:] > 0.95).all()
+    locked_from = h["time"][h["creep_1"] >= 0.95].iloc[0]
+    later = h[(h["time"] > locked_from) & (h["train_speed"] > 2.0)]
+    assert (later["creep_1"] >= 0.95).all()  # no recovery while the train still runs
 
 
 def test_damp_rail_with_wsp_watchdog_bound_and_shorter_stop(damp_runs):
     with_wsp, without, dry = damp_runs["wsp"], damp_runs["without"], damp_runs["dry"]
-    watchdog = damp_runs["sc"].wsp.watchdog_time
+    watchdog = damp_runs["watchdog"]
     assert with_wsp.summary["longest_lock_s"] <= watchdog
     assert with_wsp.stopping_distance < without.stopping_distance
     # extension against the dry stop is reported and positive
@@ -110,11 +114,14 @@ def test_wsp_controller_never_sees_train_speed_and_watchdog_refills():
 def test_polach_dry_vs_wet_wet_stop_longer():
     veh = Vehicle()
     cyl = BrakeCylinders(max_pressure=6e5)
-    dry = simulate(veh, PolachAdhesion("polach2005_dry"), 15.0, 6e5, cylinders=cyl, dt=4e-3,
+    kw = dict(cylinders=cyl, dt=4e-3)
+    dry = simulate(veh, PolachAdhesion("polach2005_dry"), 30.0, 6e5, **kw,
                    wsp=WheelSlideProtection(period=8e-3))
-    wet = simulate(veh, PolachAdhesion("polach2005_wet"), 15.0, 6e5, cylinders=cyl, dt=4e-3,
+    wet = simulate(veh, PolachAdhesion("polach2005_wet"), 30.0, 6e5, **kw,
                    wsp=WheelSlideProtection(period=8e-3))
-    assert wet.stopping_distance > dry.stopping_distance
+    assert dry.summary["vent_actions"] == 0  # no false WSP action on the dry rail
+    assert wet.summary["vent_actions"] > 0
+    assert wet.stopping_distance > 1.01 * dry.stopping_distance
 
 
 @pytest.mark.parametrize(

@@ -48,6 +48,7 @@ SCENARIO_FORMAT = "railadhesion-brake-scenario"
 _WSP_KEYS = {
     "period_s": ("period", 1e-4, 0.1),
     "reference_deceleration_m_s2": ("reference_deceleration", 0.1, 10.0),
+    "sliding_reference_deceleration_m_s2": ("sliding_reference_deceleration", 0.1, 10.0),
     "hold_slip_ratio": ("hold_slip_ratio", 0.0, 1.0),
     "hold_slip_min_m_s": ("hold_slip_min", 0.0, 10.0),
     "vent_slip_ratio": ("vent_slip_ratio", 0.0, 1.0),
