@@ -211,3 +211,21 @@ def test_stepping_api_compiled_matches_python():
     np.testing.assert_allclose(fast.histories().to_numpy(), slow.histories().to_numpy(),
                                rtol=1e-9, atol=1e-9)
     np.testing.assert_array_equal(fast.vent_actions, slow.vent_actions)
+
+
+def test_fletcher_condition_as_user_callable_and_xarray_result():
+    from railadhesion import fletcher_condition
+
+    water = fletcher_condition("W1")  # Fletcher 2013 twin-disc, water
+
+    def mu(creep, speed):
+        return np.asarray(water.adhesion(creep), float)
+
+    res = simulate(VEHICLE, CallableAdhesion(mu, label="Fletcher W1"), 8.0, 4e5,
+                   cylinders=BrakeCylinders(max_pressure=6e5), dt=5e-3)
+    assert res.success and res.settings["adhesion"]["function"] == "Fletcher W1"
+    ds = res.to_xarray()
+    assert ds["wheel_speed"].dims == ("time", "axle") and ds.sizes["axle"] == 4
+    np.testing.assert_allclose(ds["train_speed"].values, res.histories["train_speed"])
+    # the slip adhesion used never exceeds the friction coefficient of the condition
+    assert ds["adhesion_used"].max() <= water.mu + 1e-9

@@ -49,7 +49,7 @@ def family_curve(xi, speed, weights, params, stiffness):
 
 @njit(cache=True)
 def solve_wheels_family(v, omega0, pbar, loads, dt, radius, inertia, brake_coefficient,
-                        weights, params, stiffness, tol):
+                        weights, params, stiffness, tol, guess):
     """Backward-Euler wheel speeds for a trial train speed v (see the simulator docstring).
 
     Returns (omega, mu, status) with status 0 = ok, 1 = non-finite adhesion.
@@ -72,7 +72,7 @@ def solve_wheels_family(v, omega0, pbar, loads, dt, radius, inertia, brake_coeff
             continue
         lo = 0.0
         hi = omega0[i] + dt * rn * 2.0 / inertia + 1e-9
-        w = min(max(omega0[i], lo), hi)
+        w = min(max(guess[i], lo), hi)
         mu = 0.0
         for _ in range(100):
             xi = (v - w * radius) / vr
@@ -118,15 +118,43 @@ def family_evaluate(creep, speed, weights, params, stiffness):
 
 @njit(cache=True)
 def family_peak(speed, weights, params, stiffness):
-    """Largest μ per axle over 64 log-spaced creepages from 1e-4 to 1 (adhesion available)."""
+    """Largest μ per axle over creepage 1e-4 … 1 (the adhesion available).
+
+    A 17-point log-spaced grid, then a golden-section search (16 evaluations) in log creepage
+    between the neighbours of the best grid point.
+    """
     n = weights.shape[0]
     out = np.zeros(n)
+    g = 0.6180339887498949
     for i in range(n):
-        for j in range(64):
-            xi = 10.0 ** (-4.0 + 4.0 * j / 63.0)
-            mu, _ = family_curve(xi, speed, weights[i], params[i], stiffness[i])
-            if mu > out[i]:
-                out[i] = mu
+        best = -1.0
+        jbest = 0
+        for j in range(17):
+            mu, _ = family_curve(10.0 ** (-4.0 + 0.25 * j), speed, weights[i], params[i],
+                                 stiffness[i])
+            if mu > best:
+                best = mu
+                jbest = j
+        lo = -4.0 + 0.25 * max(jbest - 1, 0)
+        hi = -4.0 + 0.25 * min(jbest + 1, 16)
+        x1 = hi - g * (hi - lo)
+        x2 = lo + g * (hi - lo)
+        f1, _ = family_curve(10.0 ** x1, speed, weights[i], params[i], stiffness[i])
+        f2, _ = family_curve(10.0 ** x2, speed, weights[i], params[i], stiffness[i])
+        for _ in range(14):
+            if f1 > f2:
+                hi = x2
+                x2 = x1
+                f2 = f1
+                x1 = hi - g * (hi - lo)
+                f1, _ = family_curve(10.0 ** x1, speed, weights[i], params[i], stiffness[i])
+            else:
+                lo = x1
+                x1 = x2
+                f1 = f2
+                x2 = lo + g * (hi - lo)
+                f2, _ = family_curve(10.0 ** x2, speed, weights[i], params[i], stiffness[i])
+        out[i] = max(best, f1, f2)
     return out
 
 
@@ -170,7 +198,7 @@ def advance_family(v0, decel0, dt, omega0, p0, valves, command, static_load, tra
     for _ in range(20):
         omega, mu, status = solve_wheels_family(v, omega0, pbar, loads, dt, radius, inertia,
                                                 brake_coefficient, weights, params, stiffness,
-                                                tol)
+                                                tol, omega)
         if status != 0:
             return v, omega, p1, mu, loads, vented, 0.0, 0.0, 0.0, status
         total = 0.0

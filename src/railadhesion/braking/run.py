@@ -128,11 +128,13 @@ class BrakingResult:
 
 
 def _longest_run(mask: np.ndarray, dt: np.ndarray) -> float:
-    best = cur = 0.0
-    for m, d in zip(mask, dt, strict=True):
-        cur = cur + d if m else 0.0
-        best = max(best, cur)
-    return best
+    """Longest total of ``dt`` over consecutive True entries of ``mask``."""
+    if not np.any(mask):
+        return 0.0
+    csum = np.cumsum(np.where(mask, dt, 0.0))
+    # value of the running sum at the last False before each entry
+    base = np.maximum.accumulate(np.where(mask, 0.0, csum))
+    return float(np.max(csum - base))
 
 
 def summarise(sim: BrakingSimulator, h: pd.DataFrame) -> dict:

@@ -339,8 +339,9 @@ class BrakingSimulator:
         resistance = float(veh.running_resistance(v0))
         external = resistance + self._grade_force
         v = v0 - dt * self.deceleration
+        omega = self.omega
         for _ in range(20):
-            omega, mu = self._solve_wheels_python(v, pbar, dt)
+            omega, mu = self._solve_wheels_python(v, pbar, dt, omega)
             forces = mu * self.loads
             v_new = v0 - dt * (float(np.sum(forces)) + external) / veh.total_mass
             done = abs(v_new - v) < _TOL
@@ -368,7 +369,7 @@ class BrakingSimulator:
             self._fail(i, f" (creep {creep[i]:.6g})")
         return mu, dmu
 
-    def _solve_wheels_python(self, v, pbar, dt):
+    def _solve_wheels_python(self, v, pbar, dt, guess):
         """Vectorised over axles: the same algorithm as ``_kernels.solve_wheels_family``."""
         veh = self.vehicle
         radius, inertia, c = veh.wheel_radius, veh.wheelset_inertia, veh.brake_coefficient
@@ -380,7 +381,7 @@ class BrakingSimulator:
         locked = (-inertia * self.omega / dt - rn * mu1 + torque) >= 0
         lo = np.zeros(n)
         hi = self.omega + dt * rn * 2.0 / inertia + 1e-9
-        w = np.clip(self.omega, lo, hi)
+        w = np.clip(guess, lo, hi)
         active = ~locked
         for _ in range(100):
             xi = (v - w * radius) / vr
