@@ -21,6 +21,12 @@ __all__ = [
 
 def as_float_array(value, name: str) -> np.ndarray:
     """Return ``value`` as a float64 array, or raise ``ValueError`` naming ``name``."""
+    # np.asarray(None, dtype=float) would silently give NaN
+    if value is None or (
+        isinstance(value, list | tuple)
+        and any(v is None for v in np.ravel(np.array(value, dtype=object)))
+    ):
+        raise ValueError(f"{name} must be numeric, got {value!r}")
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError) as exc:

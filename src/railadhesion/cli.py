@@ -384,6 +384,11 @@ def fit_wilac_cmd(
 if __name__ == "__main__":  # pragma: no cover
     app()
 
+
+from railadhesion.cli_braking import register as _register_braking  # noqa: E402
+
+_register_braking(app)
+
 from railadhesion.cli_identification import register as _register_identification  # noqa: E402
 
 _register_identification(app)

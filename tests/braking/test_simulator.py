@@ -171,3 +171,43 @@ def test_locked_wheel_stays_locked_without_wsp_and_static_brake_holds():
     h = res.histories
     assert res.summary["longest_lock_s"] > 0.8 * res.stopping_time
     assert (h["wheel_speed_1"] >= 0).all()
+
+
+@pytest.mark.parametrize("case", ["wilac_wsp", "wilac_recovery_bogie", "polach_sections"])
+def test_compiled_loop_matches_python_loop(case):
+    from railadhesion.braking import AdhesionRecovery, WheelSlideProtection
+
+    cyl = BrakeCylinders(max_pressure=6e5)
+    if case == "wilac_wsp":
+        make = lambda: WilacAdhesion(WaterFlowProfile.sections([(10.0, 500.0, 25.0)]))  # noqa: E731
+    elif case == "wilac_recovery_bogie":
+        cyl = BrakeCylinders(max_pressure=6e5, valves="bogie")
+        make = lambda: WilacAdhesion(WaterFlowProfile([0.0, 30.0, 60.0], [0.0, 30.0, 25.0]),  # noqa: E731
+                                     recovery=AdhesionRecovery())
+    else:
+        make = lambda: PolachAdhesion("polach2005_dry", [(10.0, 40.0, "polach2005_wet")])  # noqa: E731
+    runs = [simulate(VEHICLE, make(), 12.0, 5.5e5, cylinders=cyl, dt=4e-3, compiled=flag,
+                     wsp=None if case == "polach_sections" else WheelSlideProtection(period=8e-3))
+            for flag in (True, False)]
+    a, b = (r.histories for r in runs)
+    assert a.shape == b.shape
+    assert runs[0].summary["vent_actions"] == runs[1].summary["vent_actions"]
+    np.testing.assert_allclose(a.to_numpy(), b.to_numpy(), rtol=1e-9, atol=1e-9)
+
+
+def test_stepping_api_compiled_matches_python():
+    def run(compiled):
+        sim = BrakingSimulator(VEHICLE, WilacAdhesion(WaterFlowProfile.sections([(5, 50, 25.0)])),
+                               15.0, compiled=compiled)
+        for k in range(400):
+            valves = [0, 0, 0, 0] if (k // 100) % 2 == 0 else [2, 1, 0, 2]
+            state = sim.step(2e-3, {"pressure_command": [5e5, 5e5, 4e5, 4e5], "valves": valves})
+        return sim, state
+
+    (fast, a), (slow, b) = run(True), run(False)
+    assert fast.compiled and fast._use_compiled and not slow._use_compiled
+    np.testing.assert_allclose(a.wheel_speeds, b.wheel_speeds, rtol=1e-10)
+    assert a.distance == pytest.approx(b.distance, rel=1e-12)
+    np.testing.assert_allclose(fast.histories().to_numpy(), slow.histories().to_numpy(),
+                               rtol=1e-9, atol=1e-9)
+    np.testing.assert_array_equal(fast.vent_actions, slow.vent_actions)

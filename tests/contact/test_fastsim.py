@@ -602,3 +602,25 @@ def test_absurd_axis_ratio_raises_naming_a_and_b():
         warnings.simplefilter("error")  # a/b = 1e600 used to warn "overflow in divide"
         with pytest.raises(ValueError, match=r"^a, b: the axis ratio a/b must be in"):
             fastsim(1e-3, 0.0, 0.0, 8e4, 1e300, 1e-300, 0.3)
+
+
+# issue 9 item 4: absurd creepages give the full-slip limit ---------------------------------
+
+
+@pytest.mark.parametrize("flexibility", ["original", "blended"])
+@pytest.mark.parametrize("grid", ["strips", "rectangular"])
+@pytest.mark.parametrize("creep", [1e60, 1e150, -1e300])
+def test_absurd_creepage_gives_mu_fz(creep, flexibility, grid):
+    """|xi| ~ 1e150 returned 0 (original) or NaN (blended): full slip must give |F| = mu Fz
+    (exactly on the strips, whose pressure is normalised to Fz; within the quadrature error on
+    CONTACT's grid), opposing the creepage, and the same as a merely large creepage."""
+    kw = dict(flexibility=flexibility, grid=grid)
+    r = fastsim(creep, 0.0, 0.0, 8e4, 6e-3, 4e-3, 0.3, **kw)
+    ref = fastsim(math.copysign(1e3, creep), 0.0, 0.0, 8e4, 6e-3, 4e-3, 0.3, **kw)
+    assert float(r.fx) == pytest.approx(float(ref.fx), rel=1e-12)
+    assert float(r.fx) == pytest.approx(-math.copysign(0.3 * 8e4, creep), rel=2e-3)
+    assert float(r.slip_fraction) == 1.0
+    # with lateral creepage and spin: finite, full slip, on the bound
+    r = fastsim(creep, -2 * creep, creep / 6e-3, 8e4, 6e-3, 4e-3, 0.3, **kw)
+    assert np.isfinite([r.fx, r.fy, r.mz]).all()
+    assert math.hypot(r.fx, r.fy) <= 0.3 * 8e4 * (1 + 1e-12)

@@ -397,3 +397,10 @@ def test_hertz_3d_nan_in_every_argument(kwargs, name):
     with pytest.raises(ValueError) as info:
         hertz_3d(**args)
     assert str(info.value).startswith(f"{name} must be")
+
+
+@pytest.mark.parametrize("value", [None, [1e5, None]])
+def test_none_is_not_read_as_nan(value):
+    """Issue 9 item 4: ``hertz_3d(None, ...)`` said "got nan"; None is not a number."""
+    with pytest.raises(ValueError, match=r"^normal_force must be numeric, got"):
+        hertz_3d(value, 0.46, np.inf, 0.3)

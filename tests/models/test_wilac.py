@@ -500,3 +500,64 @@ def test_default_parameters_load_or_fail_clearly():
             default_wilac_parameters()
         with pytest.raises(FileNotFoundError, match="wilac_default.toml"):
             Wilac()
+
+
+# issue 9 item 3: every argument broadcasts, shear_modulus and poisson included --------------
+
+
+def test_array_poisson_is_not_aligned_with_the_condition_axis():
+    """Issue 9: ``poisson=[0, .2, .3, .5]`` with ``speed=np.array(5.0)`` returned one number
+    (537.36 N), its four values mixed up with the four conditions; element-wise calls give
+    [532.81, 537.34, 539.60, 544.09] N (default set, tram rig)."""
+    p = default_wilac_parameters()
+    args = (-0.05, 0, 0, 4.2e3, np.array(5.0), 1.4e-3, 3.15e-3, 25.0, p)
+    nus = [0.0, 0.2, 0.3, 0.5]
+    fx, fy = wilac_forces(*args, poisson=nus)
+    assert fx.shape == (4,) and fy.shape == (4,)
+    each = [float(wilac_forces(*args, poisson=nu)[0]) for nu in nus]
+    np.testing.assert_allclose(fx, each, rtol=1e-12)
+    np.testing.assert_allclose(fx, [532.81, 537.34, 539.60, 544.09], atol=0.006)
+    gs = [7e10, 8.2e10, 9e10, 2e11]
+    fx, _ = wilac_forces(*args, shear_modulus=np.array(gs))
+    each = [float(wilac_forces(*args, shear_modulus=g)[0]) for g in gs]
+    np.testing.assert_allclose(fx, each, rtol=1e-12)
+
+
+_ARG_NAMES = ("creep_long", "creep_lat", "spin", "normal_force", "speed", "a", "b",
+              "water_flow", "shear_modulus", "poisson")  # fmt: skip
+_ARG_VALUES = dict(creep_long=(-0.3, 0.3), creep_lat=(-0.05, 0.05), spin=(-2.0, 2.0),
+                   normal_force=(1e3, 1.5e5), speed=(0.0, 50.0), a=(1e-3, 1e-2),
+                   b=(1e-3, 1e-2), water_flow=(0.0, 120.0), shear_modulus=(5e10, 1e11),
+                   poisson=(0.0, 0.5))  # fmt: skip
+
+
+@given(
+    name=st.sampled_from(_ARG_NAMES),
+    fractions=st.lists(st.floats(0.0, 1.0), min_size=1, max_size=5),
+    shape=st.sampled_from(["flat", "column", "0d"]),
+)
+@settings(max_examples=60, deadline=None)
+def test_any_argument_as_array_equals_elementwise_calls(name, fractions, shape):
+    """Issue 9 item 3, as a property: any one argument given as an array (1-d, a column or
+    0-d) gives the element-wise scalar calls, in the argument's shape."""
+    p = make_params()
+    base = dict(creep_long=-0.02, creep_lat=0.003, spin=0.2, normal_force=2e4, speed=8.0,
+                a=4e-3, b=3e-3, water_flow=28.0, shear_modulus=8.2e10, poisson=0.28)  # fmt: skip
+    lo, hi = _ARG_VALUES[name]
+    values = np.array([lo + f * (hi - lo) for f in fractions])
+    if shape == "0d":
+        values = np.array(values[0])
+    elif shape == "column":
+        values = values[:, None]
+
+    def call(value):
+        kw = dict(base, **{name: value})
+        return wilac_forces(*(kw[n] for n in _ARG_NAMES[:8]), p,
+                            shear_modulus=kw["shear_modulus"], poisson=kw["poisson"])  # fmt: skip
+
+    fx, fy = call(values)
+    assert np.shape(fx) == values.shape and np.shape(fy) == values.shape
+    for idx in np.ndindex(values.shape):
+        ex, ey = call(float(values[idx]))
+        assert np.asarray(fx)[idx] == pytest.approx(ex, rel=1e-12, abs=1e-9)
+        assert np.asarray(fy)[idx] == pytest.approx(ey, rel=1e-12, abs=1e-9)

@@ -188,3 +188,288 @@ def advance_family(v0, decel0, dt, omega0, p0, valves, command, static_load, tra
         creep_work += mu[i] * loads[i] * (v - omega[i] * radius) * dt
     return (v, omega, p1, mu, loads, vented, brake_work, creep_work, resistance * v * dt + 0.0,
             0)
+
+
+@njit(cache=True)
+def wilac_table(packed, loads, speed, water, weights, params):
+    """Fill WILAC's blending weights (n, 4) and Polach parameters (n, 4, 5) per axle.
+
+    ``packed`` is :func:`railadhesion.models.kernels.pack_wilac` (layout documented there):
+    the erf transitions of Trummer et al. §5.3 for the weights, and per condition and
+    parameter the regression on Q' = Q/Q_ref, v' = v/v_ref (clamped into the calibrated
+    ranges, clipped to the physical bounds), §5.2.
+    """
+    header = 22
+    nterm = int(packed[header])
+    vn = min(max(speed, packed[4]), packed[5]) / packed[1]
+    for a in range(loads.shape[0]):
+        w = water[a]
+        e1 = 0.5 * (math.erf((w - packed[6]) / packed[7]) + 1.0)
+        e2 = 0.5 * (math.erf((w - packed[8]) / packed[9]) + 1.0)
+        e3 = 0.5 * (math.erf((w - packed[10]) / packed[11]) + 1.0)
+        weights[a, 0] = 1.0 - e1
+        weights[a, 1] = e1 - e2
+        weights[a, 2] = e2 - e3
+        weights[a, 3] = e3
+        qn = min(max(loads[a], packed[2]), packed[3]) / packed[0]
+        fac = (qn, vn, 1.0 / qn, 1.0 / vn, math.exp(qn), math.exp(vn))
+        for i in range(4):
+            for j in range(5):
+                total = 0.0
+                base = header + 1 + (i * 5 + j) * nterm * 4
+                for k in range(nterm):
+                    p = base + 4 * k
+                    value = packed[p]
+                    if value == 0.0:
+                        continue
+                    for m in range(3):
+                        f = int(packed[p + 1 + m])
+                        if f >= 0:
+                            value = value * fac[f]
+                    total += value
+                params[a, i, j] = min(max(total, packed[12 + 2 * j]), packed[13 + 2 * j])
+
+
+# --------------------------------------------------------------------------------------------
+# Whole-run loop for Polach-family adhesion and the default WSP (compiled fast path of
+# railadhesion.braking.simulate). It performs, operation for operation, what
+# BrakingSimulator._advance, WheelSlideProtection.__call__ and simulate() do in Python; the
+# tests hold the two paths together.
+
+# indices into the scalar state array
+T_, X_, V_, D_, NEXT_, STOPPED_, STOP_T_, STOP_X_, WB_, WC_, WR_, WG_, INIT_, REF_, K_ = range(15)
+
+
+@njit(cache=True)
+def _water(x, values, over_time, linear, position, time):
+    q = time if over_time else position
+    if linear:
+        return np.interp(q, x, values)
+    idx = np.searchsorted(x, q, side="right") - 1
+    if idx < 0:
+        return values[0]
+    if idx > values.size - 1:
+        idx = values.size - 1
+    return values[idx]
+
+
+@njit(cache=True)
+def _prepare(kind, sc, loads, offsets, forces, creep, polach_table, sec_start, sec_end,
+             sec_idx, packed, prof_x, prof_v, over_time, linear, recovery, k0, qref,
+             weights, params, stiffness):
+    n = loads.shape[0]
+    wheel = 0.5 * loads
+    for i in range(n):
+        stiffness[i] = k0 * (wheel[i] / qref) ** (2.0 / 3.0) / wheel[i]
+    if kind == 0:  # Polach sets on sections
+        for i in range(n):
+            pos = sc[X_] - offsets[i]
+            k = 0
+            for s in range(sec_start.shape[0]):
+                if pos >= sec_start[s] and pos < sec_end[s]:
+                    k = sec_idx[s]
+            for j in range(weights.shape[1]):
+                weights[i, j] = 0.0
+                for m in range(5):
+                    params[i, j, m] = polach_table[j, m]
+            weights[i, k] = 1.0
+    else:  # WILAC
+        water = np.empty(n)
+        heat = 0.0
+        for i in range(n):
+            w = _water(prof_x, prof_v, over_time, linear, sc[X_] - offsets[i], sc[T_])
+            if recovery > 0.0:
+                w = w * math.exp(-heat / recovery)
+            water[i] = w
+            heat += forces[i] * abs(creep[i])
+        wilac_table(packed, wheel, max(sc[V_], 0.0), water, weights, params)
+
+
+@njit(cache=True)
+def _wsp(t, omega, radius, ws, wst, released, forced, prev, wdec, sc, out):
+    """WheelSlideProtection.__call__ (settings ws, state arrays); valve states into out."""
+    period = ws[0]
+    n = omega.shape[0]
+    u = omega * radius
+    if sc[INIT_] == 0.0:
+        for i in range(n):
+            prev[i] = u[i]
+        sc[REF_] = u.max()
+        sc[INIT_] = 1.0
+    alpha = period / (ws[11] + period)
+    for i in range(n):
+        raw = (prev[i] - u[i]) / period
+        wdec[i] += alpha * (raw - wdec[i])
+        prev[i] = u[i]
+    ref = sc[REF_]
+    rate = ws[1]
+    if u.max() < ref - max(ws[2] * ref, ws[3]):
+        rate = ws[14]
+    v_ref = max(u.max(), ref - rate * period)
+    sc[REF_] = v_ref
+    hold = max(ws[2] * v_ref, ws[3])
+    vent = max(ws[4] * v_ref, ws[5])
+    reapply = max(ws[6] * v_ref, ws[7])
+    for i in range(n):
+        slip = v_ref - u[i]
+        a = wdec[i]
+        st = wst[i]
+        new = st
+        want_vent = slip > vent or a > ws[9]
+        want_hold = slip > hold or a > ws[8]
+        if st == 0:
+            new = 2 if want_vent else (1 if want_hold else 0)
+        elif st == 2:
+            if -a > ws[10]:
+                new = 1
+        else:
+            accelerating = -a > ws[10]
+            if want_vent and not accelerating:
+                new = 2
+            elif slip < reapply and not accelerating and a < ws[8]:
+                new = 0
+        if t < forced[i]:
+            new = 0
+        elif new != 0:
+            if math.isnan(released[i]):
+                released[i] = t
+            elif t - released[i] >= ws[12] - 1e-12:
+                new = 0
+                forced[i] = t + ws[13]
+        if new == 0:
+            released[i] = math.nan
+        wst[i] = new
+        out[i] = new
+
+
+@njit(cache=True)
+def run_family(k_end, dt, sc, vp, static_load, transfer, offsets, cyl, demand, kind,
+               polach_table, sec_start, sec_end, sec_idx, packed, prof_x, prof_v, over_time,
+               linear, recovery, k0, qref, wsp_on, ratio, bogie, ws, wst, released, forced,
+               prev, wdec, omega, pressure, valves, forces, mu, creep, loads, available,
+               vented_total, vent_actions, weights, params, stiffness, rows, tol,
+               cmd_axle):
+    """Steps k = sc[K_] … k_end - 1 of simulate(); returns (rows written, status).
+
+    ``cmd_axle``: per-axle commanded pressures that replace ``demand`` when its first element
+    is >= 0 (the stepping API). status: 0 buffer full or k_end reached, 1 stopped,
+    2 non-finite adhesion.
+    """
+    n = omega.shape[0]
+    radius = vp[0]
+    inertia = vp[1]
+    c = vp[2]
+    mass = vp[3]
+    grade_force = vp[7]
+    stop_speed = vp[8]
+    period = vp[9]
+    cmd_arr = np.empty(n)
+    new_valves = np.empty(n, dtype=np.int64)
+    nrow = 0
+    k = int(sc[K_])
+    while k < k_end and nrow < rows.shape[0]:
+        t = k * dt
+        cmd = 0.0
+        if t >= demand[1]:
+            if demand[2] <= 0.0:
+                cmd = demand[0]
+            else:
+                cmd = demand[0] * min(1.0, (t - demand[1]) / demand[2])
+        if wsp_on and k % ratio == 0:
+            _wsp(t, omega, radius, ws, wst, released, forced, prev, wdec, sc, new_valves)
+            if bogie:
+                half = n // 2
+                m1 = 0
+                m2 = 0
+                for i in range(half):
+                    m1 = max(m1, new_valves[i])
+                    m2 = max(m2, new_valves[half + i])
+                for i in range(half):
+                    new_valves[i] = m1
+                    new_valves[half + i] = m2
+            for i in range(n):
+                if new_valves[i] == 2 and valves[i] != 2:
+                    vent_actions[i] += 1
+                valves[i] = new_valves[i]
+        # --- BrakingSimulator._advance
+        if sc[T_] >= sc[NEXT_] - 1e-12:
+            for i in range(n):
+                loads[i] = max(static_load[i] + transfer[i] * sc[D_], 0.0)
+            _prepare(kind, sc, loads, offsets, forces, creep, polach_table, sec_start, sec_end,
+                     sec_idx, packed, prof_x, prof_v, over_time, linear, recovery, k0, qref,
+                     weights, params, stiffness)
+            peak = family_peak(sc[V_], weights, params, stiffness)
+            for i in range(n):
+                available[i] = peak[i]
+            sc[NEXT_] = (math.floor(sc[T_] / period + 1e-9) + 1) * period
+        for i in range(n):
+            cmd_arr[i] = cmd
+        if cmd_axle[0] >= 0.0:
+            cmd = 0.0
+            for i in range(n):
+                cmd_arr[i] = cmd_axle[i]
+                cmd = max(cmd, cmd_axle[i])
+        v0 = sc[V_]
+        (v, om, p1, m, ld, vent, wb, wc, wr, status) = advance_family(
+            v0, sc[D_], dt, omega, pressure, valves, cmd_arr, static_load, transfer, radius,
+            inertia, c, mass, vp[4], vp[5], vp[6], grade_force, cyl[0], cyl[1], cyl[2],
+            weights, params, stiffness, tol)
+        if status != 0:
+            sc[K_] = k
+            return nrow, 2
+        sc[WB_] += wb
+        sc[WC_] += wc
+        sc[WR_] += wr
+        sc[WG_] += grade_force * v * dt
+        vr = max(v, 1e-6)
+        ke = 0.5 * mass * v * v
+        for i in range(n):
+            vented_total[i] += vent[i]
+            omega[i] = om[i]
+            pressure[i] = p1[i]
+            mu[i] = m[i]
+            loads[i] = ld[i]
+            forces[i] = m[i] * ld[i]
+            creep[i] = (v - om[i] * radius) / vr
+            ke += 0.5 * inertia * om[i] * om[i]
+        sc[D_] = (v0 - v) / dt
+        sc[X_] += 0.5 * (v0 + v) * dt
+        sc[T_] += dt
+        sc[V_] = v
+        stopped = False
+        if v <= stop_speed:
+            d = sc[D_]
+            if v > 0 and d > 0:
+                sc[STOP_X_] = sc[X_] + v * v / (2 * d)
+                sc[STOP_T_] = sc[T_] + v / d
+            else:
+                sc[STOP_X_] = sc[X_]
+                sc[STOP_T_] = sc[T_]
+            sc[STOPPED_] = 1.0
+            stopped = True
+        r = rows[nrow]
+        r[0] = sc[T_]
+        r[1] = sc[X_]
+        r[2] = v
+        r[3] = sc[D_]
+        for i in range(n):
+            r[4 + i] = omega[i]
+            r[4 + n + i] = pressure[i]
+            r[4 + 2 * n + i] = valves[i]
+            r[4 + 3 * n + i] = creep[i]
+            r[4 + 4 * n + i] = forces[i]
+            r[4 + 5 * n + i] = loads[i]
+            r[4 + 6 * n + i] = mu[i]
+            r[4 + 7 * n + i] = available[i]
+        b = 4 + 8 * n
+        r[b] = cmd
+        r[b + 1] = ke
+        r[b + 2] = sc[WB_]
+        r[b + 3] = sc[WC_]
+        r[b + 4] = sc[WR_] + sc[WG_]
+        nrow += 1
+        k += 1
+        sc[K_] = k
+        if stopped:
+            return nrow, 1
+    return nrow, 0

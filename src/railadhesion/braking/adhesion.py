@@ -46,7 +46,6 @@ from railadhesion.models.wilac import (
     WILAC_CONDITIONS,
     WilacParameters,
     default_wilac_parameters,
-    wilac_weights,
 )
 
 __all__ = [
@@ -358,6 +357,7 @@ class WilacAdhesion(_PolachFamily):
         self.parameters = parameters if parameters is not None else default_wilac_parameters()
         self.recovery = recovery
         self.current_water_flow = None
+        self._packed = None
 
     def prepare(self, speed, normal_loads, positions, time, dissipation=None):
         w = np.broadcast_to(np.asarray(self.water_flow(positions, time), float),
@@ -365,15 +365,18 @@ class WilacAdhesion(_PolachFamily):
         if self.recovery is not None and dissipation is not None:
             w = w * self.recovery.factor(dissipation)
         self.current_water_flow = w
-        self.weights = wilac_weights(w, self.parameters.transitions).T
-        q = np.asarray(normal_loads, float)
-        v = max(float(speed), 0.0)
-        table = np.empty((self.n_axles, len(WILAC_CONDITIONS), 5))
-        for k, cond in enumerate(WILAC_CONDITIONS):
-            p = self.parameters.polach_parameters(cond, q, v)
-            for j, key in enumerate(("k_A", "k_S", "mu0", "A", "B")):
-                table[:, k, j] = p[key]
-        self.params = table
+        from railadhesion.braking._kernels import wilac_table
+
+        if self._packed is None:
+            from railadhesion.models.kernels import pack_wilac
+
+            self._packed = pack_wilac(self.parameters)
+        n = self.n_axles
+        if self.weights is None:
+            self.weights = np.empty((n, len(WILAC_CONDITIONS)))
+            self.params = np.empty((n, len(WILAC_CONDITIONS), 5))
+        q = np.ascontiguousarray(normal_loads, dtype=float)
+        wilac_table(self._packed, q, max(float(speed), 0.0), w, self.weights, self.params)
         self.stiffness = self.contact.stiffness_over_load(q)
 
     def describe(self):

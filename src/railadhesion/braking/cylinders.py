@@ -68,7 +68,8 @@ class BrakeCylinders:
 
     def group_valves(self, valves: np.ndarray, n_axles: int) -> np.ndarray:
         """Per-axle valve states after the per-bogie grouping (if any)."""
-        v = np.asarray(valves, dtype=np.int64)
+        v = valves if isinstance(valves, np.ndarray) and valves.dtype == np.int64 else (
+            np.asarray(valves, dtype=np.int64))
         if self.valves == "axle":
             if v.shape != (n_axles,):
                 raise ValueError(f"valves must have {n_axles} entries, got shape {v.shape}")

@@ -9,7 +9,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from railadhesion.braking.adhesion import AxleAdhesion
+from railadhesion.braking.adhesion import (
+    AxleAdhesion,
+    PolachAdhesion,
+    WaterFlowProfile,
+    WilacAdhesion,
+)
 from railadhesion.braking.cylinders import ATMOSPHERIC_PRESSURE, BrakeCylinders
 from railadhesion.braking.simulator import BrakingSimulator
 from railadhesion.braking.vehicle import Vehicle
@@ -192,7 +197,8 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
              brake=3.0e5, *, cylinders: BrakeCylinders | None = None, wsp=None,
              control_period: float | None = None, dt: float = 1e-3, max_time: float = 600.0,
              gradient: float = 0.0, refresh_period: float = 0.01, stop_speed: float = 0.05,
-             progress: Callable[[float], None] | None = None) -> BrakingResult:
+             progress: Callable[[float], None] | None = None,
+             compiled: bool = True) -> BrakingResult:
     """Simulate a stop from ``initial_speed`` [m/s] to standstill (or ``max_time`` [s]).
 
     Parameters
@@ -216,6 +222,11 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
         Simulation step [s]; the control period must be a whole multiple of it.
     progress : callable, optional
         Called now and then with the fraction of the initial speed lost (0 … 1).
+    compiled : bool
+        Use the compiled whole-run loop when possible (Polach or WILAC with a
+        :class:`WaterFlowProfile`, a :class:`BrakeDemand`, no WSP or the default
+        :class:`WheelSlideProtection`); otherwise, or with ``False``, the same steps run in
+        Python (any adhesion model, any controller). Both give the same results.
 
     Returns
     -------
@@ -223,7 +234,8 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
     """
     sim = BrakingSimulator(vehicle, adhesion, initial_speed, cylinders=cylinders,
                            gradient=gradient, refresh_period=refresh_period,
-                           stop_speed=stop_speed, max_step=dt, record=True)
+                           stop_speed=stop_speed, max_step=dt, record=True,
+                           compiled=compiled)
     demand = BrakeDemand(float(brake)) if isinstance(brake, int | float) else brake
     if not callable(demand):
         raise ValueError(f"brake must be a pressure [Pa] or a function of time, got {brake!r}")
@@ -240,7 +252,25 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
     if not (math.isfinite(max_time) and max_time > 0):
         raise ValueError(f"max_time must be in (0, inf) s, got {max_time!r}")
     nmax = int(math.ceil(max_time / dt))
-    n = vehicle.n_axles
+    if compiled and _fast_path_possible(adhesion, demand, controller):
+        _run_compiled(sim, demand, controller, ratio, nmax, dt, progress, initial_speed)
+    else:
+        _run_python(sim, demand, controller, ratio, nmax, dt, progress, initial_speed)
+    h = sim.histories()
+    status = 0 if sim.stopped else 1
+    message = ("the train stopped" if sim.stopped
+               else f"max_time = {max_time} s reached before the train stopped")
+    settings = {"n_axles": vehicle.n_axles, "vehicle": vehicle.name, "dt_s": dt,
+                "wheel_radius_m": vehicle.wheel_radius,
+                "adhesion": adhesion.describe(), "wsp": None if controller is None
+                else type(controller).__name__, "initial_speed_m_s": initial_speed}
+    if progress is not None:
+        progress(1.0)
+    return BrakingResult(h, status, message, summarise(sim, h), settings)
+
+
+def _run_python(sim, demand, controller, ratio, nmax, dt, progress, initial_speed):
+    n = sim.vehicle.n_axles
     valves = np.zeros(n, dtype=np.int64)
     report_every = max(1, int(round(1.0 / dt)))
     for k in range(nmax):
@@ -260,13 +290,41 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
             progress(1.0 - sim.speed / initial_speed)
         if sim.stopped:
             break
-    h = sim.histories()
-    status = 0 if sim.stopped else 1
-    message = ("the train stopped" if sim.stopped
-               else f"max_time = {max_time} s reached before the train stopped")
-    settings = {"n_axles": vehicle.n_axles, "vehicle": vehicle.name, "dt_s": dt,
-                "adhesion": adhesion.describe(), "wsp": None if controller is None
-                else type(controller).__name__, "initial_speed_m_s": initial_speed}
-    if progress is not None:
-        progress(1.0)
-    return BrakingResult(h, status, message, summarise(sim, h), settings)
+
+
+def _fast_path_possible(adhesion, demand, controller) -> bool:
+    kind = type(adhesion)
+    if kind is WilacAdhesion:
+        ok = isinstance(adhesion.water_flow, WaterFlowProfile)
+    else:
+        ok = kind is PolachAdhesion
+    return (ok and type(demand) is BrakeDemand
+            and (controller is None or type(controller) is WheelSlideProtection))
+
+
+def _run_compiled(sim, demand, controller, ratio, nmax, dt, progress, initial_speed):
+    """The loop of _run_python in one compiled kernel (same operations, same results)."""
+    from railadhesion.braking import _kernels as kern
+
+    c = sim._compiled_state(controller)
+    sc = c.sc
+    c.demand[:] = (demand.pressure, demand.start_time, demand.ramp_time)
+    c.cmd_axle[0] = -1.0
+    chunk = int(min(nmax, max(1000, round(5.0 / dt))))
+    ncols = len(sim.history_columns())
+    blocks = []
+    status = 0
+    while True:
+        rows = np.empty((chunk, ncols))
+        k_end = min(nmax, int(sc[kern.K_]) + chunk)
+        nrow, status = kern.run_family(k_end, dt, *c.args(ratio), rows, 1e-10, c.cmd_axle)
+        blocks.append(rows[:nrow])
+        if progress is not None:
+            progress(1.0 - sc[kern.V_] / initial_speed)
+        if status == 2:
+            sim._sync_from_compiled()
+            sim._fail(0, " in the compiled loop")
+        if status == 1 or int(sc[kern.K_]) >= nmax:
+            break
+    sim._sync_from_compiled()
+    sim._row_array = np.concatenate(blocks) if blocks else np.empty((0, ncols))

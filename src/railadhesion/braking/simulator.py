@@ -106,12 +106,16 @@ class BrakingSimulator:
         (default 2e-3 s).
     record : bool
         Keep the history of every step (for :meth:`histories`).
+    compiled : bool
+        Run the steps in the compiled kernel when the adhesion model allows it (Polach, or
+        WILAC with a :class:`~railadhesion.braking.adhesion.WaterFlowProfile`); the Python
+        path gives the same numbers and accepts any model.
     """
 
     def __init__(self, vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float, *,
                  cylinders: BrakeCylinders | None = None, gradient: float = 0.0,
                  refresh_period: float = 0.01, stop_speed: float = 0.05,
-                 max_step: float = 2e-3, record: bool = True):
+                 max_step: float = 2e-3, record: bool = True, compiled: bool = True):
         if not isinstance(vehicle, Vehicle):
             raise ValueError(f"vehicle must be a Vehicle, got {type(vehicle).__name__}")
         if not isinstance(adhesion, AxleAdhesion):
@@ -172,6 +176,10 @@ class BrakingSimulator:
         self.vented_pressure = np.zeros(n)
         self.vent_actions = np.zeros(n, dtype=np.int64)
         self._rows: list = []
+        self._row_blocks: list = []
+        self._row_array = None
+        self._compiled = None
+        self._use_compiled = bool(compiled) and self.compiled
 
     # -- FMI-like guard -------------------------------------------------------------------
     def __setattr__(self, name, value):
@@ -216,22 +224,31 @@ class BrakingSimulator:
                              "valves")
         n = self.vehicle.n_axles
         if "pressure_command" in inputs:
-            cmd = np.asarray(inputs["pressure_command"], float)
-            if cmd.shape not in ((), (n,)) or not np.all(np.isfinite(cmd) & (cmd >= 0)):
-                raise ValueError(f"pressure_command must be a number or {n} numbers in "
-                                 f"[0, inf) Pa, got {inputs['pressure_command']!r}")
-            self.pressure_command = cmd
+            cmd = inputs["pressure_command"]
+            if type(cmd) is float and 0.0 <= cmd < math.inf:  # fast path for HIL loops
+                self.__dict__["pressure_command"] = cmd
+            else:
+                cmd = np.asarray(cmd, float)
+                if cmd.shape not in ((), (n,)) or not np.all(np.isfinite(cmd) & (cmd >= 0)):
+                    raise ValueError(f"pressure_command must be a number or {n} numbers in "
+                                     f"[0, inf) Pa, got {inputs['pressure_command']!r}")
+                self.pressure_command = cmd
         valves = inputs.get("valves")
         if valves is None:
             valves = np.full(n, APPLY, dtype=np.int64)
         valves = self.cylinders.group_valves(valves, n)
-        if np.any((valves < 0) | (valves > 2)):
+        if valves.min() < 0 or valves.max() > 2:
             raise ValueError(f"valves must be 0 (apply), 1 (hold) or 2 (vent), got {valves}")
         self._run(dt, valves)
         return self.state()
 
     def _run(self, dt, valves):
         """Advance with checked inputs (``valves`` per axle, int64)."""
+        if self._use_compiled:
+            if not self.stopped:
+                nsub = max(1, int(math.ceil(dt / self.max_step - 1e-9)))
+                self._step_compiled(nsub, dt / nsub, valves)
+            return
         self.vent_actions += (valves == VENT) & (self.valves != VENT)
         self.valves = valves
         if not self._started:
@@ -389,6 +406,61 @@ class BrakingSimulator:
         mu, _ = self._evaluate((v - w * radius) / vr, v)
         return w, mu
 
+
+    # -- compiled path ----------------------------------------------------------------------
+    @property
+    def compiled(self) -> bool:
+        """True if steps run in the compiled kernel (Polach, or WILAC with a WaterFlowProfile)."""
+        from railadhesion.braking.adhesion import PolachAdhesion, WaterFlowProfile, WilacAdhesion
+
+        kind = type(self.adhesion)
+        if kind is WilacAdhesion:
+            return isinstance(self.adhesion.water_flow, WaterFlowProfile)
+        return kind is PolachAdhesion
+
+    def _compiled_state(self, controller=None):
+        """Arrays of the compiled loop, built from the current state (kept on the object)."""
+        if getattr(self, "_compiled", None) is not None:
+            return self._compiled
+        self._compiled = _CompiledState(self, controller)
+        return self._compiled
+
+    def _sync_from_compiled(self):
+        from railadhesion.braking import _kernels as kern
+
+        c = self._compiled
+        sc = c.sc
+        d = self.__dict__  # state, not parameters: bypass the parameter guard (hot path)
+        d["time"], d["distance"], d["speed"] = sc[kern.T_], sc[kern.X_], sc[kern.V_]
+        d["deceleration"] = sc[kern.D_]
+        d["brake_work"], d["creep_work"] = sc[kern.WB_], sc[kern.WC_]
+        d["resistance_work"], d["gradient_work"] = sc[kern.WR_], sc[kern.WG_]
+        if d["omega"] is not c.omega:  # the arrays are shared from now on, updated in place
+            d["omega"], d["pressure"], d["valves"] = c.omega, c.pressure, c.valves
+            d["forces"], d["mu"], d["creep"], d["loads"] = c.forces, c.mu, c.creep, c.loads
+            d["available"], d["vented_pressure"] = c.available, c.vented
+            d["vent_actions"] = c.vent_actions
+            d["_started"] = True
+        if sc[kern.STOPPED_]:
+            d["stopped"] = True
+            d["stop_time"], d["stop_distance"] = sc[kern.STOP_T_], sc[kern.STOP_X_]
+
+    def _step_compiled(self, nsub, h, valves):
+        from railadhesion.braking import _kernels as kern
+
+        c = self._compiled_state(None)
+        c.vent_actions += (valves == VENT) & (c.valves != VENT)
+        c.valves[:] = valves
+        c.cmd_axle[:] = self.pressure_command
+        k_end = int(c.sc[kern.K_]) + nsub
+        rows = np.empty((nsub, c.ncols)) if self.record else c.scratch(nsub)
+        nrow, status = kern.run_family(k_end, h, *c.args(1), rows, _TOL, c.cmd_axle)
+        if self.record:
+            self._row_blocks.append(rows[:nrow])
+        self._sync_from_compiled()
+        if status == 2:
+            self._fail(0, " in the compiled step")
+
     # -- results --------------------------------------------------------------------------
     def history_columns(self) -> list[str]:
         n = self.vehicle.n_axles
@@ -414,8 +486,13 @@ class BrakingSimulator:
         """Time histories of every recorded step as a pandas DataFrame (first row: t = 0)."""
         import pandas as pd
 
-        rows = [self.initial_row(), *self._rows]
-        frame = pd.DataFrame(rows, columns=self.history_columns())
+        cols = self.history_columns()
+        blocks = self._row_blocks if self._row_array is None else [self._row_array]
+        if blocks:
+            data = np.vstack([np.asarray(self.initial_row(), float)[None, :], *blocks])
+            frame = pd.DataFrame(data, columns=cols)
+        else:
+            frame = pd.DataFrame([self.initial_row(), *self._rows], columns=cols)
         n = self.vehicle.n_axles
         for i in range(1, n + 1):
             frame[f"valve_{i}"] = frame[f"valve_{i}"].astype(np.int64)
@@ -430,3 +507,103 @@ class BrakingSimulator:
         kwargs.update(changes)
         return BrakingSimulator(**kwargs)
 
+
+
+class _CompiledState:
+    """State and constant arrays of the compiled loop (``_kernels.run_family``)."""
+
+    def __init__(self, sim: BrakingSimulator, controller=None):
+        from railadhesion.braking import _kernels as kern
+        from railadhesion.braking.adhesion import PolachAdhesion
+
+        veh = sim.vehicle
+        n = veh.n_axles
+        a = sim.adhesion
+        cyl = sim.cylinders
+        sc = np.zeros(15)
+        sc[kern.T_], sc[kern.X_], sc[kern.V_] = sim.time, sim.distance, sim.speed
+        sc[kern.D_] = sim.deceleration
+        sc[kern.NEXT_] = sim._next_refresh
+        self.sc = sc
+        self.vp = np.array([veh.wheel_radius, veh.wheelset_inertia, veh.brake_coefficient,
+                            veh.total_mass, veh.davis_a, veh.davis_b, veh.davis_c,
+                            sim._grade_force, sim.stop_speed, sim.refresh_period])
+        empty = np.zeros(1)
+        if type(a) is PolachAdhesion:
+            self.kind = 0
+            self.table = np.ascontiguousarray(a._table)
+            sec = a.section_list
+            self.sec_start = np.array([x[0] for x in sec], float)
+            self.sec_end = np.array([x[1] for x in sec], float)
+            self.sec_idx = np.array([x[2] for x in sec], dtype=np.int64)
+            self.packed, self.prof_x, self.prof_v = empty, empty, empty
+            self.over_time, self.linear, self.recovery = False, False, 0.0
+            k_sets = len(a.sets)
+        else:
+            from railadhesion.models.kernels import pack_wilac
+
+            self.kind = 1
+            self.table = np.zeros((1, 5))
+            self.sec_start = self.sec_end = np.zeros(0)
+            self.sec_idx = np.zeros(0, dtype=np.int64)
+            if a._packed is None:
+                a._packed = pack_wilac(a.parameters)
+            self.packed = a._packed
+            prof = a.water_flow
+            self.prof_x, self.prof_v = prof.x, prof.values
+            self.over_time, self.linear = prof.over == "time", prof.kind == "linear"
+            self.recovery = 0.0 if a.recovery is None else a.recovery.energy_scale
+            k_sets = 4
+        self.weights = np.zeros((n, k_sets))
+        self.params = np.zeros((n, k_sets, 5))
+        self.stiffness = np.zeros(n)
+        self.wsp_on = controller is not None
+        if self.wsp_on:
+            st = controller.settings
+            self.ws = np.array([st.period, st.reference_deceleration, st.hold_slip_ratio,
+                                st.hold_slip_min, st.vent_slip_ratio, st.vent_slip_min,
+                                st.reapply_slip_ratio, st.reapply_slip_min,
+                                st.hold_deceleration, st.vent_deceleration,
+                                st.recovery_acceleration, st.deceleration_filter,
+                                st.watchdog_time, st.watchdog_refill_time,
+                                st.sliding_reference_deceleration])
+        else:
+            self.ws = np.zeros(15)
+        self.wst = np.zeros(n, dtype=np.int64)
+        self.released = np.full(n, np.nan)
+        self.forced = np.full(n, -np.inf)
+        self.prev = np.zeros(n)
+        self.wdec = np.zeros(n)
+        self.omega = np.array(sim.omega, float)
+        self.pressure = np.array(sim.pressure, float)
+        self.valves = np.array(sim.valves, dtype=np.int64)
+        self.forces = np.array(sim.forces, float)
+        self.mu = np.array(sim.mu, float)
+        self.creep = np.array(sim.creep, float)
+        self.loads = np.array(sim.loads, float)
+        self.available = np.array(sim.available, float)
+        self.vented = np.array(sim.vented_pressure, float)
+        self.vent_actions = np.array(sim.vent_actions, dtype=np.int64)
+        self.demand = np.zeros(3)
+        self.cyl = np.array([cyl.fill_time_constant, cyl.vent_time_constant, cyl.max_pressure])
+        self.bogie = cyl.valves == "bogie"
+        self.cmd_axle = np.full(n, -1.0)
+        self.k0, self.qref = a.contact._k0, a.contact.reference_load
+        self.ncols = len(sim.history_columns())
+        self._scratch = np.empty((0, self.ncols))
+        self.sim = sim
+
+    def scratch(self, rows):
+        if self._scratch.shape[0] < rows:
+            self._scratch = np.empty((rows, self.ncols))
+        return self._scratch
+
+    def args(self, ratio):
+        return (self.sc, self.vp, self.sim._static_load, self.sim._transfer, self.sim._offsets,
+                self.cyl, self.demand, self.kind, self.table, self.sec_start, self.sec_end,
+                self.sec_idx, self.packed, self.prof_x, self.prof_v, self.over_time,
+                self.linear, self.recovery, self.k0, self.qref, self.wsp_on, ratio, self.bogie,
+                self.ws, self.wst, self.released, self.forced, self.prev, self.wdec,
+                self.omega, self.pressure, self.valves, self.forces, self.mu, self.creep,
+                self.loads, self.available, self.vented, self.vent_actions, self.weights,
+                self.params, self.stiffness)

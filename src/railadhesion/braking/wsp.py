@@ -29,19 +29,23 @@ deceleration thresholds, the three valve states and a watchdog.
 
 * Reference speed: ``v_ref = max(max_i ω_i R, v_ref_prev − a_ref · period)``: the fastest
   wheel, but not falling faster than the plausible train deceleration ``a_ref`` (default
-  2 m/s²; it must exceed the deceleration the brakes can give on a good rail, else the
+  2.5 m/s²; it must exceed the deceleration the brakes can give on a good rail, else the
   reference lags the train and fakes slip; too large and a slide of all axles at once is seen
-  late).
+  late). While every wheel is below the reference by more than the hold threshold (all
+  axles sliding), the reference falls at ``sliding_reference_deceleration`` instead (default
+  1 m/s², about what a train achieves on a low-adhesion rail), so that a slide of all axles
+  at once does not drag the reference down with it.
 * Per axle: slip speed ``s_i = v_ref − ω_i R``; wheel deceleration ``a_i`` from the
   difference of successive wheel speeds, low-pass filtered (time constant
   ``deceleration_filter``).
 * APPLY → HOLD when ``s_i > hold_slip`` or ``a_i > hold_deceleration``; → VENT when
   ``s_i > vent_slip`` or ``a_i > vent_deceleration``. Slip thresholds are
   ``max(ratio · v_ref, minimum)`` [m/s].
-* VENT → HOLD when the wheel re-accelerates (``−a_i > recovery_acceleration``) or the slip
-  has fallen below ``hold_slip``; HOLD → APPLY when the slip is below ``reapply_slip`` and the
-  wheel no longer decelerates beyond ``hold_deceleration``; HOLD → VENT on the vent
-  conditions.
+* VENT → HOLD when the wheel re-accelerates (``−a_i > recovery_acceleration``); HOLD →
+  APPLY once the wheel has stopped re-accelerating (it has rejoined the train) and its slip
+  is below ``reapply_slip``; HOLD → VENT on the vent conditions if the wheel is not
+  re-accelerating. Waiting for the end of the re-acceleration is what lets a wheel that slid
+  together with all the others find the train speed again (and lift the reference).
 * Watchdog: a valve group may not stay out of APPLY (hold or vent) longer than
   ``watchdog_time``; it is then forced to APPLY (refilled) for ``watchdog_refill_time``.
 """
@@ -63,7 +67,8 @@ class WSPSettings:
     """Thresholds of :class:`WheelSlideProtection` (SI units; defaults are assumptions)."""
 
     period: float = 5e-3
-    reference_deceleration: float = 2.0
+    reference_deceleration: float = 2.5
+    sliding_reference_deceleration: float = 1.0
     hold_slip_ratio: float = 0.05
     hold_slip_min: float = 0.3
     vent_slip_ratio: float = 0.10
@@ -82,7 +87,8 @@ class WSPSettings:
             x = getattr(self, f.name)
             if not (isinstance(x, int | float) and math.isfinite(x) and x >= 0):
                 raise ValueError(f"{f.name} must be a finite number >= 0, got {x!r}")
-        for name in ("period", "reference_deceleration", "watchdog_time"):
+        for name in ("period", "reference_deceleration", "sliding_reference_deceleration",
+                     "watchdog_time"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name} must be in (0, inf), got {getattr(self, name)!r}")
         if not self.reapply_slip_ratio <= self.hold_slip_ratio <= self.vent_slip_ratio:
@@ -122,7 +128,11 @@ class WheelSlideProtection:
         alpha = s.period / (s.deceleration_filter + s.period)
         self.deceleration += alpha * (raw - self.deceleration)
         self.previous = u.copy()
-        v_ref = max(float(u.max()), self.reference_speed - s.reference_deceleration * s.period)
+        ref = self.reference_speed
+        hold = max(s.hold_slip_ratio * ref, s.hold_slip_min)
+        rate = (s.sliding_reference_deceleration if float(u.max()) < ref - hold
+                else s.reference_deceleration)
+        v_ref = max(float(u.max()), ref - rate * s.period)
         self.reference_speed = v_ref
         slip = v_ref - u
         hold = max(s.hold_slip_ratio * v_ref, s.hold_slip_min)
@@ -137,12 +147,13 @@ class WheelSlideProtection:
             if st == APPLY:
                 new[i] = VENT if want_vent else (HOLD if want_hold else APPLY)
             elif st == VENT:
-                if -a[i] > s.recovery_acceleration or slip[i] < hold:
+                if -a[i] > s.recovery_acceleration:
                     new[i] = HOLD
             else:  # HOLD
-                if want_vent and -a[i] <= s.recovery_acceleration:
+                accelerating = -a[i] > s.recovery_acceleration
+                if want_vent and not accelerating:
                     new[i] = VENT
-                elif slip[i] < reapply and a[i] < s.hold_deceleration:
+                elif slip[i] < reapply and not accelerating and a[i] < s.hold_deceleration:
                     new[i] = APPLY
             # watchdog
             if time < self.forced_until[i]:

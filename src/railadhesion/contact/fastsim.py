@@ -21,6 +21,7 @@ wheel and oppose the creepage (Kalker's, as CONTACT); at small creepage
 
 from __future__ import annotations
 
+import math
 import operator
 from dataclasses import dataclass
 from functools import lru_cache
@@ -34,7 +35,13 @@ from railadhesion._validate import (
     check_positive,
     check_range,
 )
-from railadhesion.contact.kalker import axis_ratio, kalker_coefficients
+from railadhesion.contact.kalker import (
+    _AOB_MAX,
+    _AOB_MIN,
+    _coefficients_scalar,
+    axis_ratio,
+    kalker_coefficients,
+)
 
 __all__ = ["FastsimResult", "fastsim"]
 
@@ -52,6 +59,11 @@ _SPIN_TO_PER_MM = 1e-3
 _CHUNK_ELEMENTS = 16384
 #: [Pa]; keeps g/|p| finite where p = 0 in the march (tractions that small are irrelevant).
 _TINY_TRACTION = 1e-30
+#: Largest creepage magnitude max(|xi|, |eta|, |phi| a) marched as given. Larger creepages
+#: are scaled down to it, all three by the same factor (direction kept): the contact is then in
+#: full slip for any physical contact, where the result does not depend on the magnitude, and
+#: the march stays clear of overflow (|xi| ~ 1e150 gave 0 or NaN instead of mu Fz).
+_CREEP_MAX = 1e50
 
 
 @dataclass(frozen=True)
@@ -338,6 +350,17 @@ def fastsim(
     >>> [round(float(f), 2) for f in r.fx]
     [-13.66, 13.66]
     """
+    if (
+        grid == "strips" and not return_tractions and type(flexibility) is str
+        and type(nx) is int and type(ny) is int
+    ):  # fmt: skip
+        values = _float_scalars(
+            (creep_long, creep_lat, spin, normal_force, a, b, mu, shear_modulus, poisson)
+        )
+        if values is not None:
+            out = _fastsim_scalar(*values, nx, ny, bound, flexibility)
+            if out is not None:
+                return out
     xi = check_finite(creep_long, "creep_long")
     eta = check_finite(creep_lat, "creep_lat")
     phi = check_finite(spin, "spin")
@@ -364,6 +387,7 @@ def fastsim(
     args = np.broadcast_arrays(xi, eta, phi, fz, a_, b_, mu_, g_mod, nu, *flx_given)
     shape = args[0].shape
     xi, eta, phi, fz, a_, b_, mu_, g_mod, nu, *flx_given = (np.ravel(v) for v in args)
+    xi, eta, phi = _limit_creepage(xi, eta, phi, a_)
     if flx_given:
         l1, l2, l3 = flx_given
     else:
@@ -371,7 +395,90 @@ def fastsim(
             a_, b_, xi, eta, phi, fz, mu_, g_mod, nu, flexibility == "blended"
         )
 
+    if not return_tractions:  # the compiled march (same numbers as the NumPy one below)
+        from railadhesion.contact import _fastsim_kernels as kern
+
+        flat = [np.ascontiguousarray(x, dtype=float) for x in
+                (xi, eta, phi, fz, a_, b_, mu_, *np.broadcast_arrays(l1, l2, l3, xi)[:3])]
+        if grid == "strips":
+            out = kern.march_strips(*flat, _grid_pattern(nx, ny, bound))
+        else:
+            out = kern.march_rect(*flat, scale, rect)
+        return FastsimResult(*(_shaped(v, shape) for v in out))
+    return _fastsim_reference(xi, eta, phi, fz, a_, b_, mu_, l1, l2, l3, shape, nx, ny, bound,
+                              grid, scale, rect if grid == "rectangular" else None,
+                              return_tractions)  # fmt: skip
+
+
+def _float_scalars(values) -> list | None:
+    """``values`` as floats if every one is a Python or NumPy float or int, else ``None``."""
+    out = []
+    for v in values:
+        t = type(v)
+        if t is float or t is np.float64 or t is int:
+            out.append(float(v))
+        else:
+            return None
+    return out
+
+
+def _fastsim_scalar(xi, eta, phi, fz, a, b, mu, g_mod, nu, nx, ny, bound, flexibility):
+    """:func:`fastsim` for one contact on the strips, with ``math`` instead of NumPy around
+    the compiled march (a few microseconds of Python). ``None`` if any input is invalid or
+    out of range: the caller's array path then raises the error naming it."""
+    fin = math.isfinite
+    if not (fin(xi) and fin(eta) and fin(phi) and fin(fz) and fin(a) and fin(b) and fin(mu)
+            and fin(g_mod) and fz >= 0 and a > 0 and b > 0 and mu >= 0 and g_mod > 0
+            and 0.0 <= nu <= 0.5 and nx >= 1 and ny >= 1 and bound in _BOUNDS
+            and flexibility in _FLEXIBILITIES):  # fmt: skip
+        return None
+    a_over_b = a / b
+    if not _AOB_MIN <= a_over_b <= _AOB_MAX:
+        return None
+    size = max(abs(xi), abs(eta), abs(phi) * a)
+    if size > _CREEP_MAX:
+        scale = _CREEP_MAX / size
+        xi, eta, phi = xi * scale, eta * scale, phi * scale
+    c11, c22, c23, _ = _coefficients_scalar(a_over_b, nu)
+    l1 = 8.0 * a / (3.0 * g_mod * c11)
+    l2 = 8.0 * a / (3.0 * g_mod * c22)
+    l3 = math.pi * a * math.sqrt(a_over_b) / (4.0 * g_mod * c23)
+    if flexibility == "blended":  # the operations of _flexibilities, in floats
+        spin_term = (phi * (3.0 * math.pi * a / 32.0)) ** 2
+        num = xi * xi + eta * eta + spin_term
+        den = xi * xi / l1 + eta * eta / l2 + spin_term / l3
+        l_crss = num / den if den > 0.0 else l1
+        c2 = a * b
+        c3 = c2 * math.sqrt(c2)
+        mu_fz = mu * fz
+        ch_xi = mu_fz / (c2 * g_mod * c11)
+        ch_eta = mu_fz / (c2 * g_mod * c22)
+        ch_phi = mu_fz / (c3 * g_mod * c23) * _SPIN_TO_PER_MM
+        phi_mm = phi * _SPIN_TO_PER_MM
+        ch2 = ch_xi * ch_xi + ch_eta * ch_eta + ch_phi * ch_phi
+        crp2 = xi * xi + eta * eta + phi_mm * phi_mm
+        f_crp = math.sqrt(crp2 / ch2) if ch2 > 0.0 else 0.0
+        w = min(max(f_crp / 3.0, 0.0), 1.0)
+        l1, l2, l3 = ((1.0 - w) * l1 + w * l_crss, (1.0 - w) * l2 + w * l_crss,
+                      (1.0 - w) * l3 + w * l_crss)  # fmt: skip
+    from railadhesion.contact import _fastsim_kernels as kern
+
+    eta_j, sq, tx, gy, norm = _grid_pattern(nx, ny, bound)
+    out = kern.strips_one(xi, eta, phi, fz, a, b, mu, l1, l2, l3, eta_j, sq, tx, gy, norm)
+    return FastsimResult(*(np.float64(v) for v in out))
+
+
+def _shaped(v, shape):
+    v = v.reshape(shape)
+    return v[()] if v.ndim == 0 else v
+
+
+def _fastsim_reference(xi, eta, phi, fz, a_, b_, mu_, l1, l2, l3, shape, nx, ny, bound, grid,
+                       scale, rect, return_tractions):  # fmt: skip
+    """NumPy reference of :func:`fastsim` (validated, raveled inputs): the readable march, used
+    for ``return_tractions=True``; the compiled march is tested against it."""
     n = xi.size
+    l1, l2, l3 = (np.broadcast_to(x, (n,)) for x in (l1, l2, l3))
     fx = np.empty(n)
     fy = np.empty(n)
     mz = np.empty(n)
@@ -425,6 +532,17 @@ def fastsim(
             "slip": slip_all.reshape(grid_shape),
         }
     return FastsimResult(shaped(fx), shaped(fy), shaped(mz), shaped(slip_fraction), **extra)
+
+
+def _limit_creepage(xi, eta, phi, a):
+    """Creepages scaled down to magnitude :data:`_CREEP_MAX` where they exceed it (see there)."""
+    with np.errstate(over="ignore"):
+        size = np.maximum(np.maximum(np.abs(xi), np.abs(eta)), np.abs(phi) * a)
+    over = size > _CREEP_MAX
+    if not over.any():
+        return xi, eta, phi
+    scale = np.where(over, _CREEP_MAX / np.where(over, size, 1.0), 1.0)
+    return xi * scale, eta * scale, phi * scale
 
 
 def _check_flexibility(flexibility) -> list:

@@ -7,7 +7,7 @@ from railadhesion.models.parameters import (
     PolachParameters,
     polach_parameters,
 )
-from railadhesion.models.polach import Polach, polach_forces
+from railadhesion.models.polach import Polach, PolachContact, polach_forces
 from railadhesion.models.twod import (
     FLETCHER_CONDITIONS,
     FletcherCondition,
@@ -38,6 +38,7 @@ __all__ = [
     "WILAC_CONDITIONS",
     "FletcherCondition",
     "Polach",
+    "PolachContact",
     "PolachParameters",
     "TwoDTraction",
     "WaterTransition",

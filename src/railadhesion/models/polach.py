@@ -28,6 +28,7 @@ from functools import lru_cache
 import numpy as np
 
 from railadhesion._validate import (
+    as_float_array,
     check_finite,
     check_nonnegative,
     check_positive,
@@ -36,7 +37,7 @@ from railadhesion._validate import (
 from railadhesion.contact.kalker import _AOB_MAX, _AOB_MIN, axis_ratio, kalker_coefficients
 from railadhesion.models.parameters import PolachParameters, polach_parameters
 
-__all__ = ["Polach", "polach_forces"]
+__all__ = ["Polach", "PolachContact", "polach_forces"]
 
 _TWO_OVER_PI = 2.0 / math.pi
 _PI_OVER_4 = math.pi / 4.0
@@ -95,9 +96,11 @@ def polach_forces(
     mu0 : array_like
         Maximum friction coefficient mu0 [-], > 0.
     k_A : array_like, optional
-        Stiffness reduction factor in the area of adhesion [-], > 0 (Polach: <= 1).
+        Stiffness reduction factor in the area of adhesion [-], in (0, 1] (Polach 2005:
+        k_S <= k_A <= 1).
     k_S : array_like, optional
-        Stiffness reduction factor in the area of slip [-], > 0 (Polach: k_S <= k_A).
+        Stiffness reduction factor in the area of slip [-], in (0, 1]. Polach recommends
+        k_S <= k_A; k_S > k_A is accepted and evaluated as published (see Notes, Bounds).
     A : array_like, optional
         mu_inf/mu0 [-], >= 0. ``A = 1`` gives constant friction.
     B : array_like, optional
@@ -165,13 +168,27 @@ def polach_forces(
     coefficients are not.
 
     Bounds: with k_S <= k_A the bracket of F is at most pi/2, so |F| <= mu Q <=
-    mu0 Q max(1, A); with k_S > k_A it can exceed mu Q. The total force stays within
-    mu0 Q max(1, A) when the spin does not oppose the lateral creepage (checked by property
-    tests). When it does, on long contacts (a/b > 1), the spin term F_yS, which k_A and k_S
-    do not reduce, can push |(fx, fy)| above mu Q (up to about 1.6 mu Q with k_A = 0.3,
-    k_S = 0.1 at a/b = 5). A tangential force above the friction limit is not physical, so
-    **this implementation caps |(fx, fy)| at mu Q** (mu at the current slip velocity), scaling
-    both components; elsewhere the cap is inactive and the published model is unchanged.
+    mu0 Q max(1, A). With k_S > k_A (which Polach 2005 excludes, k_S <= k_A <= 1, but a
+    fitted or regressed set may reach) the published model itself exceeds mu Q: the bracket
+    reaches up to pi/2 + 1/2, so |F| <= (1 + 1/pi) mu Q (e.g. a/b = 0.5, k_A = 0.1, k_S = 1,
+    pure longitudinal creep: |F|/(mu Q) = 1.19, 1.23, 1.09 at 1, 3, 10 % on the Eurosprinter
+    contact at Q = 100 kN, mu = 0.3). This is returned as published, unchanged.
+
+    **The spin cap.** When the spin opposes the lateral creepage on long contacts (a/b > 1),
+    the spin term F_yS, which k_A and k_S do not reduce, can push |(fx, fy)| above mu Q (up
+    to about 1.6 mu Q with k_A = 0.3, k_S = 0.1 at a/b = 5). A tangential force above the
+    friction limit is not physical, so **where the spin term is non-zero this implementation
+    caps |(fx, fy)| at max(mu Q, |F|)** (mu at the current slip velocity, F the force of the
+    creepage part above), scaling both components: it removes only the overshoot the spin
+    term adds. Without spin the cap never acts, whatever k_A and k_S.
+
+    **Known limit with spin reinforcing the lateral creep.** When psi a has the sign of s_y,
+    s_yC = s_y + psi a and F_yS is added along F_y, but Polach's F_yS falls with eps_psi like
+    1/(1 + eps_psi^2)^2 while the exact theory keeps a spin contribution: the lateral force
+    is then underestimated. On the Eurosprinter contact (a/b = 0.5, Q = 106.7 kN, mu = 0.33)
+    at eta = 0.01, psi a = 0.01, Polach gives Fy = -0.51 mu Q where FASTSIM (40 x 40 strips)
+    gives -0.83 mu Q with blended flexibilities (-0.72 mu Q with Kalker's original ones);
+    without the spin both give -1.00 mu Q. Use FASTSIM or CONTACT where large spin matters.
 
     References
     ----------
@@ -206,20 +223,30 @@ def polach_forces(
     scalars = _scalars(args)
     if scalars is None:
         return _polach_array(*args)
-    return _polach_scalar(*scalars)
+    sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu = scalars
+    fx, fy, bad = _kernels().polach_checked(
+        sx, sy, psi, q, v, a, b, g, nu, 0.0, 0.0, 0.0, k_a, k_s, mu0, big_a, big_b
+    )
+    if bad >= 0:
+        _polach_scalar(*scalars)  # the reference scalar path raises the error naming it
+        raise AssertionError("polach kernel flagged an input the reference accepts")
+    return np.float64(fx), np.float64(fy)
 
 
 def _scalars(values) -> list | None:
     """``values`` for the scalar fast path, or ``None`` if any of them is not a real scalar.
 
-    Python and NumPy scalars and 0-d arrays qualify (no array work is then needed); ``float``,
-    ``int`` and ``numpy.float64`` are passed through, other NumPy scalars and 0-d arrays become
-    floats.
+    Python and NumPy scalars and 0-d arrays qualify (no array work is then needed); ``float``
+    and ``numpy.float64`` are passed through, ints, other NumPy scalars and 0-d arrays become
+    floats (so that the compiled kernels see one signature).
     """
     scalars = []
     for v in values:
-        if type(v) in _SCALAR_TYPES:
+        t = type(v)
+        if t is float or t is np.float64:
             scalars.append(v)
+        elif t is int:
+            scalars.append(float(v))
         elif isinstance(v, np.generic | np.ndarray) and v.ndim == 0 and v.dtype.kind in "fiu":
             scalars.append(float(v))
         else:
@@ -246,13 +273,15 @@ def _polach_scalar(
             if not isf(val):
                 raise ValueError(f"{name} must be finite (no NaN or inf), got {float(val)!r}")
         positive = (
-            ("normal_force", q), ("a", a), ("b", b), ("mu0", mu0), ("k_A", k_a), ("k_S", k_s),
-            ("shear_modulus", g),
+            ("normal_force", q), ("a", a), ("b", b), ("mu0", mu0), ("shear_modulus", g),
         )  # fmt: skip
         nonnegative = (("speed", v), ("A", big_a), ("B", big_b))
     else:
-        positive = (("mu0", mu0), ("k_A", k_a), ("k_S", k_s))
+        positive = (("mu0", mu0),)
         nonnegative = (("A", big_a), ("B", big_b))
+    for name, val in (("k_A", k_a), ("k_S", k_s)):
+        if not 0.0 < val <= 1.0:  # NaN fails too
+            raise _bad(name, "(0.0, 1.0]", val)
     for name, val in positive:
         if not (val > 0 and isf(val)):
             raise _bad(name, "(0, inf)", val)
@@ -289,14 +318,49 @@ def _polach_scalar(
     # psi*|s_yC| first would, for huge creepages, and give inf*0 = NaN after the cap)
     fys = gc3c23 * (psi / sc) * (abs(syc) / e2) / e2
     fx, fy = -f_over_sc * sx, -(f_over_sc * sy + fys)
-    total = math.hypot(fx, fy)
-    if total > qmu:  # Coulomb cap (see Notes): only opposing spin on long contacts gets here
-        fx, fy = fx * (qmu / total), fy * (qmu / total)
+    if fys != 0.0:  # spin cap (see Notes): removes only the overshoot the spin term adds
+        limit = max(qmu, f_over_sc * math.hypot(sx, sy))
+        total = math.hypot(fx, fy)
+        if total > limit:
+            fx, fy = fx * (limit / total), fy * (limit / total)
     return np.float64(fx), np.float64(fy)
 
 
-def _polach_array(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu):
-    """Array path of :func:`polach_forces` (validated, broadcast, no Python loops)."""
+_ARG_NAMES = (
+    "creep_long", "creep_lat", "spin", "normal_force", "speed", "a", "b",
+    "mu0", "k_A", "k_S", "A", "B", "shear_modulus", "poisson",
+)  # fmt: skip
+
+
+def _kernels():
+    """The compiled kernels (:mod:`railadhesion.models.kernels`), imported on first use so
+    that ``import railadhesion`` does not import numba."""
+    from railadhesion.models import kernels
+
+    return kernels
+
+
+def _polach_array(*args):
+    """Array path of :func:`polach_forces`: the compiled kernel, validated in the same pass.
+
+    Gives the numbers of :func:`_polach_reference` (to rounding). If any argument is out of
+    range, the reference runs to raise the error naming it.
+    """
+    arrays = [as_float_array(x, name) for x, name in zip(args, _ARG_NAMES, strict=True)]
+    k = _kernels()
+    shape, n, flat = k.flatten_args(arrays)
+    fx, fy, ok = k.polach_many(flat, n)
+    if not ok:
+        _polach_reference(*arrays)  # raises the ValueError naming the argument
+        raise AssertionError("polach kernel flagged an input the reference accepts")
+    if not shape:
+        return np.float64(fx[0]), np.float64(fy[0])
+    return fx.reshape(shape), fy.reshape(shape)
+
+
+def _polach_reference(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu):
+    """NumPy reference of the array path of :func:`polach_forces` (validated, broadcast, no
+    Python loops): the readable implementation the compiled kernel is tested against."""
     sx = check_finite(sx, "creep_long")
     sy = check_finite(sy, "creep_lat")
     psi = check_finite(psi, "spin")
@@ -305,8 +369,8 @@ def _polach_array(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu):
     a = check_positive(a, "a")
     b = check_positive(b, "b")
     mu0 = check_positive(mu0, "mu0")
-    k_a = check_positive(k_a, "k_A")
-    k_s = check_positive(k_s, "k_S")
+    k_a = check_range(k_a, "k_A", 0.0, 1.0, closed="right")
+    k_s = check_range(k_s, "k_S", 0.0, 1.0, closed="right")
     big_a = check_nonnegative(big_a, "A")
     big_b = check_nonnegative(big_b, "B")
     g = check_positive(g, "shear_modulus")
@@ -344,9 +408,11 @@ def _polach_array(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu):
     fx = np.where(active, -f_over_sc * sx, 0.0)
     fy = np.where(active, -(f_over_sc * sy + fys), 0.0)
     total = np.hypot(fx, fy)
-    over = total > qmu
-    # Coulomb cap; divide only where it applies (qmu/total of a tiny force would overflow)
-    scale = np.where(over, qmu / np.where(over, total, 1.0), 1.0)
+    # spin cap at max(mu Q, |F|) where F_yS != 0 (see Notes); divide only where it applies
+    # (limit/total of a tiny force would overflow)
+    limit = np.maximum(qmu, f_over_sc * np.hypot(sx, sy))
+    over = (total > limit) & (fys != 0.0) & active
+    scale = np.where(over, limit / np.where(over, total, 1.0), 1.0)
     fx, fy = fx * scale, fy * scale
     if fx.ndim == 0:
         return np.float64(fx), np.float64(fy)
@@ -417,3 +483,138 @@ class Polach:
 
         fx, fy = self.forces(creep_long, creep_lat, spin, normal_force, speed, a, b)
         return adhesion(fx, fy, normal_force)
+
+    def contact(self, normal_force, speed, a, b) -> PolachContact:
+        """A :class:`PolachContact` of this model on one contact (fast repeated calls)."""
+        p = self.params
+        return PolachContact(
+            normal_force, speed, a, b, mu0=p.mu0, k_A=p.k_A, k_S=p.k_S, A=p.A, B=p.B,
+            shear_modulus=self.shear_modulus, poisson=self.poisson,
+        )  # fmt: skip
+
+
+class PolachContact:
+    """One contact's fixed data, for fast repeated calls of Polach's model in inner loops.
+
+    Holds the parameter set, G, nu, the semi-axes and their Kalker coefficients (looked up
+    once); :meth:`forces` then evaluates :func:`polach_forces` for new creepages (and
+    optionally a new speed or normal force) in plain Python floating point, about a
+    microsecond a call. Same numbers as :func:`polach_forces` (to rounding, about 1e-15).
+
+    Parameters
+    ----------
+    normal_force : float
+        Normal force Q [N], > 0 (default for :meth:`forces`).
+    speed : float
+        Rolling speed V [m/s], >= 0 (default for :meth:`forces`).
+    a, b : float
+        Contact semi-axes in the rolling and lateral directions [m], > 0.
+    mu0, k_A, k_S, A, B, shear_modulus, poisson : float
+        As :func:`polach_forces` (validated once, here).
+
+    Examples
+    --------
+    An ODE right-hand side (one wheel braking: state V, omega):
+
+    >>> contact = PolachContact(1e5, 20.0, 6.3e-3, 12.6e-3, mu0=0.55, k_S=0.4, A=0.4, B=0.6)
+    >>> def rhs(t, y, mass=8000.0, inertia=100.0, radius=0.46, torque=9e3):
+    ...     speed, omega = y  # braking creepage > 0 gives fx < 0
+    ...     fx, _ = contact.forces((speed - omega * radius) / speed, speed=speed)
+    ...     return [fx / mass, (-torque - fx * radius) / inertia]
+    >>> from scipy.integrate import solve_ivp
+    >>> sol = solve_ivp(rhs, (0.0, 0.1), [20.0, 20.0 / 0.46 * 0.99], max_step=1e-3)
+    >>> bool(sol.success)
+    True
+    >>> fx, fy = contact.forces(0.01)
+    >>> fx == float(polach_forces(0.01, 0.0, 0.0, 1e5, 20.0, 6.3e-3, 12.6e-3, mu0=0.55,
+    ...                           k_S=0.4, A=0.4, B=0.6)[0])
+    True
+
+    For compiled inner loops (numba) use
+    :func:`railadhesion.models.kernels.polach_scalar` instead.
+    """
+
+    __slots__ = (
+        "normal_force", "speed", "a", "b", "mu0", "k_A", "k_S", "A", "B", "shear_modulus",
+        "poisson", "c11", "c22", "c23", "_eps_k", "_k_psi", "_gc3c23", "_epsp_k", "_const_mu",
+    )  # fmt: skip
+
+    def __init__(self, normal_force, speed, a, b, *, mu0, k_A=1.0, k_S=1.0, A=1.0, B=0.0,
+                 shear_modulus=8.2e10, poisson=0.28):  # fmt: skip
+        values = (0.0, 0.0, 0.0, normal_force, speed, a, b, mu0, k_A, k_S, A, B,
+                  shear_modulus, poisson)  # fmt: skip
+        scalars = _scalars(values)
+        if scalars is None:
+            raise ValueError("PolachContact holds one contact: every argument must be a scalar")
+        _polach_scalar(*scalars)  # validates every argument, errors name it
+        (_, _, _, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu) = (float(x) for x in scalars)
+        self.normal_force, self.speed, self.a, self.b = q, v, a, b
+        self.mu0, self.k_A, self.k_S, self.A, self.B = mu0, k_a, k_s, big_a, big_b
+        self.shear_modulus, self.poisson = g, nu
+        a_over_b = a / b
+        self.c11, self.c22, self.c23 = _kalker_scalar(a_over_b, nu)
+        self._eps_k = _PI_OVER_4 * g * a * b
+        self._k_psi = 1.0 + 6.3 * (1.0 - math.exp(-a_over_b))
+        self._gc3c23 = g * a * b * math.sqrt(a * b) * self.c23
+        self._epsp_k = 8.0 / 3.0 * self._gc3c23 / a
+        self._const_mu = big_b == 0.0 or big_a == 1.0
+
+    def __repr__(self) -> str:
+        return (f"PolachContact(normal_force={self.normal_force!r}, speed={self.speed!r}, "
+                f"a={self.a!r}, b={self.b!r}, mu0={self.mu0!r}, k_A={self.k_A!r}, "
+                f"k_S={self.k_S!r}, A={self.A!r}, B={self.B!r})")  # fmt: skip
+
+    def forces(self, creep_long, creep_lat=0.0, spin=0.0, speed=None, normal_force=None):
+        """Forces (fx, fy) [N] of the rail on the wheel, as Python floats.
+
+        ``speed`` and ``normal_force`` default to the values given at construction. Raises
+        ``ValueError`` for non-finite creepages or an out-of-range speed or normal force.
+        """
+        sx, sy, psi = creep_long, creep_lat, spin
+        if (sx - sx) + (sy - sy) + (psi - psi) != 0.0:  # NaN or inf in a creepage
+            for name, val in (("creep_long", sx), ("creep_lat", sy), ("spin", psi)):
+                if not math.isfinite(val):
+                    raise ValueError(f"{name} must be finite (no NaN or inf), got {val!r}")
+        q = self.normal_force
+        if normal_force is not None:
+            q = normal_force
+            if not 0.0 < q < math.inf:
+                raise _bad("normal_force", "(0, inf)", q)
+        v = self.speed
+        if speed is not None:
+            v = speed
+            if not 0.0 <= v < math.inf:
+                raise _bad("speed", "[0, inf)", v)
+        syc = sy + psi * self.a
+        if not abs(syc) > abs(sy):
+            syc = sy
+        sc = math.hypot(sx, syc)
+        if sc == 0.0:
+            return 0.0, 0.0
+        s = math.hypot(sx, sy)
+        cjj = math.hypot(self.c11 * sx, self.c22 * sy) / s if s > 0.0 else self.c22
+        if self._const_mu:
+            qmu = q * self.mu0
+        else:
+            big_a = self.A
+            qmu = q * (self.mu0 * ((1.0 - big_a) * math.exp(-self.B * sc * v) + big_a))
+            if qmu == 0.0:
+                return 0.0, 0.0
+        eps = self._eps_k * cjj * sc / qmu
+        if eps > _EPS_MAX:
+            eps = _EPS_MAX
+        x = self.k_A * eps
+        f_over_sc = _TWO_OVER_PI * qmu * (x / (1.0 + x * x) + math.atan(self.k_S * eps)) / sc
+        if psi == 0.0:
+            return -f_over_sc * sx, -f_over_sc * sy
+        abs_syc = abs(syc)
+        eps_psi = self._epsp_k * abs_syc / (self._k_psi * qmu)
+        e2 = 1.0 + eps_psi * eps_psi
+        fys = self._gc3c23 * (psi / sc) * (abs_syc / e2) / e2
+        fx, fy = -f_over_sc * sx, -(f_over_sc * sy + fys)
+        if fys != 0.0:
+            limit = max(qmu, f_over_sc * s)
+            total = math.hypot(fx, fy)
+            if total > limit:
+                fx, fy = fx * (limit / total), fy * (limit / total)
+        return fx, fy

@@ -32,9 +32,20 @@ from typing import NamedTuple
 import numpy as np
 from scipy.special import erf
 
-from railadhesion._validate import check_choice, check_nonnegative, check_positive
+from railadhesion._validate import (
+    as_float_array,
+    check_choice,
+    check_nonnegative,
+    check_positive,
+)
 from railadhesion.models.parameters import PARAMETER_RANGES
-from railadhesion.models.polach import _polach_scalar, _scalars, polach_forces
+from railadhesion.models.polach import (
+    _kernels,
+    _polach_reference,
+    _polach_scalar,
+    _scalars,
+    polach_forces,
+)
 from railadhesion.models.regression import ParameterRegression
 
 __all__ = [
@@ -700,15 +711,51 @@ def wilac_forces(
     """
     if not isinstance(params, WilacParameters):
         raise ValueError(f"params must be a WilacParameters, got {type(params).__name__}")
-    if (
-        type(water_flow) in _SCALAR_TYPES
-        and type(normal_force) in _SCALAR_TYPES
-        and type(speed) in _SCALAR_TYPES
-    ):
-        return _wilac_scalar(
-            creep_long, creep_lat, spin, normal_force, speed, a, b, water_flow, params,
-            shear_modulus, poisson,
-        )  # fmt: skip
+    args = (
+        creep_long, creep_lat, spin, normal_force, speed, a, b, water_flow, shear_modulus,
+        poisson,
+    )  # fmt: skip
+    kernels = _kernels()
+    packed = _packed(params)
+    scalars = _scalars(args)
+    if scalars is not None:
+        fx, fy, ok = kernels.wilac_checked(*scalars, 0.0, 0.0, 0.0, packed)
+        if not ok:  # the reference raises the error naming the argument
+            _wilac_scalar(*scalars[:8], params, *scalars[8:])
+            raise AssertionError("WILAC kernel flagged an input the reference accepts")
+        return np.float64(fx), np.float64(fy)
+    arrays = [as_float_array(x, name) for x, name in zip(args, _WILAC_ARGS, strict=True)]
+    shape, n, flat = kernels.flatten_args(arrays)
+    fx, fy, ok = kernels.wilac_many(flat, packed, n)
+    if not ok:
+        _wilac_reference(*arrays[:8], params, shear_modulus=arrays[8], poisson=arrays[9])
+        raise AssertionError("WILAC kernel flagged an input the reference accepts")
+    if not shape:
+        return np.float64(fx[0]), np.float64(fy[0])
+    return fx.reshape(shape), fy.reshape(shape)
+
+
+_WILAC_ARGS = (
+    "creep_long", "creep_lat", "spin", "normal_force", "speed", "a", "b", "water_flow",
+    "shear_modulus", "poisson",
+)  # fmt: skip
+
+
+def _packed(params: WilacParameters) -> np.ndarray:
+    """:func:`railadhesion.models.kernels.pack_wilac` of ``params``, computed once per set."""
+    packed = params.__dict__.get("_packed_kernel_arrays")
+    if packed is None:
+        packed = _kernels().pack_wilac(params)
+        object.__setattr__(params, "_packed_kernel_arrays", packed)
+    return packed
+
+
+def _wilac_reference(
+    creep_long, creep_lat, spin, normal_force, speed, a, b, water_flow, params, *,
+    shear_modulus=8.2e10, poisson=0.28,
+):  # fmt: skip
+    """NumPy reference of the array path of :func:`wilac_forces` (the readable implementation
+    the compiled kernel is tested against): stacked conditions, one Polach call."""
     q = check_positive(normal_force, "normal_force")
     v = check_nonnegative(speed, "speed")
     weights = wilac_weights(water_flow, params.transitions)
@@ -718,7 +765,7 @@ def wilac_forces(
     # input is aligned on the trailing axes of the full broadcast shape.
     ndim = max(
         weights.ndim - 1, qn.ndim, vn.ndim,
-        *(np.ndim(x) for x in (creep_long, creep_lat, spin, a, b)),
+        *(np.ndim(x) for x in (creep_long, creep_lat, spin, a, b, shear_modulus, poisson)),
     )  # fmt: skip
     pshape = np.broadcast_shapes(qn.shape, vn.shape)
     fac = _factor_arrays(qn, vn)
@@ -727,9 +774,12 @@ def wilac_forces(
     )
     stacked = stacked.reshape((len(active), 5) + (1,) * (ndim - len(pshape)) + pshape)
     k_a, k_s, mu0, big_a, big_b = (stacked[:, j] for j in range(5))
-    fxs, fys = polach_forces(
-        creep_long, creep_lat, spin, normal_force, speed, a, b,
-        mu0=mu0, k_A=k_a, k_S=k_s, A=big_a, B=big_b, shear_modulus=shear_modulus, poisson=poisson,
+    fxs, fys = _polach_reference(
+        *(as_float_array(x, name) for x, name in zip(
+            (creep_long, creep_lat, spin, normal_force, speed, a, b), _WILAC_ARGS, strict=False
+        )),
+        mu0, k_a, k_s, big_a, big_b, as_float_array(shear_modulus, "shear_modulus"),
+        as_float_array(poisson, "poisson"),
     )  # fmt: skip
     f = weights[active]
     f = f.reshape((len(active),) + (1,) * (ndim - (f.ndim - 1)) + f.shape[1:])

@@ -1,0 +1,120 @@
+"""``railadhesion brake``: run a braking scenario (TOML) and write summary, histories, figures."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import typer
+from rich.console import Console
+from rich.markup import escape
+from rich.table import Table
+
+console = Console()
+
+
+def _clean(obj):
+    """JSON-safe copy (NaN and inf become null)."""
+    if isinstance(obj, dict):
+        return {str(k): _clean(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_clean(v) for v in obj]
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if hasattr(obj, "item"):
+        return _clean(obj.item())
+    return obj
+
+
+def write_outputs(result, out: Path, *, figures: bool = True, parquet: bool = True,
+                  log: bool = False) -> list[Path]:
+    """Write summary.json, histories.csv (+ .parquet), figures and optionally a test log."""
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    summary = {"status": result.status, "message": result.message, **result.summary,
+               "settings": result.settings}
+    path = out / "summary.json"
+    path.write_text(json.dumps(_clean(summary), indent=2, ensure_ascii=False) + "\n",
+                    encoding="utf-8")
+    written.append(path)
+    path = out / "histories.csv"
+    result.histories.to_csv(path, index=False, float_format="%.9g")
+    written.append(path)
+    if parquet:
+        try:
+            path = out / "histories.parquet"
+            result.histories.to_parquet(path, index=False)
+            written.append(path)
+        except ImportError:  # pragma: no cover - pyarrow is a dependency
+            pass
+    if figures:
+        from railadhesion.braking.figures import braking_figures
+
+        for name, fig in braking_figures(result).items():
+            path = out / f"{name}.png"
+            fig.savefig(path, dpi=100, bbox_inches="tight")
+            written.append(path)
+    if log:
+        from railadhesion.braking.log import write_braking_log
+
+        path = out / "braking_log.csv"
+        write_braking_log(result, path)
+        written.append(path)
+    return written
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``brake`` command to the main app."""
+
+    @app.command("brake")
+    def brake(
+        scenario: Path = typer.Argument(..., help="Scenario TOML file (docs/braking.md)."),
+        out: Path = typer.Option(..., "--out", help="Output folder."),
+        dt: float | None = typer.Option(None, help="Override the time step [s]."),
+        figures: bool = typer.Option(True, help="Write PNG figures."),
+        log: bool = typer.Option(False, help="Also write a braking-test log (2.4 ms, CSV)."),
+        quiet: bool = typer.Option(False, help="No progress bar."),
+    ) -> None:
+        """Simulate a braking scenario: summary JSON, CSV/Parquet histories, figures."""
+        from rich.progress import Progress
+
+        from railadhesion.braking.scenario import load_scenario, run_scenario
+        from railadhesion.braking.simulator import SimulationError
+
+        try:
+            sc = load_scenario(scenario)
+        except ValueError as exc:
+            console.print(f"[red]error:[/red] {escape(str(exc))}")
+            raise typer.Exit(code=2) from None
+        try:
+            if quiet:
+                result, _ = run_scenario(sc, dt=dt)
+            else:
+                with Progress(console=console, transient=True) as bar:
+                    task = bar.add_task("braking (speed lost)", total=1.0)
+                    result, _ = run_scenario(
+                        sc, dt=dt, progress=lambda f: bar.update(task, completed=f))
+            write_outputs(result, out, figures=figures, log=log)
+        except (SimulationError, ValueError) as exc:
+            console.print(f"[red]error:[/red] {escape(str(exc))}")
+            raise typer.Exit(code=2) from None
+        s = result.summary
+        table = Table(title=escape(sc.name or str(scenario)))
+        table.add_column("quantity")
+        table.add_column("value", justify="right")
+        table.add_row("status", escape(result.message))
+        table.add_row(escape("stopping distance [m]"), f"{s['stopping_distance_m']:.1f}")
+        table.add_row(escape("stopping time [s]"), f"{s['stopping_time_s']:.2f}")
+        if "extension_m" in s:
+            table.add_row(escape("dry-rail stopping distance [m]"),
+                          f"{s['dry_stopping_distance_m']:.1f}")
+            table.add_row(escape("extension vs dry [m, %]"),
+                          f"{s['extension_m']:.1f}  ({s['extension_percent']:.1f} %)")
+        table.add_row(escape("max slip [%]"), f"{100 * s['max_slip']:.1f}")
+        table.add_row(escape("longest lock [s]"), f"{s['longest_lock_s']:.2f}")
+        table.add_row("mean adhesion utilisation", f"{s['mean_adhesion_utilisation']:.3f}")
+        table.add_row(escape("WSP vent actions / vented air [l]"),
+                      f"{s['vent_actions']} / {s['vented_air_l']:.0f}")
+        console.print(table)
+        console.print(f"outputs written to {escape(str(out))}")

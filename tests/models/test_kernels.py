@@ -1,0 +1,265 @@
+"""The compiled kernels (railadhesion.models.kernels) against the NumPy reference.
+
+The NumPy implementations (``_polach_reference``, ``_wilac_reference``,
+``kalker_coefficients``) are the readable reference; the kernels must give the same numbers to
+about 1e-12 relative everywhere, edge cases included (zero creep, pure spin, huge creep, the
+spin cap, subnormal loads).
+"""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from railadhesion.contact.kalker import kalker_coefficients
+from railadhesion.models import kernels
+from railadhesion.models.polach import _polach_reference, _polach_scalar, polach_forces
+from railadhesion.models.wilac import (
+    WILAC_CONDITIONS,
+    WilacCondition,
+    WilacParameters,
+    _wilac_reference,
+    default_wilac_parameters,
+    wilac_forces,
+)
+
+RTOL = 1e-12
+SETTINGS = settings(max_examples=60, deadline=None)
+
+creep = st.one_of(
+    st.just(0.0),
+    st.floats(-0.5, 0.5, allow_nan=False),
+    st.floats(-1e-6, 1e-6, allow_nan=False),
+    st.sampled_from([1e-320, -1e-310, 1e300, -1e200, 5e-324]),
+)
+spin = st.one_of(st.just(0.0), st.floats(-20.0, 20.0), st.sampled_from([1e-320, 1e250, -3e5]))
+load = st.one_of(st.floats(1e2, 1e6), st.sampled_from([1e-310, 5e-324, 1e300]))
+k_st = st.floats(0.01, 1.0)
+
+
+def _close(ours, ref, scale):
+    """Equal to RTOL relative, or to 1e-13 of ``scale`` (mu Q) for components near zero."""
+    ours, ref = np.asarray(ours, float), np.asarray(ref, float)
+    np.testing.assert_allclose(ours, ref, rtol=RTOL, atol=1e-13 * np.max(scale))
+
+
+@given(
+    sx=st.lists(creep, min_size=1, max_size=6),
+    sy=creep, psi=spin, q=load, v=st.floats(0.0, 60.0), a=st.floats(1e-4, 2e-2),
+    ratio=st.sampled_from([1e-3, 0.05, 0.3, 1.0, 2.5, 40.0]), mu0=st.floats(0.02, 1.0),
+    k_a=k_st, k_s=k_st, big_a=st.floats(0.0, 2.0), big_b=st.one_of(st.just(0.0), st.floats(0, 50)),
+    nu=st.floats(0.0, 0.5),
+)  # fmt: skip
+@SETTINGS
+def test_polach_kernel_equals_numpy_reference(sx, sy, psi, q, v, a, ratio, mu0, k_a, k_s,
+                                              big_a, big_b, nu):  # fmt: skip
+    b = a / ratio
+    args = [np.array(sx), sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, 8.2e10, nu]
+    ref = _polach_reference(*(np.asarray(x, float) for x in args))
+    ours = polach_forces(*args[:7], mu0=mu0, k_A=k_a, k_S=k_s, A=big_a, B=big_b, poisson=nu)
+    scale = mu0 * q * max(1.0, big_a) * 2
+    _close(ours[0], ref[0], scale)
+    _close(ours[1], ref[1], scale)
+    # the scalar path (compiled, validated) and the Python reference scalar path
+    for i, x in enumerate(sx):
+        s = polach_forces(x, *args[1:7], mu0=mu0, k_A=k_a, k_S=k_s, A=big_a, B=big_b, poisson=nu)
+        r = _polach_scalar(x, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, 8.2e10, nu)
+        _close(s, r, scale)
+        _close(s, (ours[0][i], ours[1][i]), scale)
+
+
+def test_polach_kernel_edge_cases():
+    """Zero creep, pure spin, huge creep, the spin cap (active), subnormal loads, A = 0 with
+    friction gone, large and parallel arrays (the parallel kernel from 8192 contacts)."""
+    sx = np.array([0.0, 0.0, 1e300, 0.0, 1e-3, 0.5, 0.0, 1e-320])
+    sy = np.array([0.0, 0.0, 1e300, 7e-3, 0.0, 0.0, 0.0, 0.0])
+    psi = np.array([0.0, 0.3, 1e300, -1.95 * 7e-3 / 9e-3, 0.0, 0.0, 1e-320, 0.0])
+    q = np.array([1e5, 1e5, 1e5, 2e5, 1e-310, 1e5, 5e-324, 1e5])
+    big_a = np.array([0.4, 0.4, 0.4, 1.0, 0.4, 0.0, 0.4, 0.4])
+    big_b = np.array([0.6, 0.6, 0.6, 0.0, 0.6, 100.0, 0.6, 0.6])
+    args = [sx, sy, psi, q, 50.0, 9e-3, 1.8e-3, 0.1, 0.3, 0.1, big_a, big_b, 8.2e10, 0.28]
+    ref = _polach_reference(*(np.asarray(x, float) for x in args))
+    ours = polach_forces(*args[:7], mu0=0.1, k_A=0.3, k_S=0.1, A=big_a, B=big_b)
+    _close(ours, ref, 0.1 * 2e5)
+    assert ours[0][0] == 0.0 and ours[1][0] == 0.0
+    assert math.hypot(ours[0][3], ours[1][3]) == pytest.approx(0.1 * 2e5, rel=1e-12)  # capped
+    assert ours[0][5] == 0.0  # friction gone
+    rng = np.random.default_rng(3)
+    n = 20_000
+    big = [rng.uniform(-0.3, 0.3, n), rng.uniform(-0.01, 0.01, n), rng.uniform(-2, 2, n),
+           rng.uniform(2e4, 1.2e5, n), rng.uniform(0, 40, n), rng.uniform(3e-3, 8e-3, n),
+           rng.uniform(3e-3, 8e-3, n), 0.55, 1.0, 0.4, 0.4, 0.6, 8.2e10, 0.28]  # fmt: skip
+    ref = _polach_reference(*(np.asarray(x, float) for x in big))
+    ours = polach_forces(*big[:7], mu0=0.55, k_A=1.0, k_S=0.4, A=0.4, B=0.6)
+    _close(ours, ref, 0.55 * 1.2e5)
+    # partial broadcasting: (n, 1) against (1, m)
+    ours = polach_forces(big[0][:50, None], 0.0, 0.0, big[3][None, :7], 10.0, 6e-3, 5e-3,
+                         mu0=0.3)  # fmt: skip
+    ref = _polach_reference(big[0][:50, None], *(np.asarray(x, float) for x in (
+        0.0, 0.0, big[3][None, :7], 10.0, 6e-3, 5e-3, 0.3, 1.0, 1.0, 1.0, 0.0, 8.2e10, 0.28)))
+    assert ours[0].shape == (50, 7)
+    _close(ours, ref, 0.3 * 1.2e5)
+
+
+def test_polach_empty_arrays():
+    fx, fy = polach_forces(np.zeros(0), 0.0, 0.0, 1e5, 10.0, 6e-3, 5e-3, mu0=0.3)
+    assert fx.shape == (0,) and fy.shape == (0,)
+
+
+@given(r=st.one_of(st.floats(1e-150, 1e150), st.sampled_from([0.1, 0.5, 1.0, 1.9, 10.0, 0.099])),
+       nu=st.one_of(st.floats(0.0, 0.5), st.sampled_from([0.0, 0.25, 0.5])))  # fmt: skip
+@SETTINGS
+def test_kalker_kernel_equals_reference(r, nu):
+    ref = kalker_coefficients(r, nu)
+    ours = kernels.kalker_scalar(r, nu)
+    np.testing.assert_allclose(ours, tuple(ref), rtol=RTOL)
+    np.testing.assert_allclose(ours[:3], kernels._kalker3(r, nu), rtol=0, atol=0)
+    many = kernels.kalker_many(np.array([r, 1.0]), np.array([nu]))
+    np.testing.assert_allclose(many[:, 0], ours, rtol=0, atol=0)
+
+
+# --- WILAC --------------------------------------------------------------------------------
+
+
+def _params():
+    dry = WilacCondition(k_A=1.0, k_S=0.4, mu0=0.55, A=0.4, B=0.6)
+    wet = WilacCondition(k_A=0.3, k_S=0.1, mu0=0.3, A=0.4, B=0.2)
+    damp = WilacCondition(k_A=0.2, k_S=0.05, mu0={"terms": ["1", "Q", "1/v*exp(Q)"],
+                                                   "coefficients": [0.1, 0.05, 0.01]},
+                          A=0.5, B=1.0)  # fmt: skip
+    return WilacParameters({"dry": dry, "damp2": damp, "damp1": wet, "wet": wet}, 1e5, 40.0,
+                           (4e3, 1e5), (1.0, 40.0))  # fmt: skip
+
+
+@pytest.mark.parametrize("params", [_params(), default_wilac_parameters()],
+                         ids=["fixture", "default"])  # fmt: skip
+def test_wilac_kernel_equals_numpy_reference(params):
+    rng = np.random.default_rng(7)
+    n = 9000  # above the parallel threshold
+    args = [rng.uniform(-0.6, 0.6, n), rng.uniform(-0.01, 0.01, n), rng.uniform(-2, 2, n),
+            rng.uniform(1e3, 1.5e5, n), rng.uniform(0, 50, n), rng.uniform(1e-3, 9e-3, n),
+            rng.uniform(1e-3, 9e-3, n), rng.uniform(0, 120, n)]  # fmt: skip
+    args[0][:3] = 0.0
+    args[1][:3] = 0.0
+    args[2][:2] = 0.0
+    args[7][:100] = 25.0
+    ref = _wilac_reference(*args, params)
+    ours = wilac_forces(*args, params)
+    _close(ours, ref, 1.5 * 1.5e5)
+    # scalar path, a few contacts
+    for i in range(0, n, 1500):
+        s = wilac_forces(*(float(x[i]) for x in args), params)
+        _close(s, (ours[0][i], ours[1][i]), 1.5 * 1.5e5)
+
+
+def test_jitted_scalar_api_matches_public_functions():
+    """The stable numba API (polach_scalar, wilac_scalar with pack_wilac) gives the public
+    functions' numbers, with the Kalker coefficients passed in or looked up (c11 = 0)."""
+    a, b, nu = 6e-3, 5e-3, 0.28
+    c11, c22, c23, _ = kernels.kalker_scalar(a / b, nu)
+    pars = (1.0, 0.4, 0.55, 0.4, 0.6)
+    for sx, sy, psi in ((0.01, 0.001, 0.1), (0.0, 0.0, 0.0), (-0.2, 0.0, -1.0)):
+        ref = polach_forces(sx, sy, psi, 1e5, 20.0, a, b, mu0=0.55, k_A=1.0, k_S=0.4, A=0.4,
+                            B=0.6, poisson=nu)  # fmt: skip
+        got = kernels.polach_scalar(sx, sy, psi, 1e5, 20.0, a, b, 8.2e10, nu, c11, c22, c23,
+                                    *pars)  # fmt: skip
+        looked_up = kernels.polach_scalar(sx, sy, psi, 1e5, 20.0, a, b, 8.2e10, nu, 0.0, 0.0,
+                                          0.0, *pars)  # fmt: skip
+        assert got == ref and looked_up == ref
+    params = default_wilac_parameters()
+    packed = kernels.pack_wilac(params)
+    for w in (0.0, 25.0, 35.0, 350.0):
+        ref = wilac_forces(-0.05, 0.0, 0.1, 4.2e3, 5.0, 3e-3, 4e-3, w, params)
+        got = kernels.wilac_scalar(-0.05, 0.0, 0.1, 4.2e3, 5.0, 3e-3, 4e-3, w, 8.2e10, 0.28,
+                                   0.0, 0.0, 0.0, packed)  # fmt: skip
+        assert got == ref
+
+
+def test_pack_wilac_layout():
+    params = _params()
+    packed = kernels.pack_wilac(params)
+    nterm = int(packed[kernels.HEADER_SIZE])
+    assert nterm == 3 and packed.size == kernels.HEADER_SIZE + 1 + 4 * 5 * nterm * 4
+    assert packed[:6].tolist() == [1e5, 40.0, 4e3, 1e5, 1.0, 40.0]
+    reg = packed[kernels.HEADER_SIZE + 1 :].reshape(4, 5, nterm, 4)
+    damp2 = WILAC_CONDITIONS.index("damp2")
+    # mu0 of damp2: 0.1 + 0.05 Q' + 0.01 (1/v') exp(Q'): factor indices Q=0, 1/v=3, exp(Q)=4
+    assert reg[damp2, 2].tolist() == [[0.1, -1, -1, -1], [0.05, 0, -1, -1], [0.01, 3, 4, -1]]
+
+
+def test_jitted_api_is_callable_from_user_numba_code():
+    """The braking simulator's use: a user's @njit function calls the kernels directly."""
+    from numba import njit
+
+    @njit
+    def total_brake_force(creeps, packed):
+        c11, c22, c23, _ = kernels.kalker_scalar(6e-3 / 5e-3, 0.28)
+        out = 0.0
+        for s in creeps:
+            fx, _ = kernels.polach_scalar(s, 0.0, 0.0, 1e5, 20.0, 6e-3, 5e-3, 8.2e10, 0.28,
+                                          c11, c22, c23, 1.0, 0.4, 0.55, 0.4, 0.6)  # fmt: skip
+            gx, _ = kernels.wilac_scalar(s, 0.0, 0.0, 1e5, 20.0, 6e-3, 5e-3, 25.0, 8.2e10, 0.28,
+                                         c11, c22, c23, packed)  # fmt: skip
+            out += fx + gx
+        return out
+
+    params = default_wilac_parameters()
+    creeps = np.array([0.01, 0.05])
+    expected = sum(
+        float(polach_forces(s, 0.0, 0.0, 1e5, 20.0, 6e-3, 5e-3, mu0=0.55, k_S=0.4, A=0.4,
+                            B=0.6)[0])
+        + float(wilac_forces(s, 0.0, 0.0, 1e5, 20.0, 6e-3, 5e-3, 25.0, params)[0])
+        for s in creeps
+    )  # fmt: skip
+    assert total_brake_force(creeps, kernels.pack_wilac(params)) == pytest.approx(expected,
+                                                                                  rel=1e-14)
+
+
+def test_import_does_not_import_numba():
+    """``import railadhesion`` stays fast: numba is imported on the first kernel call."""
+    code = "import sys, railadhesion; print('numba' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)  # fmt: skip
+    assert out.stdout.strip() == "False"
+
+
+# --- the fixed-contact object ---------------------------------------------------------------
+
+
+@given(sx=creep, sy=creep, psi=spin, v=st.floats(0.0, 60.0), q=st.floats(1e2, 1e6),
+       ratio=st.sampled_from([0.05, 0.5, 1.0, 5.0]), k_a=k_st, k_s=k_st,
+       big_a=st.floats(0.0, 2.0), big_b=st.one_of(st.just(0.0), st.floats(0, 50)))  # fmt: skip
+@SETTINGS
+def test_polach_contact_equals_polach_forces(sx, sy, psi, v, q, ratio, k_a, k_s, big_a, big_b):
+    from railadhesion.models.polach import PolachContact
+
+    a = 6e-3
+    kw = dict(mu0=0.4, k_A=k_a, k_S=k_s, A=big_a, B=big_b)
+    contact = PolachContact(1e5, 10.0, a, a / ratio, **kw)
+    ref = polach_forces(sx, sy, psi, q, v, a, a / ratio, **kw)
+    got = contact.forces(sx, sy, psi, speed=v, normal_force=q)
+    assert type(got[0]) is float
+    _close(got, ref, 0.4 * q * 2)
+
+
+def test_polach_contact_validates():
+    from railadhesion.models.polach import Polach, PolachContact
+
+    with pytest.raises(ValueError, match="^k_A must be in"):
+        PolachContact(1e5, 10.0, 6e-3, 5e-3, mu0=0.3, k_A=2.0)
+    with pytest.raises(ValueError, match="one contact"):
+        PolachContact(np.array([1e5, 2e5]), 10.0, 6e-3, 5e-3, mu0=0.3)
+    contact = Polach("polach2005_wet").contact(1e5, 10.0, 6e-3, 5e-3)
+    for args, kwargs, name in (((math.nan,), {}, "creep_long"), ((0.0, math.inf), {}, "creep_lat"),
+                               ((0.0, 0.0, -math.inf), {}, "spin"),
+                               ((0.01,), {"speed": -1.0}, "speed"),
+                               ((0.01,), {"normal_force": 0.0}, "normal_force")):  # fmt: skip
+        with pytest.raises(ValueError, match=f"^{name} must be"):
+            contact.forces(*args, **kwargs)
+    assert "PolachContact(normal_force=100000.0" in repr(contact)
