@@ -306,7 +306,9 @@ def brake_coefficient(
     if not window.any():
         raise ValueError(
             "no sample with the brake applied (mean pressure >= "
-            f"{min_pressure / BAR:g} bar) in the usable part of the log: c cannot be identified"
+            f"{min_pressure / BAR:g} bar) in the usable part of the log (valid data, all wheels "
+            f"turning, v >= min_speed, more than {_EDGE_TIME:g} s from a gap or an end): c "
+            "cannot be identified"
         )
     vals = c[window]
     tw = t[window]
