@@ -722,24 +722,16 @@ def fit_wilac_cmd(
     console.print(f"WILAC parameters written to {escape(str(out))}")
 
 
-from railadhesion import cli_export  # noqa: E402
+# Commands of the other concerns, each in its own module.
+from railadhesion import (  # noqa: E402
+    cli_braking,
+    cli_export,
+    cli_identification,
+    cli_sweeps,
+)
 
-cli_export.register(app)
-
-
-from railadhesion.cli_identification import register as _register_identification  # noqa: E402
-
-_register_identification(app)
-
-
-from railadhesion.cli_braking import register as _register_braking  # noqa: E402
-
-_register_braking(app)
-
-from railadhesion import cli_sweeps  # noqa: E402
-
-cli_sweeps.register(app)
-
+for _module in (cli_braking, cli_identification, cli_sweeps, cli_export):
+    _module.register(app)
 
 if __name__ == "__main__":  # pragma: no cover
     app()

@@ -143,6 +143,17 @@ def identify(
             summary["curves_relative_slip"] = law_rel.to_frame().replace(
                 {np.nan: None}).to_dict(orient="records")
             summary["curve_form"] = "mu_s * (1 - exp(-s/s0)) * (A + (1 - A) * exp(-B*s))"
+            by_phase = {}
+            for phase in ("loss", "recovery"):
+                try:
+                    fitted = fit_adhesion_curves(ident, speed_bands=bands, phase=phase).overall
+                except ValueError as exc:  # too few samples in that phase
+                    by_phase[phase] = {"error": str(exc)}
+                    continue
+                by_phase[phase] = {**fitted.params, "n_samples": fitted.n_samples,
+                                   "r_squared": fitted.r_squared,
+                                   "slip_range_m_s": list(fitted.slip_range)}
+            summary["curves_by_phase_absolute_slip"] = by_phase
             (out / "summary.json").write_text(json.dumps(summary, indent=2), encoding="utf-8")
             bar.update(task, completed=len(stages), description="done")
         except (ValueError, OSError) as exc:

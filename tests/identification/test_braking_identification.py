@@ -126,3 +126,15 @@ def test_axle_count_mismatch(mini_run):
     veh = Vehicle(n_axles=6)
     with pytest.raises(ValueError, match="axles"):
         identify_adhesion(braking_log_from_frame(frame), veh)
+
+
+def test_pitch_angle_eq13_when_the_secondary_stiffness_is_given():
+    veh = Vehicle(secondary_stiffness=1.2e6)
+    frame, *_ = analytic_log(veh, 0.02)
+    res = identify_adhesion(braking_log_from_frame(frame), veh)
+    k = 4000
+    d = res.deceleration[k]
+    # eq. 13 by hand: theta = -M_c h d / (2 k2 l^2) = -32600 * 0.8 * d / (2 * 1.2e6 * 9.5**2)
+    assert res.pitch_angle[k] == pytest.approx(-32600 * 0.8 * d / (2 * 1.2e6 * 90.25))
+    assert res.pitch_angle[k] < 0
+    assert identify_adhesion(braking_log_from_frame(frame), Vehicle()).pitch_angle is None

@@ -111,6 +111,9 @@ class BrakingIdentification:
         Brake-cylinder pressures [Pa], filtered at the wheel cut-off.
     normal_load : ndarray (n, N)
         Axle normal loads N_i [N] (eqs. 11-12).
+    pitch_angle : ndarray (n,) or None
+        Car-body pitch angle [rad] (eq. 13; negative nose down under braking), when the
+        vehicle gives its secondary stiffness k_2; else None.
     mu : ndarray (n, N)
         Adhesion coefficient (eq. 10) [-].
     slip : ndarray (n, N)
@@ -144,6 +147,7 @@ class BrakingIdentification:
     angular_acceleration: np.ndarray
     pressure: np.ndarray
     normal_load: np.ndarray
+    pitch_angle: np.ndarray | None
     mu: np.ndarray
     slip: np.ndarray
     relative_slip: np.ndarray
@@ -209,6 +213,8 @@ class BrakingIdentification:
             "speed_range_m_s": [float(np.min(speed)), float(np.max(speed))] if speed.size
             else None,
             "mu_range": [float(np.min(mu)), float(np.max(mu))] if mu.size else None,
+            "pitch_angle_range_rad": None if self.pitch_angle is None else
+            [float(np.min(self.pitch_angle)), float(np.max(self.pitch_angle))],
             "windows": {
                 "loss": int((w["phase"] == "loss").sum()) if len(w) else 0,
                 "recovery": int((w["phase"] == "recovery").sum()) if len(w) else 0,
@@ -300,7 +306,9 @@ def brake_coefficient(
     if not window.any():
         raise ValueError(
             "no sample with the brake applied (mean pressure >= "
-            f"{min_pressure / BAR:g} bar) in the usable part of the log: c cannot be identified"
+            f"{min_pressure / BAR:g} bar) in the usable part of the log (valid data, all wheels "
+            f"turning, v >= min_speed, more than {_EDGE_TIME:g} s from a gap or an end): c "
+            "cannot be identified"
         )
     vals = c[window]
     tw = t[window]
@@ -527,6 +535,9 @@ def identify_adhesion(
         np.ascontiguousarray(log.train_speed), np.ascontiguousarray(log.valid), sub,
         edge_fast, j, c, r, float(min_speed),
     )
+    pitch = None
+    if getattr(vehicle, "secondary_stiffness", None) is not None:
+        pitch = np.asarray(vehicle.pitch_angle(d_f), dtype=float)
     fast_ok = v_f >= min_speed
     rel_rate = np.empty((n, n_ax))
     for a, b in _segments(log.segment):
@@ -575,7 +586,8 @@ def identify_adhesion(
     }
     return BrakingIdentification(
         time=t, speed=v_f, deceleration=d_f, angular_acceleration=wd2, pressure=p2,
-        normal_load=loads, mu=mu, slip=slip, relative_slip=rel, slip_rate=slip_rate,
+        normal_load=loads, pitch_angle=pitch, mu=mu, slip=slip, relative_slip=rel,
+        slip_rate=slip_rate,
         relative_slip_rate=rel_rate, use=use, phase=phase, windows=windows, brake=brake,
         brake_coefficient=c, settings=settings, log=log, vehicle=vehicle,
     )
