@@ -18,8 +18,8 @@ Integration (stiff wheels: the creep-force slope gives wheel time constants
    implicit equation ``J (ω − ω0)/dt = R N μ((v − ωR)/v) − c p̄`` is solved by a safeguarded
    Newton iteration (bisection inside a bracket, analytic slope for the Polach family); a wheel
    whose equation has no root with ω ≥ 0 locks (ω = 0). The train speed is then updated
-   implicitly by fixed-point iteration ``v = v0 − dt (Σ T_i(ω, v) + F)/M`` (contraction factor
-   ~ dt Σ dT/dv / M, a few per cent) until it changes by less than 1e-10 m/s;
+   implicitly: the fixed point of ``v = v0 − dt (Σ T_i(ω(v), v) + F)/M`` (a contraction,
+   factor ~ dt Σ dT/dv / M, a few per cent), found with secant steps, to 1e-10 m/s;
 3. distance by the trapezoidal rule.
 
 The scheme is L-stable for the wheel modes at any step, deterministic (no randomness, fixed
