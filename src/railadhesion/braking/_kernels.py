@@ -62,14 +62,15 @@ def solve_wheels_family(v, omega0, pbar, loads, dt, radius, inertia, brake_coeff
         nl = loads[i]
         rn = radius * nl
         torque = brake_coefficient * pbar[i]
-        mu1, _ = family_curve(1.0, v, weights[i], params[i], stiffness[i])
-        g0 = -inertia * omega0[i] / dt - rn * mu1 + torque
-        if not math.isfinite(g0):
-            return omega, mu_out, 1
-        if g0 >= 0.0:  # the wheel stops within the step: static brake friction holds it
-            omega[i] = 0.0
-            mu_out[i] = mu1
-            continue
+        if torque >= inertia * omega0[i] / dt:  # else the wheel cannot stop in this step
+            mu1, _ = family_curve(1.0, v, weights[i], params[i], stiffness[i])
+            g0 = -inertia * omega0[i] / dt - rn * mu1 + torque
+            if not math.isfinite(g0):
+                return omega, mu_out, 1
+            if g0 >= 0.0:  # the wheel stops within the step: static brake friction holds it
+                omega[i] = 0.0
+                mu_out[i] = mu1
+                continue
         lo = 0.0
         hi = omega0[i] + dt * rn * 2.0 / inertia + 1e-9
         w = min(max(guess[i], lo), hi)
@@ -195,7 +196,9 @@ def advance_family(v0, decel0, dt, omega0, p0, valves, command, static_load, tra
     v = v0 - dt * decel0
     omega = omega0.copy()
     mu = np.zeros(n)
-    for _ in range(20):
+    v_prev = v
+    r_prev = 0.0
+    for it in range(30):
         omega, mu, status = solve_wheels_family(v, omega0, pbar, loads, dt, radius, inertia,
                                                 brake_coefficient, weights, params, stiffness,
                                                 tol, omega)
@@ -205,10 +208,18 @@ def advance_family(v0, decel0, dt, omega0, p0, valves, command, static_load, tra
         for i in range(n):
             total += mu[i] * loads[i]
         v_new = v0 - dt * (total + external) / mass
-        done = abs(v_new - v) < tol
-        v = v_new
-        if done:
+        r = v_new - v
+        if abs(r) < tol:
+            v = v_new
             break
+        # secant step on r(v) = F(v) - v (plain fixed point on the first pass)
+        if it == 0 or r == r_prev:
+            v_next = v_new
+        else:
+            v_next = v - r * (v - v_prev) / (r - r_prev)
+        v_prev = v
+        r_prev = r
+        v = v_next
     brake_work = 0.0
     creep_work = 0.0
     for i in range(n):

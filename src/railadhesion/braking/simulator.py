@@ -18,8 +18,8 @@ Integration (stiff wheels: the creep-force slope gives wheel time constants
    implicit equation ``J (ω − ω0)/dt = R N μ((v − ωR)/v) − c p̄`` is solved by a safeguarded
    Newton iteration (bisection inside a bracket, analytic slope for the Polach family); a wheel
    whose equation has no root with ω ≥ 0 locks (ω = 0). The train speed is then updated
-   implicitly by fixed-point iteration ``v = v0 − dt (Σ T_i(ω, v) + F)/M`` (contraction factor
-   ~ dt Σ dT/dv / M, a few per cent) until it changes by less than 1e-10 m/s;
+   implicitly: the fixed point of ``v = v0 − dt (Σ T_i(ω(v), v) + F)/M`` (a contraction,
+   factor ~ dt Σ dT/dv / M, a few per cent), found with secant steps, to 1e-10 m/s;
 3. distance by the trapezoidal rule.
 
 The scheme is L-stable for the wheel modes at any step, deterministic (no randomness, fixed
@@ -340,14 +340,22 @@ class BrakingSimulator:
         external = resistance + self._grade_force
         v = v0 - dt * self.deceleration
         omega = self.omega
-        for _ in range(20):
+        v_prev, r_prev = v, 0.0
+        for it in range(30):
             omega, mu = self._solve_wheels_python(v, pbar, dt, omega)
             forces = mu * self.loads
-            v_new = v0 - dt * (float(np.sum(forces)) + external) / veh.total_mass
-            done = abs(v_new - v) < _TOL
-            v = v_new
-            if done:
+            total = 0.0
+            for f in forces:  # summed in axle order, as the compiled kernel does
+                total += f
+            v_new = v0 - dt * (total + external) / veh.total_mass
+            r = v_new - v
+            if abs(r) < _TOL:
+                v = v_new
                 break
+            # secant step on r(v) = F(v) - v (plain fixed point on the first pass)
+            v_next = v_new if it == 0 or r == r_prev else v - r * (v - v_prev) / (r - r_prev)
+            v_prev, r_prev = v, r
+            v = v_next
         wb = float(np.sum(c * pbar * omega)) * dt
         wc = float(np.sum(forces * (v - omega * radius))) * dt
         return v, omega, p1, mu, forces, vented, wb, wc, resistance * v * dt
