@@ -13,6 +13,10 @@ import math
 import numpy as np
 from numba import njit
 
+from railadhesion.models.kernels import _condition_parameters as _wilac_condition_parameters
+from railadhesion.models.kernels import _factors as _wilac_factors
+from railadhesion.models.kernels import _weights as _wilac_weights
+
 _TWO_OVER_PI = 2.0 / math.pi
 
 
@@ -233,40 +237,20 @@ def advance_family(v0, decel0, dt, omega0, p0, valves, command, static_load, tra
 def wilac_table(packed, loads, speed, water, weights, params):
     """Fill WILAC's blending weights (n, 4) and Polach parameters (n, 4, 5) per axle.
 
-    ``packed`` is :func:`railadhesion.models.kernels.pack_wilac` (layout documented there):
-    the erf transitions of Trummer et al. §5.3 for the weights, and per condition and
-    parameter the regression on Q' = Q/Q_ref, v' = v/v_ref (clamped into the calibrated
-    ranges, clipped to the physical bounds), §5.2.
+    ``packed`` is :func:`railadhesion.models.kernels.pack_wilac` (layout documented there);
+    the weights (erf transitions, Trummer et al. §5.3) and the regressions on Q', v' (clamped
+    into the calibrated ranges, clipped to the physical bounds, §5.2) are the WILAC kernel's
+    own functions, so the two cannot drift apart.
     """
-    header = 22
-    nterm = int(packed[header])
-    vn = min(max(speed, packed[4]), packed[5]) / packed[1]
+    fac = np.empty(7)
     for a in range(loads.shape[0]):
-        w = water[a]
-        e1 = 0.5 * (math.erf((w - packed[6]) / packed[7]) + 1.0)
-        e2 = 0.5 * (math.erf((w - packed[8]) / packed[9]) + 1.0)
-        e3 = 0.5 * (math.erf((w - packed[10]) / packed[11]) + 1.0)
-        weights[a, 0] = 1.0 - e1
-        weights[a, 1] = e1 - e2
-        weights[a, 2] = e2 - e3
-        weights[a, 3] = e3
-        qn = min(max(loads[a], packed[2]), packed[3]) / packed[0]
-        fac = (qn, vn, 1.0 / qn, 1.0 / vn, math.exp(qn), math.exp(vn))
+        f = _wilac_weights(water[a], packed)
         for i in range(4):
-            for j in range(5):
-                total = 0.0
-                base = header + 1 + (i * 5 + j) * nterm * 4
-                for k in range(nterm):
-                    p = base + 4 * k
-                    value = packed[p]
-                    if value == 0.0:
-                        continue
-                    for m in range(3):
-                        f = int(packed[p + 1 + m])
-                        if f >= 0:
-                            value = value * fac[f]
-                    total += value
-                params[a, i, j] = min(max(total, packed[12 + 2 * j]), packed[13 + 2 * j])
+            weights[a, i] = f[i]
+        _wilac_factors(loads[a], speed, packed, fac)
+        flat = params[a].reshape(20)
+        for i in range(4):
+            _wilac_condition_parameters(packed, i, fac, flat)
 
 
 # --------------------------------------------------------------------------------------------
