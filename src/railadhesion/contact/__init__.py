@@ -1,11 +1,5 @@
 """Contact mechanics: Hertz, Kalker linear theory, FASTSIM, Kalker's exact rolling theory."""
 
-from railadhesion.contact.exact import (
-    ExactResult,
-    exact_rolling,
-    solve_tangential,
-    tangential_influence,
-)
 from railadhesion.contact.fastsim import FastsimResult, fastsim
 from railadhesion.contact.geometry import NAMED_GEOMETRIES, contact_semi_axes
 from railadhesion.contact.hertz import (
@@ -22,6 +16,24 @@ from railadhesion.contact.kalker import (
     kalker_coefficients,
     linear_creep_forces,
 )
+
+# The exact solver compiles with numba: it is imported on first use, so that
+# ``import railadhesion`` stays fast and does not import numba.
+_LAZY = {
+    "ExactResult": "railadhesion.contact.exact",
+    "exact_rolling": "railadhesion.contact.exact",
+    "solve_tangential": "railadhesion.contact.exact",
+    "tangential_influence": "railadhesion.contact.exact",
+}
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module 'railadhesion.contact' has no attribute {name!r}")
+
 
 __all__ = [
     "ExactResult",
