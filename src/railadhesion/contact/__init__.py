@@ -21,6 +21,7 @@ from railadhesion.contact.kalker import (
     kalker_coefficients,
     linear_creep_forces,
 )
+from railadhesion.contact.table import exact_table_forces
 
 __all__ = [
     "ExactResult",
@@ -30,6 +31,7 @@ __all__ = [
     "LineContact",
     "combined_elastic_constants",
     "exact_rolling",
+    "exact_table_forces",
     "fastsim",
     "hertz_3d",
     "hertz_3d_from_curvatures",
