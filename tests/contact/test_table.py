@@ -4,6 +4,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from railadhesion.contact import kalker_coefficients
 from railadhesion.contact.exact import exact_rolling
@@ -73,3 +75,23 @@ def test_scalar_broadcast_and_bad_input():
         exact_table_forces(0.001, 0.0, 0.0, FZ, 1e-3, 1e-2, MU)
     with pytest.raises(ValueError, match="mu"):
         exact_table_forces(0.001, 0.0, 0.0, FZ, a, b, -1.0)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    xi=st.floats(-0.02, 0.02),
+    eta=st.floats(-0.02, 0.02),
+    phi=st.floats(-20.0, 20.0),
+    aob=st.floats(0.2, 5.0),
+)
+def test_property_bound_and_symmetries(xi, eta, phi, aob):
+    a, b, _ = _contact(aob)
+    fx, fy, mz = exact_table_forces(xi, eta, phi, FZ, a, b, MU)
+    assert math.hypot(fx, fy) <= MU * FZ * (1 + 1e-12)
+    # symmetries: exact by construction off the symmetry planes, to the build solver's
+    # tolerance on them (xi = 0 or eta = 0 look up both signs of the spin directly)
+    tol_f, tol_m = 1e-6 * MU * FZ, 1e-6 * MU * FZ * 1e-2
+    gx, gy, gz = exact_table_forces(-xi, -eta, -phi, FZ, a, b, MU)
+    assert abs(gx + fx) <= tol_f and abs(gy + fy) <= tol_f and abs(gz + mz) <= tol_m
+    hx, hy, hz = exact_table_forces(xi, -eta, -phi, FZ, a, b, MU)
+    assert abs(hx - fx) <= tol_f and abs(hy + fy) <= tol_f and abs(hz + mz) <= tol_m
