@@ -249,3 +249,11 @@ def test_bad_input_names_the_argument(kw, msg):
         (args if k in args else opts)[k] = v
     with pytest.raises(ValueError, match=msg):
         exact_rolling(**args, **opts)
+
+
+def test_warm_start_gives_the_same_solution():
+    xi = np.linspace(0.0, 0.003, 7)
+    cold = exact_rolling(xi, 0.0005, 0.3, 6e4, 5e-3, 6e-3, 0.3, nx=12, ny=12)
+    warm = exact_rolling(xi, 0.0005, 0.3, 6e4, 5e-3, 6e-3, 0.3, nx=12, ny=12, warm_start=True)
+    np.testing.assert_allclose(warm.fx, cold.fx, rtol=1e-4, atol=1e-5 * 0.3 * 6e4)
+    np.testing.assert_allclose(warm.fy, cold.fy, rtol=1e-4, atol=1e-5 * 0.3 * 6e4)

@@ -17,13 +17,14 @@ from railadhesion.contact.kalker import (
     linear_creep_forces,
 )
 
-# The exact solver compiles with numba: it is imported on first use, so that
+# The exact solver and its table model compile with numba: it is imported on first use, so that
 # ``import railadhesion`` stays fast and does not import numba.
 _LAZY = {
     "ExactResult": "railadhesion.contact.exact",
     "exact_rolling": "railadhesion.contact.exact",
     "solve_tangential": "railadhesion.contact.exact",
     "tangential_influence": "railadhesion.contact.exact",
+    "exact_table_forces": "railadhesion.contact.table",
 }
 
 
@@ -45,6 +46,8 @@ __all__ = [
     "combined_elastic_constants",
     "exact_rolling",
     "contact_semi_axes",
+
+    "exact_table_forces",
     "fastsim",
     "hertz_3d",
     "hertz_3d_from_curvatures",

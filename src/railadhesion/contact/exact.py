@@ -368,7 +368,7 @@ def _gauss_seidel(g, wx, wy, kxx, kxy, kyy, dgx, dgy, tol, max_iter, px, py, sx,
 @numba.njit(cache=True)
 def _solve_hertz_batch(
     xi, eta, phi, fz, a, b, mu, gmod, nu, mx, my, scale, spin_offset, tol, max_iter,
-    out_f, out_iter, out_err, px_all, py_all, sx_all, sy_all, state_all, keep_fields,
+    out_f, out_iter, out_err, px_all, py_all, sx_all, sy_all, state_all, keep_fields, warm,
 ):  # fmt: skip
     """Loop over cases: Hertz pressure on the grid, kernel (reused when unchanged), solve."""
     n = xi.size
@@ -405,11 +405,14 @@ def _solve_hertz_batch(
         dx = 2.0 * scale * a[c] / mx
         dy = 2.0 * scale * b[c] / my
         ratio = dy / dx
+        restart = True
         if ratio != last_ratio or nu[c] != last_nu:
             kxx, kxy, kyy = _rolling_kernel(mx, my, 1.0, ratio, nu[c])
             dgx, dgy = _gs_diagonal(ratio, nu[c])
             last_ratio = ratio
             last_nu = nu[c]
+        elif warm:
+            restart = False  # start from the previous case's tractions (same kernel)
         # kernel computed for dx = 1: K scales as 1/length * length = dimensionless
         # p_n scaled so that sum(p_n dA) = Fz exactly
         pfac = fz[c] / (ssum * dx * dy)
@@ -420,8 +423,15 @@ def _solve_hertz_batch(
                 y = b[c] * yh[j]
                 wx[j, i] = xi[c] - phi[c] * y
                 wy[j, i] = eta[c] + phi[c] * (x + spin_offset * dx)
-                px[j, i] = 0.0
-                py[j, i] = 0.0
+                if restart:
+                    px[j, i] = 0.0
+                    py[j, i] = 0.0
+                else:  # previous tractions, scaled into the new traction bound
+                    pt = math.sqrt(px[j, i] ** 2 + py[j, i] ** 2)
+                    if pt > g[j, i]:
+                        f = g[j, i] / pt
+                        px[j, i] *= f
+                        py[j, i] *= f
         it, err = _gauss_seidel(
             g, wx, wy, kxx, kxy, kyy, dgx, dgy, tol, max_iter, px, py, sx, sy, st
         )
@@ -533,6 +543,7 @@ def exact_rolling(
     tol: float = 1e-6,
     max_iter: int = 5000,
     return_fields: bool = False,
+    warm_start: bool = False,
 ) -> ExactResult:
     """Creep forces of steady rolling by Kalker's exact theory (half-space, Coulomb friction).
 
@@ -568,6 +579,10 @@ def exact_rolling(
         Largest number of Gauss-Seidel sweeps.
     return_fields : bool, optional
         Also return the grid, tractions, pressure, slip and the stick/slip map.
+    warm_start : bool, optional
+        Start each case from the tractions of the previous case when the grid is the same
+        (same a/b and nu): fewer sweeps along creep curves. The results then depend on the
+        order of the cases within the tolerance ``tol``. Default False.
 
     Returns
     -------
@@ -631,7 +646,7 @@ def exact_rolling(
         state = np.empty((1, 1, 1), np.int8)
     _solve_hertz_batch(
         *flat, nx, ny, scale, spin_offset, tol, max_iter,
-        out_f, out_iter, out_err, *fields, state, return_fields,
+        out_f, out_iter, out_err, *fields, state, return_fields, bool(warm_start),
     )  # fmt: skip
 
     def shaped(v):
