@@ -74,7 +74,8 @@ def main(argv=None) -> None:
               f"{np.round(np.array(cg) / (k.c11, k.c22, k.c23), 4)}, "
               f"{time.perf_counter() - t0:.0f} s", flush=True)  # fmt: skip
     np.savez_compressed(
-        args.out, values=values, aob=aob, tmag=tmag, theta=theta, uspin=uspin, cgrid=cgrid,
+        args.out, values=values.astype(np.float32), aob=aob, tmag=tmag, theta=theta,
+        uspin=uspin, cgrid=cgrid,
         grid=np.array([n, n]), poisson=np.array(TABLE_POISSON),
     )  # fmt: skip
     print(f"wrote {args.out}")
