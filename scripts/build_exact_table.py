@@ -9,7 +9,7 @@ at every node of :func:`railadhesion.contact.table.table_axes` in normalised for
 and c chosen so that tau = mu p0/G = 1e-3 and c = 1 cm; the results depend only on the
 normalised creepages). The Kalker-scaled node creepages are converted with the linear
 coefficients of the build grid itself (solved first, stored as ``cgrid``). Runtime: about
-5 minutes on 2 cores (about 18 000 cases).
+7 minutes on one core of the project machine (about 60 000 cases).
 """
 
 from __future__ import annotations

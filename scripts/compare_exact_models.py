@@ -173,7 +173,7 @@ def main(out: Path = DEFAULT_OUT) -> None:
         "* The table model carries the exact theory's spin effects, which Polach's closed "
         "form and FASTSIM approximate; its error is that of the interpolation plus the "
         "20 × 20 build grid after the Kalker-coefficient correction.",
-        "* The table's largest errors (0.03–0.04 μFz) sit in deep sliding with large spin "
+        "* The table's largest errors (0.02–0.03 μFz) sit in deep sliding with large spin "
         "on long contacts (a/b = 2–5, Kalker-scaled creepage ≈ 10 and spin ≈ 6): there both "
         "the magnitude and the spin fall in the last node interval before their infinite "
         "limits, where the table is coarse (checked: the solver itself converges there, "

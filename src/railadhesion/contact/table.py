@@ -51,7 +51,7 @@ AOB_MIN, AOB_MAX = 0.2, 5.0
 BIG = 1e4
 
 
-def table_axes(n_aob=9, n_mag=21, n_dir=7, n_spin=25):
+def table_axes(n_aob=9, n_mag=29, n_dir=7, n_spin=33):
     """Node coordinates of the table: (a/b, t, theta, u); see :func:`node_creepages`."""
     aob = np.geomspace(AOB_MIN, AOB_MAX, n_aob)
     tmag = np.linspace(0.0, 1.0, n_mag)
