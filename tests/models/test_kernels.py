@@ -269,3 +269,16 @@ def test_polach_contact_validates():
         with pytest.raises(ValueError, match=f"^{name} must be"):
             contact.forces(*args, **kwargs)
     assert "PolachContact(normal_force=100000.0" in repr(contact)
+
+
+def test_wilac_kernel_reuses_parameters_only_while_q_and_v_repeat():
+    """The kernel reuses a condition's Polach parameters while Q and v repeat: water flows
+    switching conditions on and off, and Q, v changing in runs, must give the reference."""
+    params = default_wilac_parameters()
+    n = 600
+    w = np.tile([0.0, 350.0, 25.0, 35.0, 350.0, 0.0], n // 6)
+    q = np.repeat([4.2e3, 2e4, 4.2e3, 1e5, 1e5 + 1.0], n // 5)
+    v = np.repeat([5.0, 5.0, 20.0, 0.5, 5.0, 5.0], n // 6)
+    sx = np.linspace(-0.5, 0.5, n)
+    args = (sx, 0.002, 0.1, q, v, 3e-3, 4e-3, w, params)
+    _close(wilac_forces(*args), _wilac_reference(*args), 1.5 * 1e5)
