@@ -180,6 +180,56 @@ def _timed(fn) -> float:
     return time.perf_counter() - t0
 
 
+def bench_braking(tmp: Path, steps: int = 2000) -> tuple[float, float]:
+    """Per-step cost [µs] of the braking-vehicle FMU (damp example, 1 ms steps, every input
+    changing) and of the stepping API driven directly with the same inputs."""
+    import shutil
+
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    from railadhesion.braking import BrakingSimulator
+    from railadhesion.braking.scenario import load_scenario
+    from railadhesion.export import build_braking_fmu
+
+    scenario = Path(__file__).resolve().parents[1] / "examples" / "brake_damp.toml"
+    fmu = build_braking_fmu(tmp / "brake.fmu", scenario)
+    md = read_model_description(fmu)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    cmd_refs = [vr[f"pressure_command_{k}"] for k in range(1, 5)]
+    valve_refs = [vr[f"valve_{k}"] for k in range(1, 5)]
+    out_refs = [vr[n] for n in ("train_speed", "wheel_speed_1", "wheel_speed_2",
+                                "wheel_speed_3", "wheel_speed_4")]  # fmt: skip
+    unzipped = extract(fmu)
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipped,
+                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="b")
+    slave.instantiate()
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    slave.exitInitializationMode()
+    commands = [[3e5 + 1e3 * (i % 50)] * 4 for i in range(steps)]
+    valves = [[0, 0, (i // 100) % 3, 0] for i in range(steps)]
+    t0 = time.perf_counter()
+    for i in range(steps):
+        slave.setReal(cmd_refs, commands[i])
+        slave.setReal(valve_refs, [float(v) for v in valves[i]])
+        slave.doStep(currentCommunicationPoint=i * 1e-3, communicationStepSize=1e-3)
+        slave.getReal(out_refs)
+    fmu_us = (time.perf_counter() - t0) / steps * 1e6
+    slave.terminate()
+    slave.freeInstance()
+    shutil.rmtree(unzipped, ignore_errors=True)
+    sc = load_scenario(scenario)
+    sim = BrakingSimulator(sc.vehicle, sc.adhesion(), sc.initial_speed, cylinders=sc.cylinders,
+                           record=False)
+    t0 = time.perf_counter()
+    for i in range(steps):
+        sim.step(1e-3, {"pressure_command": np.array(commands[i]),
+                        "valves": np.array(valves[i])})  # fmt: skip
+    direct_us = (time.perf_counter() - t0) / steps * 1e6
+    return fmu_us, direct_us
+
+
 def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
@@ -202,6 +252,10 @@ def main() -> None:
                   f"{r['fmu'] / r['direct']:>7.1f}{r['simulate']:>14.1f}")
         print(f"FMI + pythonfmu + FMPy overhead (FMU that copies its input, 8 values in, 3 out): "
               f"{bench_overhead(tmp):.1f} µs/step")
+        fmu_us, direct_us = bench_braking(tmp)
+        print(f"braking-vehicle FMU (4 axles, WILAC damp example, 1 ms steps): {fmu_us:.1f} "
+              f"µs/step under FMPy, {direct_us:.1f} µs/step through BrakingSimulator.step "
+              f"directly ({1e3 / fmu_us:.1f}x / {1e3 / direct_us:.1f}x real time)")
 
 
 if __name__ == "__main__":

@@ -74,6 +74,30 @@ def export_fmu(
     console.print("modelDescription.xml passes FMPy's validation")
 
 
+@export_app.command("braking-fmu")
+def export_braking_fmu(
+    scenario: Path = typer.Argument(..., help="Braking scenario TOML (docs/braking.md)."),
+    out: Path = typer.Option(Path("braking.fmu"), help="The FMU file to write (.fmu)."),
+) -> None:
+    """Write the braking vehicle of SCENARIO as an FMI 2.0 co-simulation FMU (inputs: commanded
+    pressure and WSP valve per axle; needs Python on the host)."""
+    from railadhesion.export import build_braking_fmu
+
+    try:
+        path = build_braking_fmu(out, scenario)
+    except ValueError as exc:
+        _fail(exc)
+    except OSError as exc:
+        _fail(f"cannot write {out}: {exc.strerror or exc}")
+    console.print(f"FMU written to {escape(str(path))}")
+    from fmpy.validation import validate_fmu
+
+    problems = validate_fmu(str(path))
+    if problems:
+        _fail("the FMU does not pass FMPy's validation: " + "; ".join(problems))
+    console.print("modelDescription.xml passes FMPy's validation")
+
+
 @export_app.command("table")
 def export_table(
     model: str = typer.Option("wilac", help=_MODEL_HELP),

@@ -1,6 +1,8 @@
 """Use the models from other tools: FMI 2.0 co-simulation FMUs and creep-force tables.
 
 * :func:`build_creep_force_fmu`: a WILAC or Polach creep-force law as an FMU (pythonfmu);
+* :func:`build_braking_fmu`: the braking simulator's stepping API as an FMU (inputs: commanded
+  pressure and WSP valve per axle);
 * :func:`creep_force_table`: a model evaluated on a grid, written as NetCDF
   (:func:`write_table_netcdf`) and as a plain CSV (:func:`write_table_csv`), with the error
   of multilinear interpolation in the table measured at the cell midpoints.
@@ -8,6 +10,7 @@
 See the README section "Using the models from other tools" and ``docs/creep-force-tables.md``.
 """
 
+from railadhesion.export.braking_fmu import braking_fmu_variables, build_braking_fmu
 from railadhesion.export.fmu import (
     FMU_MODELS,
     FmuVariable,
@@ -31,6 +34,8 @@ __all__ = [
     "FMU_MODELS",
     "FmuVariable",
     "InterpolationError",
+    "braking_fmu_variables",
+    "build_braking_fmu",
     "build_creep_force_fmu",
     "build_fmu",
     "creep_force_table",

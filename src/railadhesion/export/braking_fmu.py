@@ -1,0 +1,145 @@
+"""The braking-vehicle FMU: the braking simulator's stepping API as an FMI 2.0 co-simulation FMU.
+
+The shape a WSP hardware-in-the-loop rig or a train-level simulator connects to: inputs are the
+commanded brake-cylinder pressure and the WSP valve state of every axle, outputs the wheel
+speeds, the train speed and distance, the cylinder pressures and the creep forces. The vehicle,
+the brake cylinders, the adhesion model and the track (water-flow sections) come from a
+braking scenario file (``docs/braking.md``), embedded in the FMU with its provenance.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import html
+import json
+import tempfile
+from pathlib import Path
+from xml.etree import ElementTree as ET
+
+from railadhesion.export.fmu import FmuVariable, build_fmu
+
+__all__ = ["braking_fmu_variables", "build_braking_fmu"]
+
+_CONFIG_FILE = "railadhesion_fmu.json"
+_SCENARIO_FILE = "scenario.toml"
+
+
+def braking_fmu_variables(n_axles: int) -> list[FmuVariable]:
+    """The variables of a braking FMU with ``n_axles`` axles (axle 1 leading)."""
+    variables = []
+    for k in range(1, n_axles + 1):
+        variables += [
+            FmuVariable(f"pressure_command_{k}", "input", "Pa",
+                        f"commanded brake-cylinder pressure of axle {k} (the cylinder "
+                        "limits it to its maximum)", 0.0, 0.0),
+            FmuVariable(f"valve_{k}", "input", "1",
+                        f"WSP valve state of axle {k}: 0 apply, 1 hold, 2 vent (rounded)",
+                        0.0, 0.0, 2.0),
+        ]  # fmt: skip
+    variables += [
+        FmuVariable("train_speed", "output", "m/s", "train speed"),
+        FmuVariable("distance", "output", "m", "distance run since the start"),
+        FmuVariable("deceleration", "output", "m/s2", "train deceleration (braking > 0)"),
+        FmuVariable("stopped", "output", "1", "1 once the train has stopped, else 0"),
+    ]
+    for k in range(1, n_axles + 1):
+        variables += [
+            FmuVariable(f"wheel_speed_{k}", "output", "rad/s", f"angular speed of wheelset {k}"),
+            FmuVariable(f"brake_pressure_{k}", "output", "Pa",
+                        f"brake-cylinder pressure of axle {k}"),
+            FmuVariable(f"creep_force_{k}", "output", "N",
+                        f"longitudinal creep force of axle {k} (rail on wheelset, retarding "
+                        "when braking)"),
+            FmuVariable(f"adhesion_used_{k}", "output", "1",
+                        f"adhesion used by axle {k}: creep force / normal load"),
+            FmuVariable(f"normal_load_{k}", "output", "N",
+                        f"normal load of axle {k} (with pitch load transfer)"),
+        ]  # fmt: skip
+    return variables
+
+
+def build_braking_fmu(out, scenario) -> Path:
+    """Write an FMI 2.0 co-simulation FMU of a braking vehicle (the stepping API).
+
+    Parameters
+    ----------
+    out : str or os.PathLike
+        The ``.fmu`` file to write.
+    scenario : str or os.PathLike
+        A braking scenario TOML file (``docs/braking.md``). Its vehicle, initial speed, brake
+        cylinders, adhesion model, track and gradient are used; its brake demand and WSP
+        settings are not (the co-simulation master commands pressures and valves). It is
+        embedded verbatim as ``resources/scenario.toml``, so the files it names must be
+        built-in names (``coach_default``, the ``default`` WILAC set) or absolute paths on
+        the host.
+
+    Returns
+    -------
+    pathlib.Path
+        ``out``.
+
+    Notes
+    -----
+    Each ``doStep(t, h)`` calls :meth:`railadhesion.braking.BrakingSimulator.step` with ``h``
+    and the current inputs, so the FMU's outputs equal the stepping API's (tested to 1e-12
+    under FMPy). Like the creep-force FMU it runs Python: the host needs a Python interpreter
+    with ``railadhesion`` installed.
+    """
+    import railadhesion
+    from railadhesion.braking.scenario import load_scenario
+
+    path = Path(scenario)
+    if not path.is_file():
+        raise ValueError(f"scenario must be an existing TOML file, got {str(path)!r}")
+    text = path.read_text(encoding="utf-8")
+    with tempfile.TemporaryDirectory() as tmp:  # the copy must load on its own, as in the FMU
+        copy = Path(tmp) / _SCENARIO_FILE
+        copy.write_text(text, encoding="utf-8")
+        try:
+            loaded = load_scenario(copy)
+        except ValueError as exc:
+            raise ValueError(
+                f"scenario {str(path)!r} does not load on its own (files it names must be "
+                f"built-in names or absolute paths): {exc}"
+            ) from exc
+    vehicle = loaded.vehicle
+    variables = braking_fmu_variables(vehicle.n_axles)
+    sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    description = (
+        f"railadhesion {railadhesion.__version__}: braking vehicle '{vehicle.name}' "
+        f"({vehicle.n_axles} axles) from scenario '{loaded.name}', initial speed "
+        f"{loaded.initial_speed:g} m/s; inputs: commanded cylinder pressure and WSP valve per "
+        f"axle. Scenario embedded as resources/{_SCENARIO_FILE} (sha256 {sha[:12]}...)."
+    )
+    config = {
+        "scenario_file": _SCENARIO_FILE,
+        "railadhesion_version": railadhesion.__version__,
+        "description": description,
+        "fmu_version": f"railadhesion {railadhesion.__version__}, scenario {sha[:12]}",
+        "variables": [v.to_config() for v in variables],
+    }
+    meta = ET.Element("Scenario", {"name": loaded.name, "file": f"resources/{_SCENARIO_FILE}",
+                                   "sha256": sha, "railadhesionVersion": railadhesion.__version__})
+    prov = ET.SubElement(meta, "VehicleProvenance")
+    for key, value in dict(vehicle.provenance).items():
+        prov.set(str(key), str(value))
+    rows = "".join(
+        f"<tr><td>{html.escape(v.name)}</td><td>{v.causality}</td><td>{html.escape(v.unit)}"
+        f"</td><td>{html.escape(v.description)}</td></tr>" for v in variables
+    )
+    documentation = (
+        "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>Braking-vehicle FMU"
+        f"</title></head><body>\n<h1>Braking-vehicle FMU (railadhesion)</h1>\n"
+        f"<p>{html.escape(description)}</p>\n<p>Runs Python: the host needs a Python "
+        "interpreter with the railadhesion package installed.</p>\n<table border='1'>"
+        f"<tr><th>name</th><th>causality</th><th>unit</th><th>description</th></tr>{rows}"
+        f"</table>\n<h2>Scenario</h2>\n<pre>{html.escape(text)}</pre>\n</body></html>\n"
+    )
+    return build_fmu(
+        Path(__file__).with_name("railadhesion_braking.py"),
+        variables,
+        out,
+        resources={_CONFIG_FILE: json.dumps(config, indent=2), _SCENARIO_FILE: text},
+        documentation=documentation,
+        metadata=meta,
+    )
