@@ -15,8 +15,9 @@ their ratio:
 
 Timings are medians of several repeats (wall clock); the machine may be shared, so compare
 ratios within one run rather than absolute figures across runs. Memory: the peak of the
-allocations traced by ``tracemalloc`` during one call (NumPy arrays are traced; the compiled
-kernels' two output arrays, 16 bytes per contact, are not, and are added). After the kernel
+allocations traced by ``tracemalloc`` during one call (NumPy arrays are traced, the outputs of
+the compiled kernels included: NumPy allocates them; the kernels' scratch, about 150 KB per
+thread whatever the size, is not). After the kernel
 figures, every other ``benchmarks/bench_*.py`` script is run as a subprocess and its output
 printed.
 """
@@ -133,9 +134,11 @@ def micro(t):
     return f"{t * 1e6:.2f} µs"
 
 
-def compile_times() -> tuple[float, float, float]:
-    """(import time, cold first-call time, cached first-call time) [s], in fresh processes;
-    the cold one with an empty numba cache directory."""
+def compile_times() -> tuple[float, float, float, float, float]:
+    """(import time, cold first-call time, cached first-call time, cold and cached first call
+    of the parallel kernels) [s], in fresh processes; the cold ones with an empty numba cache
+    directory. The first calls are small (serial kernels) and scalar; the parallel kernels
+    (10^5 contacts and more) compile on their first call."""
     code = (
         "import time; t0 = time.perf_counter(); import railadhesion as ra;"
         "t1 = time.perf_counter();"
@@ -145,7 +148,12 @@ def compile_times() -> tuple[float, float, float]:
         "ra.wilac_forces(x, 0.0, 0.0, 4.2e3, 5.0, 3e-3, 4e-3, 25.0,"
         "                ra.default_wilac_parameters());"
         "ra.fastsim(0.001, 0.0, 0.0, 8e4, 6e-3, 5e-3, 0.3);"
-        "t2 = time.perf_counter(); print(t1 - t0, t2 - t1)"
+        "t2 = time.perf_counter(); x = np.linspace(-0.1, 0.1, 200_000);"
+        "ra.polach_forces(x, 0.0, 0.1, 1e5, 10.0, 6e-3, 5e-3, mu0=0.3);"
+        "ra.wilac_forces(x, 0.0, 0.0, 4.2e3, 5.0, 3e-3, 4e-3, 25.0,"
+        "                ra.default_wilac_parameters());"
+        "ra.fastsim(np.full(1000, 1e-3), 0.0, 0.0, 8e4, 6e-3, 5e-3, 0.3);"
+        "t3 = time.perf_counter(); print(t1 - t0, t2 - t1, t3 - t2)"
     )
     env = dict(os.environ, PYTHONPATH=str(SRC))
     with tempfile.TemporaryDirectory() as cache:
@@ -154,7 +162,7 @@ def compile_times() -> tuple[float, float, float]:
                               text=True, check=True).stdout.split()  # fmt: skip
         warm = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
                               text=True, check=True).stdout.split()  # fmt: skip
-    return float(warm[0]), float(cold[1]), float(warm[1])
+    return float(warm[0]), float(cold[1]), float(warm[1]), float(cold[2]), float(warm[2])
 
 
 def main(argv=None) -> None:
@@ -185,11 +193,13 @@ def main(argv=None) -> None:
           f"numba {numba.__version__}; load average {os.getloadavg()[0]:.1f} at start")  # fmt: skip
     threads = numba.get_num_threads()
     table = Table()
-    imp, cold, warm = compile_times()
+    imp, cold, warm, cold_par, warm_par = compile_times()
     table.add("import railadhesion", f"{imp * 1e3:.0f} ms", note="numba not imported")
     table.add("first kernel calls, cold cache", f"{cold:.1f} s",
               note="compiles Polach, WILAC, FASTSIM; once per installation")  # fmt: skip
     table.add("first kernel calls, cached", f"{warm:.2f} s", note="numba import + cache load")
+    table.add("first call of the parallel kernels, cold cache", f"{cold_par:.1f} s",
+              note=f"10^5 contacts and more; cached: {warm_par:.2f} s")  # fmt: skip
 
     dry = polach_parameters("polach2005_dry").as_dict()
     pars = (dry["mu0"], dry["k_A"], dry["k_S"], dry["A"], dry["B"])
@@ -218,7 +228,7 @@ def main(argv=None) -> None:
             numba.set_num_threads(1)
             t_one = median_time(ours)
             numba.set_num_threads(threads)
-            mem = traced_peak(ours) + 16 * n
+            mem = traced_peak(ours)
             mem_plain = traced_peak(plain)
             table.add(f"Polach {tag}, {label}", rate(n, t_ours), f"plain NumPy {rate(n, t_plain)}",
                       f"{t_plain / t_ours:.1f}x",
@@ -238,7 +248,7 @@ def main(argv=None) -> None:
         numba.set_num_threads(1)
         t_w1 = median_time(wilac, 3)
         numba.set_num_threads(threads)
-        mem = (traced_peak(wilac) + 16 * n) / n
+        mem = traced_peak(wilac) / n
         note = f"{threads} threads; 1 thread {rate(n, t_w1)}; memory {mem:.0f} B/contact"
         label = f"WILAC {tag}, array w 0-100 µl/s, spin, a/b varying"
         if n <= 1_000_000:
@@ -316,7 +326,8 @@ def main(argv=None) -> None:
     t = scalar_latency(lambda: kalker_coefficients(0.7, 0.28))
     table.add("Kalker coefficients, one call", micro(t))
     table.add("threads used by the parallel kernels", str(threads),
-              note=f"numba threading layer {numba.threading_layer()}")  # fmt: skip
+              note="numba.get_num_threads(): Polach, WILAC in a pool of Python threads; "
+                   f"FASTSIM numba's threading layer {numba.threading_layer()}")  # fmt: skip
     print(f"\nload average {os.getloadavg()[0]:.1f} at the end")
     table.show()
 

@@ -282,3 +282,134 @@ def test_wilac_kernel_reuses_parameters_only_while_q_and_v_repeat():
     sx = np.linspace(-0.5, 0.5, n)
     args = (sx, 0.002, 0.1, q, v, 3e-3, 4e-3, w, params)
     _close(wilac_forces(*args), _wilac_reference(*args), 1.5 * 1e5)
+
+
+# --- the batch kernels' paths (chunks of kernels._BATCH contacts) ----------------------------
+
+
+def _both_kernels(monkeypatch, call):
+    """``call()`` with the serial kernel, then with the parallel one; both results."""
+    serial = call()
+    monkeypatch.setattr(kernels, "_PARALLEL_MIN", 1)
+    monkeypatch.setattr(kernels, "_PARALLEL_MIN_WILAC", 1)
+    return serial, call()
+
+
+def test_polach_batch_kalker_lookup_paths(monkeypatch):
+    """a/b constant up to rounding (looked up once per distinct value), more distinct values
+    than the chunk remembers, the asymptotic range g < 0.1 and a/b > 700 (K_psi from exp
+    below -700) in arrays: the reference's numbers; serial and parallel kernels identical."""
+    rng = np.random.default_rng(5)
+    n = 3 * kernels._BATCH + 17
+    scale = rng.uniform(0.8, 1.25, n)
+    a = 6e-3 * scale
+    b = 5e-3 * scale  # a/b = 1.2 up to an ulp: a few distinct values
+    assert 1 < np.unique(a / b).size <= kernels._MEMO
+    ratios = np.array([1e-3, 0.05, 0.099, 0.1, 0.5, 1.0, 1.9, 10.0, 10.1, 40.0, 800.0, 1e5])
+    chunk = slice(kernels._BATCH, 2 * kernels._BATCH)  # the second chunk: many distinct a/b
+    a[chunk] = 4e-3 * np.resize(ratios, kernels._BATCH)
+    b[chunk] = 4e-3
+    args = [rng.uniform(-0.3, 0.3, n), rng.uniform(-0.01, 0.01, n), rng.uniform(-2, 2, n),
+            rng.uniform(2e4, 1.2e5, n), rng.uniform(0, 40, n), a, b]  # fmt: skip
+    pars = dict(mu0=0.55, k_A=0.8, k_S=0.4, A=0.4, B=0.6)
+    ref = _polach_reference(*(np.asarray(x, float) for x in args), 0.55, 0.8, 0.4, 0.4, 0.6,
+                            8.2e10, 0.28)  # fmt: skip
+    serial, parallel = _both_kernels(monkeypatch, lambda: polach_forces(*args, **pars))
+    _close(serial, ref, 0.55 * 1.2e5)
+    np.testing.assert_array_equal(serial, parallel)
+
+
+def test_batch_validation_names_the_argument_in_any_chunk():
+    n = 2 * kernels._BATCH + 3
+    sx = np.linspace(-0.1, 0.1, n)
+    q = np.full(n, 1e5)
+    q[n - 2] = -1.0  # in the last chunk
+    with pytest.raises(ValueError, match=r"^normal_force must be in \(0, inf\)"):
+        polach_forces(sx, 0.0, 0.0, q, 10.0, 6e-3, 5e-3, mu0=0.3)
+    k_a = np.full(n, 0.5)
+    k_a[kernels._BATCH] = np.nan
+    with pytest.raises(ValueError, match=r"^k_A must be in \(0.0, 1.0\]"):
+        polach_forces(sx, 0.0, 0.0, 1e5, 10.0, 6e-3, 5e-3, mu0=0.3, k_A=k_a)
+    a = np.full(n, 6e-3)
+    a[n - 1] = 6e-3 * 1e160  # a/b beyond Kalker's range
+    with pytest.raises(ValueError, match=r"^a, b: the axis ratio a/b must be in"):
+        polach_forces(sx, 0.0, 0.0, 1e5, 10.0, a, 6e-3, mu0=0.3)
+    w = np.full(n, 25.0)
+    w[n - 1] = -1.0
+    with pytest.raises(ValueError, match=r"^water_flow must be in \[0, inf\)"):
+        wilac_forces(sx, 0.0, 0.0, 1e5, 10.0, 6e-3, 5e-3, w, default_wilac_parameters())
+
+
+@pytest.mark.parametrize("params", [_params(), default_wilac_parameters()],
+                         ids=["fixture", "default"])  # fmt: skip
+def test_wilac_batch_paths(params, monkeypatch):
+    """Single Q and V (parameters once per call), no spin, a single water flow (conditions of
+    zero weight skipped), water flows switching conditions on and off within a chunk: the
+    reference's numbers; serial and parallel kernels identical."""
+    rng = np.random.default_rng(9)
+    n = 2 * kernels._BATCH + 5
+    sx = rng.uniform(-0.6, 0.6, n)
+    sy = rng.uniform(-0.01, 0.01, n)
+    psi = rng.uniform(-2, 2, n)
+    q = rng.uniform(1e3, 1.5e5, n)
+    v = rng.uniform(0, 50, n)
+    a = rng.uniform(1e-3, 9e-3, n)
+    w = rng.choice([0.0, 10.0, 25.0, 40.0, 60.0, 95.0, 350.0], n)
+    cases = (
+        (sx, sy, psi, 4.2e4, 12.0, a, 5e-3, w),  # single Q, V
+        (sx, sy, 0.0, q, v, a, 5e-3, w),  # no spin
+        (sx, sy, psi, q, v, 6e-3, 5e-3, 0.0),  # single w: dry and damp2 only
+        (sx, 0.0, psi, q, v, a, 5e-3, 350.0),  # single w: wet only
+    )
+    for args in cases:
+        ref = _wilac_reference(*args, params)
+        serial, parallel = _both_kernels(monkeypatch, lambda args=args: wilac_forces(*args,
+                                                                                     params))
+        monkeypatch.undo()
+        _close(serial, ref, 1.5 * 1.5e5)
+        np.testing.assert_array_equal(serial, parallel)
+
+
+def test_serial_and_parallel_twins_have_separate_caches():
+    """numba's disk cache is keyed by the function's qualified name, line and signature, not
+    by ``parallel``: the twins must carry different names or one would load the other's
+    cached code (the parallel FASTSIM kernel then ran serially)."""
+    from railadhesion.contact import _fastsim_kernels as fk
+
+    for par, ser in ((fk._strips_par, fk._strips_ser), (fk._rect_par, fk._rect_ser)):
+        assert par.targetoptions.get("parallel") and not ser.targetoptions.get("parallel")
+        assert par.py_func.__qualname__ != ser.py_func.__qualname__
+        assert par.py_func.__code__ is ser.py_func.__code__
+
+
+def test_polach_contact_numbers_and_mutation():
+    """Ints and NumPy scalars are accepted (converted, no new compilation); a changed normal
+    force or speed is used by the next call."""
+    from railadhesion.models.polach import PolachContact
+
+    contact = PolachContact(1e5, 20.0, 6e-3, 5e-3, mu0=0.4, k_S=0.5, A=0.4, B=0.6)
+    assert contact.forces(0) == (0.0, 0.0)
+    got = contact.forces(np.float64(0.01), 0, np.int64(1))
+    ref = polach_forces(0.01, 0.0, 1.0, 1e5, 20.0, 6e-3, 5e-3, mu0=0.4, k_S=0.5, A=0.4, B=0.6)
+    assert got == (float(ref[0]), float(ref[1]))
+    contact.normal_force = 5e4
+    contact.speed = 3.0
+    ref = polach_forces(0.01, 0.0, 0.0, 5e4, 3.0, 6e-3, 5e-3, mu0=0.4, k_S=0.5, A=0.4, B=0.6)
+    assert contact.forces(0.01) == (float(ref[0]), float(ref[1]))
+
+
+def test_read_only_and_writeable_inputs_share_one_compiled_kernel():
+    """numba compiles anew for each combination of read-only and writeable arguments (about
+    15 s on a cold cache): the public functions pass read-only views only."""
+    x = np.linspace(-0.1, 0.1, 7)
+    frozen = x.copy()
+    frozen.flags.writeable = False
+    a = np.full(7, 6e-3)
+    fx1, _ = polach_forces(x, 0.0, 0.1, 1e5, 10.0, a, 5e-3, mu0=0.3)
+    fx2, _ = polach_forces(frozen, 0.0, 0.1, 1e5, 10.0, a, 5e-3, mu0=0.3)
+    wilac_forces(frozen, 0.0, 0.1, 1e5, 10.0, a, 5e-3, x + 1.0, default_wilac_parameters())
+    np.testing.assert_array_equal(fx1, fx2)
+    assert x.flags.writeable and a.flags.writeable  # the caller's arrays are untouched
+    for sig in kernels._batch_chunks.signatures:
+        inputs = [t for i, t in enumerate(sig) if i not in (16, 17) and hasattr(t, "mutable")]
+        assert not any(t.mutable for t in inputs), sig

@@ -14,6 +14,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from railadhesion._jit import serial_and_parallel
+
 _TINY_TRACTION = 1e-30
 _FACPHI = 1.0 / 6.0
 #: Below this many contacts the serial kernels run (thread start-up, and on a busy machine
@@ -176,10 +178,8 @@ def _rect_py(xi, eta, phi, fz, a, b, mu, l1, l2, l3, scale, xh, yh, mask, shape,
     return fx, fy, mz, sf
 
 
-_strips_par = njit(cache=True, parallel=True, error_model="numpy")(_strips_py)
-_strips_ser = njit(cache=True, error_model="numpy")(_strips_py)
-_rect_par = njit(cache=True, parallel=True, error_model="numpy")(_rect_py)
-_rect_ser = njit(cache=True, error_model="numpy")(_rect_py)
+_strips_par, _strips_ser = serial_and_parallel(_strips_py, error_model="numpy")
+_rect_par, _rect_ser = serial_and_parallel(_rect_py, error_model="numpy")
 
 
 def march_strips(xi, eta, phi, fz, a, b, mu, l1, l2, l3, pattern):

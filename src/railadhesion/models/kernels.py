@@ -59,7 +59,9 @@ the public functions; they are not part of the stable API.
 from __future__ import annotations
 
 import math
+import os
 
+import numba
 import numpy as np
 from numba import njit, prange
 
@@ -89,9 +91,6 @@ _LOG2 = math.log(2.0)
 
 #: Number of header values of a packed WILAC set (:func:`pack_wilac`).
 HEADER_SIZE = 22
-#: Number of contacts a thread processes in sequence (the Kalker lookup is reused within it
-#: while a/b and nu do not change).
-_CHUNK = 2048
 #: Below this many contacts the serial kernels are used: thread start-up and, on a busy
 #: machine, waiting for a descheduled thread at the end of the parallel loop cost more than
 #: the work (measured: 10^4 contacts took 60 ms with 2 threads on a loaded machine, 0.3 ms
@@ -214,31 +213,7 @@ def _hyp(x, y):
 
 @njit(cache=True, error_model="numpy")
 def _kalker3(a_over_b, nu):
-    """C11, C22, C23 of :func:`kalker_scalar` (the same operations, without C33)."""
-    le = a_over_b <= 1.0
-    g = a_over_b if le else 1.0 / a_over_b
-    w0 = 8.0 * (nu - 0.25) * (nu - 0.5)
-    w1 = -16.0 * (nu - 0.5) * nu
-    w2 = 8.0 * nu * (nu - 0.25)
-    t = g if le else 2.0 - g
-    s = (min(max(t, 0.1), 1.9) - 0.1) * 10.0
-    sr = math.floor(s + 0.5)
-    if abs(s - sr) < 1e-9:
-        s = sr
-    i = min(int(s), _KNROW - 2)
-    f = s - i
-    e = 1.0 - f
-    out0 = _nu_blend(w0, w1, w2, _KROWS[i, 0, 0] * e + _KROWS[i + 1, 0, 0] * f,
-                     _KROWS[i, 0, 1] * e + _KROWS[i + 1, 0, 1] * f,
-                     _KROWS[i, 0, 2] * e + _KROWS[i + 1, 0, 2] * f)  # fmt: skip
-    out1 = _nu_blend(w0, w1, w2, _KROWS[i, 1, 0] * e + _KROWS[i + 1, 1, 0] * f,
-                     _KROWS[i, 1, 1] * e + _KROWS[i + 1, 1, 1] * f,
-                     _KROWS[i, 1, 2] * e + _KROWS[i + 1, 1, 2] * f)  # fmt: skip
-    out2 = _nu_blend(w0, w1, w2, _KROWS[i, 2, 0] * e + _KROWS[i + 1, 2, 0] * f,
-                     _KROWS[i, 2, 1] * e + _KROWS[i + 1, 2, 1] * f,
-                     _KROWS[i, 2, 2] * e + _KROWS[i + 1, 2, 2] * f)  # fmt: skip
-    if g >= _KG_MIN:
-        return out0, out1, out2
+    """C11, C22, C23 of :func:`kalker_scalar`."""
     c = kalker_scalar(a_over_b, nu)
     return c[0], c[1], c[2]
 
@@ -315,6 +290,25 @@ def polach_scalar(creep_x, creep_y, spin, normal_force, speed, a, b, G, nu, c11,
 
 
 @njit(cache=True, error_model="numpy")
+def _contact_forces(creep_x, creep_y, spin, normal_force, speed, data):
+    """:func:`polach_scalar` with one contact's fixed data ``data`` = (a, b, G, nu, c11, c22,
+    c23, k_A, k_S, mu0, A, B) (:class:`~railadhesion.models.polach.PolachContact`)."""
+    return polach_scalar(creep_x, creep_y, spin, normal_force, speed, data[0], data[1], data[2],
+                         data[3], data[4], data[5], data[6], data[7], data[8], data[9], data[10],
+                         data[11])  # fmt: skip
+
+
+def contact_kernel():
+    """:func:`_contact_forces` for float64 arguments only: other numbers (ints, NumPy
+    scalars) are converted by numba's dispatcher instead of compiling new versions."""
+    if not _contact_forces.signatures:
+        _contact_forces.compile("UniTuple(float64, 2)(float64, float64, float64, float64, "
+                                "float64, float64[::1])")  # fmt: skip
+        _contact_forces.disable_compile()
+    return _contact_forces
+
+
+@njit(cache=True, error_model="numpy")
 def polach_checked(creep_x, creep_y, spin, normal_force, speed, a, b, G, nu, c11, c22, c23,
                    k_A, k_S, mu0, A, B):  # fmt: skip
     """:func:`polach_scalar` with validation: returns (fx, fy, bad), ``bad`` = -1 if every
@@ -366,23 +360,6 @@ def _first_bad(sx, sy, psi, q, v, a, b, g, nu, k_a, k_s, mu0, big_a, big_b):
     return -1
 
 
-@njit(cache=True, error_model="numpy")
-def _bad_polach(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu):
-    """True if any argument is outside the range of polach_forces (NaN fails every test)."""
-    if not (math.isfinite(sx) and math.isfinite(sy) and math.isfinite(psi)):
-        return True
-    if not (0.0 < q < math.inf and 0.0 < a < math.inf and 0.0 < b < math.inf):
-        return True
-    if not (0.0 < mu0 < math.inf and 0.0 < g < math.inf):
-        return True
-    if not (0.0 < k_a <= 1.0 and 0.0 < k_s <= 1.0 and 0.0 <= nu <= 0.5):
-        return True
-    if not (0.0 <= v < math.inf and 0.0 <= big_a < math.inf and 0.0 <= big_b < math.inf):
-        return True
-    r = a / b
-    return not (_AOB_MIN <= r <= _AOB_MAX)
-
-
 # Rational approximation of arctan on [0, 0.66] after range reduction (coefficients of
 # S. L. Moshier's Cephes library, ``atan.c``): within 1 ulp of libm's atan, and free of calls
 # and branches so that loops over it vectorise.
@@ -417,6 +394,35 @@ def _atan_nonneg(x):
     return y0 + ((xr * (z * pz / qz) + xr) + extra)
 
 
+# --- batched kernels --------------------------------------------------------------------------
+#
+# Contacts are processed in chunks of _BATCH. Each stage of a model is one short loop over the
+# chunk in a function of its own: few arrays per loop (LLVM then needs few run-time aliasing
+# checks), no calls that do not inline, no float -> int64 conversions (AVX2 has none), so that
+# every stage compiles to SIMD code (four doubles per instruction). Contacts that need care
+# (zero creepage, magnitudes beyond 1e+-150, friction gone, exponents below -700) are flagged
+# and recomputed by the scalar code (:func:`_contact_terms`, :func:`_polach_terms`), which
+# follows the reference operation by operation. Stages and the scalar code use the same
+# operations in the same order, so that results agree to rounding (exp and arctan: within an
+# ulp of libm's).
+
+#: Contacts per chunk (the chunk's scratch rows stay in the level-2 cache).
+_BATCH = 512
+# exp(x) = 2^n exp(r): 2^n is built from n's bits; adding 1.5 2^52 to the float n leaves n in
+# the low bits of the sum (|n| < 2^51), which integer SIMD operations then shift into place.
+_ROUND_SHIFT = 6755399441055744.0
+_ROUND_SHIFT_BITS = 0x4338000000000000
+_E2, _E3, _E4, _E5, _E6, _E7 = _EXP_C[2:8]
+_E8, _E9, _E10, _E11, _E12, _E13 = _EXP_C[8:14]
+
+
+@njit(cache=True, error_model="numpy")
+def _fill(out, value, m):
+    """out[:m] = value (a loop: slice assignment would compile numba's shape-error code)."""
+    for k in range(m):
+        out[k] = value
+
+
 @njit(cache=True, error_model="numpy")
 def _chunk(arr, const, lo, hi):
     """arr[lo:hi], or the first hi - lo values of ``const`` (arr repeated) if arr has one."""
@@ -425,264 +431,303 @@ def _chunk(arr, const, lo, hi):
     return arr[lo:hi]
 
 
-def _polach_many_py(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu, n):
-    """Polach over n contacts; every argument a 1-d float64 array of length n or 1.
+# Allowed ranges of the arguments, as (low, low if closed else NaN, high, high if closed else
+# NaN): x is in range if (x > low or x == low_closed) and (x < high or x == high_closed).
+_INF = math.inf
+_NAN = math.nan
+_FINITE = (-_INF, _NAN, _INF, _NAN)
+_POSITIVE = (0.0, _NAN, _INF, _NAN)
+_NONNEGATIVE = (0.0, 0.0, _INF, _NAN)
+_FRACTION = (0.0, _NAN, 1.0, 1.0)  # (0, 1]
+_POISSON = (0.0, 0.0, 0.5, 0.5)  # [0, 0.5]
 
-    Returns (fx, fy, ok); ``ok`` False if an argument is out of range (the caller then runs
-    the reference validation to raise the error naming it). Contacts are processed in
-    chunks; within a chunk the common case runs in call-free, branch-free loops that the
-    compiler vectorises, and contacts needing care (zero creepage, magnitudes beyond
-    1e+-150, no friction left) are recomputed by the scalar code of :func:`polach_scalar`.
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _count_outside(xs, bounds, m):
+    """Number of the first m values of xs outside ``bounds`` (see _FINITE; NaN counts)."""
+    low, low_closed, high, high_closed = bounds
+    nbad = 0
+    for k in range(m):
+        x = xs[k]
+        nbad += 0 if ((x > low) | (x == low_closed)) & ((x < high) | (x == high_closed)) else 1
+    return nbad
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _spin_factors(ratio, kpsi, tmp, tmp2, m):
+    """Polach's K_psi = 1 + 6.3 (1 - exp(-a/b)) (tmp, tmp2: scratch)."""
+    for k in range(m):
+        tmp[k] = -ratio[k]
+    _exp_into(tmp, kpsi, tmp2, m)
+    for k in range(m):
+        kpsi[k] = 1.0 + 6.3 * (1.0 - kpsi[k])
+
+
+#: The most distinct (a/b, nu) pairs a chunk remembers before it looks contacts up one by one.
+_MEMO = 8
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _kalker_memo(ratio, nus, c11, c22, c23, kpsi, m):
+    """Kalker's coefficients and K_psi contact by contact, each distinct (a/b, nu) looked up
+    once (an a/b that is constant up to rounding takes a few values). Stops at the
+    (_MEMO + 1)-th distinct pair; returns (contacts done, False if an a/b was out of range)."""
+    memo = np.empty((_MEMO, 6))
+    memo[0, 0] = math.nan
+    used = 0
+    last = 0
+    ok = True
+    for k in range(m):
+        r = ratio[k]
+        nk = nus[k]
+        j = last
+        if not (memo[j, 0] == r and memo[j, 1] == nk):
+            j = -1
+            for e in range(used):
+                if memo[e, 0] == r and memo[e, 1] == nk:
+                    j = e
+                    break
+            if j < 0:
+                if used == _MEMO:
+                    return k, ok
+                j = used
+                used += 1
+                memo[j, 0] = r
+                memo[j, 1] = nk
+                if not _AOB_MIN <= r <= _AOB_MAX:
+                    ok = False
+                    r = 1.0
+                memo[j, 2], memo[j, 3], memo[j, 4] = _kalker3(r, nk)
+                memo[j, 5] = 1.0 + 6.3 * (1.0 - math.exp(-r))
+            last = j
+        c11[k] = memo[j, 2]
+        c22[k] = memo[j, 3]
+        c23[k] = memo[j, 4]
+        kpsi[k] = memo[j, 5]
+    return m, ok
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _kalker_rows(ratio, nus, c11, c22, c23, kpsi, tmp, tmp2, m):
+    """Kalker's C11, C22, C23 and Polach's K_psi per contact (tmp, tmp2: scratch); False if
+    an a/b is outside Kalker's range. Few distinct (a/b, nu): each looked up once
+    (:func:`_kalker_memo`); else contact by contact, K_psi vectorised."""
+    done, ok = _kalker_memo(ratio, nus, c11, c22, c23, kpsi, m)
+    if done == m:
+        return ok
+    for k in range(done, m):
+        r = ratio[k]
+        if not _AOB_MIN <= r <= _AOB_MAX:
+            ok = False
+            r = 1.0
+        c11[k], c22[k], c23[k] = _kalker3(r, nus[k])
+    _spin_factors(ratio[done:], kpsi[done:], tmp, tmp2, m - done)
+    for k in range(done, m):  # exp(-a/b) below -700: the scalar code
+        if not ratio[k] <= 700.0:
+            kpsi[k] = 1.0 + 6.3 * (1.0 - math.exp(-ratio[k]))
+    return ok
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _exp_parts(x, e, t, m):
+    """exp(x) = 2^n exp(r), x clamped to [-700, 700]: e = exp(r) (Taylor series to r^13) and
+    t = n + 1.5 2^52 (see :func:`_exp_into`)."""
+    for k in range(m):
+        xk = min(max(x[k], -700.0), 700.0)
+        nn = np.floor(xk * _LOG2E + 0.5)
+        r = (xk - nn * _LN2_HI) - nn * _LN2_LO
+        ek = _E13 * r + _E12
+        ek = ek * r + _E11
+        ek = ek * r + _E10
+        ek = ek * r + _E9
+        ek = ek * r + _E8
+        ek = ek * r + _E7
+        ek = ek * r + _E6
+        ek = ek * r + _E5
+        ek = ek * r + _E4
+        ek = ek * r + _E3
+        ek = ek * r + _E2
+        ek = ek * r + 1.0
+        ek = ek * r + 1.0
+        e[k] = ek
+        t[k] = nn + _ROUND_SHIFT
+
+
+@njit(cache=True, error_model="numpy")
+def _exp_into(x, out, tmp, m):
+    """out = exp(x) (within an ulp of libm's) for x in [-700, 700]; values beyond are those
+    of the clamped x (callers flag them or recompute them). ``tmp``: scratch."""
+    _exp_parts(x, out, tmp, m)
+    bits = tmp.view(np.int64)
+    for k in range(m):
+        bits[k] = (bits[k] - _ROUND_SHIFT_BITS + 1023) << 52
+    for k in range(m):
+        out[k] = out[k] * tmp[k]
+
+
+@njit(cache=True, error_model="numpy")
+def _negated_products(fos, xs, out, m):
+    for k in range(m):
+        out[k] = -fos[k] * xs[k]
+
+
+@njit(cache=True, error_model="numpy")
+def _scale(out, xs, m):
+    for k in range(m):
+        out[k] = out[k] * xs[k]
+
+
+# Rows of a chunk's scratch array (``rows``, shape (_POLACH_ROWS, _BATCH)): the contact's
+# geometry (filled once, shared by WILAC's conditions), then scratch of one Polach evaluation.
+_R_C11, _R_C22, _R_C23, _R_KPSI, _R_SC, _R_ABSYC, _R_S, _R_EPSN, _R_GC3, _R_FLAG0 = range(10)
+_R_FLAG, _R_ARG, _R_EXP, _R_TMP, _R_QMU, _R_FOS, _R_E2, _R_FYS = range(10, 18)
+_POLACH_ROWS = 18
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _contact_rows(xs, ys, ps, as_, bs, gs, nus, rows, m, kalker, spin_free):
+    """The creepage geometry of a chunk into ``rows`` (Kalker's coefficients, K_psi, s_C,
+    |s_yC|, s, the eps numerator, G c^3 C23, the flags of the norms).
+
+    ``kalker`` = (c11, c22, c23, K_psi) if a/b and nu are the same for every contact (looked
+    up once per call), else (0, 0, 0, 0): looked up here. False if an a/b is out of Kalker's
+    range.
     """
-    fx = np.empty(n)
-    fy = np.empty(n)
-    m0 = max(min(_CHUNK, n), 1)
-    k_sx = np.full(m0, sx[0])
-    k_sy = np.full(m0, sy[0])
-    k_psi_ = np.full(m0, psi[0])
-    k_q = np.full(m0, q[0])
-    k_v = np.full(m0, v[0])
-    k_a_ = np.full(m0, a[0])
-    k_b = np.full(m0, b[0])
-    k_mu0 = np.full(m0, mu0[0])
-    k_ka = np.full(m0, k_a[0])
-    k_ks = np.full(m0, k_s[0])
-    k_ba = np.full(m0, big_a[0])
-    k_bb = np.full(m0, big_b[0])
-    k_g = np.full(m0, g[0])
-    k_nu = np.full(m0, nu[0])
-    const_shape = a.size == 1 and b.size == 1 and nu.size == 1
-    c11_0 = c22_0 = c23_0 = 0.0
-    kpsi_0 = 1.0
-    if const_shape and 0.0 < a[0] < math.inf and 0.0 < b[0] < math.inf and 0.0 <= nu[0] <= 0.5:
-        r0 = a[0] / b[0]
-        if _AOB_MIN <= r0 <= _AOB_MAX:
-            c11_0, c22_0, c23_0 = _kalker3(r0, nu[0])
-            kpsi_0 = 1.0 + 6.3 * (1.0 - math.exp(-r0))
-    shape_ok = not const_shape or c11_0 > 0.0
-    const_mu = big_a.size == 1 and big_b.size == 1 and (big_b[0] == 0.0 or big_a[0] == 1.0)
-    spin_free = psi.size == 1 and psi[0] == 0.0
-    nchunk = (n + _CHUNK - 1) // _CHUNK
-    bad = np.zeros(nchunk, dtype=np.uint8)
-    for c in prange(nchunk):
-        lo = c * _CHUNK
-        hi = min(lo + _CHUNK, n)
-        m = hi - lo
-        xs = _chunk(sx, k_sx, lo, hi)
-        ys = _chunk(sy, k_sy, lo, hi)
-        ps = _chunk(psi, k_psi_, lo, hi)
-        qs = _chunk(q, k_q, lo, hi)
-        vs = _chunk(v, k_v, lo, hi)
-        as_ = _chunk(a, k_a_, lo, hi)
-        bs = _chunk(b, k_b, lo, hi)
-        mus = _chunk(mu0, k_mu0, lo, hi)
-        kas = _chunk(k_a, k_ka, lo, hi)
-        kss = _chunk(k_s, k_ks, lo, hi)
-        bas = _chunk(big_a, k_ba, lo, hi)
-        bbs = _chunk(big_b, k_bb, lo, hi)
-        gs = _chunk(g, k_g, lo, hi)
-        nus = _chunk(nu, k_nu, lo, hi)
-        # validation (vectorised count of out-of-range values)
-        nbad = 0
+    c11, c22, c23, kpsi = rows[_R_C11][:m], rows[_R_C22][:m], rows[_R_C23][:m], rows[_R_KPSI][:m]
+    scs, absyc, ss = rows[_R_SC][:m], rows[_R_ABSYC][:m], rows[_R_S][:m]
+    epsn, gc3, flag0 = rows[_R_EPSN][:m], rows[_R_GC3][:m], rows[_R_FLAG0][:m]
+    ok = True
+    if kalker[0] > 0.0:
+        _fill(c11, kalker[0], m)
+        _fill(c22, kalker[1], m)
+        _fill(c23, kalker[2], m)
+        _fill(kpsi, kalker[3], m)
+    else:
+        for k in range(m):  # a/b
+            gc3[k] = as_[k] / bs[k]
+        ok = _kalker_rows(gc3, nus, c11, c22, c23, kpsi, ss, absyc, m)
+    # Each stage is one short loop (few arrays: few run-time aliasing checks), compiled to
+    # SIMD code; the operations are those of _contact_terms, in its order.
+    for k in range(m):  # s_yC (its magnitude) and s_C
+        y = ys[k]
+        syc = y + ps[k] * as_[k]
+        syc = syc if abs(syc) > abs(y) else y
+        absyc[k] = abs(syc)
+        scs[k] = math.sqrt(xs[k] * xs[k] + syc * syc)
+    for k in range(m):  # s
+        ss[k] = math.sqrt(xs[k] * xs[k] + ys[k] * ys[k])
+    for k in range(m):  # Kalker's coefficient in the creep direction, c_jj
+        u = c11[k] * xs[k]
+        w = c22[k] * ys[k]
+        epsn[k] = math.sqrt(u * u + w * w) / ss[k] if ss[k] > 0.0 else c22[k]
+    for k in range(m):  # 1 where a norm is outside (1e-150, 1e150): hypot needed
+        m1 = max(abs(xs[k]), absyc[k])
+        m2 = max(abs(xs[k]), abs(ys[k]))
+        m3 = max(abs(c11[k] * xs[k]), abs(c22[k] * ys[k]))
+        fine = (
+            ((m1 > 1e-150) & (m1 < 1e150))
+            & ((m2 == 0.0) | ((m2 > 1e-150) & (m2 < 1e150)))
+            & ((m3 == 0.0) | ((m3 > 1e-150) & (m3 < 1e150)))
+        )
+        flag0[k] = 0.0 if fine else 1.0
+    for k in range(m):  # pi G a b c_jj s_C / 4 (eps times Q mu), in place of c_jj
+        epsn[k] = _PI_OVER_4 * gs[k] * as_[k] * bs[k] * epsn[k] * scs[k]
+    if not spin_free:
+        for k in range(m):  # G c^3 C23, c = sqrt(ab)
+            aa = as_[k]
+            gc3[k] = gs[k] * aa * bs[k] * math.sqrt(aa * bs[k]) * c23[k]
+    return ok
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _polach_rows(xs, ys, ps, qs, vs, as_, bs, gs, mus, kas, kss, bas, bbs, rows, ox, oy, m,
+                 const_mu, spin_free):  # fmt: skip
+    """Polach's forces of a chunk into ox, oy, from the geometry of :func:`_contact_rows`
+    in ``rows`` (whose other rows are scratch)."""
+    c11, c22, c23, kpsi = rows[_R_C11][:m], rows[_R_C22][:m], rows[_R_C23][:m], rows[_R_KPSI][:m]
+    scs, absyc, ss = rows[_R_SC][:m], rows[_R_ABSYC][:m], rows[_R_S][:m]
+    epsn, gc3, flag0 = rows[_R_EPSN][:m], rows[_R_GC3][:m], rows[_R_FLAG0][:m]
+    flag, arg, expo, tmp = rows[_R_FLAG][:m], rows[_R_ARG][:m], rows[_R_EXP][:m], rows[_R_TMP][:m]
+    qmus, fos, e2, fys = rows[_R_QMU][:m], rows[_R_FOS][:m], rows[_R_E2][:m], rows[_R_FYS][:m]
+    for k in range(m):
+        flag[k] = flag0[k]
+    if const_mu:
         for k in range(m):
-            ok = (
-                (xs[k] - xs[k] == 0.0) & (ys[k] - ys[k] == 0.0) & (ps[k] - ps[k] == 0.0)
-                & (qs[k] > 0.0) & (qs[k] < math.inf) & (vs[k] >= 0.0) & (vs[k] < math.inf)
-                & (as_[k] > 0.0) & (as_[k] < math.inf) & (bs[k] > 0.0) & (bs[k] < math.inf)
-                & (mus[k] > 0.0) & (mus[k] < math.inf) & (kas[k] > 0.0) & (kas[k] <= 1.0)
-                & (kss[k] > 0.0) & (kss[k] <= 1.0) & (bas[k] >= 0.0) & (bas[k] < math.inf)
-                & (bbs[k] >= 0.0) & (bbs[k] < math.inf) & (gs[k] > 0.0) & (gs[k] < math.inf)
-                & (nus[k] >= 0.0) & (nus[k] <= 0.5)
-            )  # fmt: skip
-            nbad += 0 if ok else 1
-        if nbad > 0 or not shape_ok:
-            bad[c] = 1
-            for k in range(m):
-                fx[lo + k] = math.nan
-                fy[lo + k] = math.nan
-            continue
-        # Kalker's coefficients and K_psi per contact (once per call if a/b is constant)
-        c11 = np.empty(m)
-        c22 = np.empty(m)
-        c23 = np.empty(m)
-        kpsi = np.empty(m)
-        if const_shape:
-            c11[:] = c11_0
-            c22[:] = c22_0
-            c23[:] = c23_0
-            kpsi[:] = kpsi_0
-        else:  # vectorised table lookup; the asymptotic range (g < 0.1) by the scalar code
-            kbits = np.empty(m, dtype=np.int64)
-            k_two_n = kbits.view(np.float64)
-            for k in range(m):
-                r = as_[k] / bs[k]
-                nu_k = nus[k]
-                le = r <= 1.0
-                gk = r if le else 1.0 / r
-                t = gk if le else 2.0 - gk
-                sidx = (min(max(t, 0.1), 1.9) - 0.1) * 10.0
-                sr = math.floor(sidx + 0.5)
-                sidx = sr if abs(sidx - sr) < 1e-9 else sidx
-                i = min(int(sidx), _KNROW - 2)
-                f = sidx - i
-                e = 1.0 - f
-                w0 = 8.0 * (nu_k - 0.25) * (nu_k - 0.5)
-                w1 = -16.0 * (nu_k - 0.5) * nu_k
-                w2 = 8.0 * nu_k * (nu_k - 0.25)
-                c11[k] = _nu_blend(w0, w1, w2, _KROWS[i, 0, 0] * e + _KROWS[i + 1, 0, 0] * f,
-                                   _KROWS[i, 0, 1] * e + _KROWS[i + 1, 0, 1] * f,
-                                   _KROWS[i, 0, 2] * e + _KROWS[i + 1, 0, 2] * f)  # fmt: skip
-                c22[k] = _nu_blend(w0, w1, w2, _KROWS[i, 1, 0] * e + _KROWS[i + 1, 1, 0] * f,
-                                   _KROWS[i, 1, 1] * e + _KROWS[i + 1, 1, 1] * f,
-                                   _KROWS[i, 1, 2] * e + _KROWS[i + 1, 1, 2] * f)  # fmt: skip
-                c23[k] = _nu_blend(w0, w1, w2, _KROWS[i, 2, 0] * e + _KROWS[i + 1, 2, 0] * f,
-                                   _KROWS[i, 2, 1] * e + _KROWS[i + 1, 2, 1] * f,
-                                   _KROWS[i, 2, 2] * e + _KROWS[i + 1, 2, 2] * f)  # fmt: skip
-                # K_psi = 1 + 6.3 (1 - exp(-a/b)), exp as in the friction loop below
-                arg = max(-r, -700.0)
-                nn = math.floor(arg * _LOG2E + 0.5)
-                rr = (arg - nn * _LN2_HI) - nn * _LN2_LO
-                ex = _EXP_C[13]
-                for j in range(12, -1, -1):
-                    ex = ex * rr + _EXP_C[j]
-                kpsi[k] = ex
-                kbits[k] = (np.int64(nn) + 1023) << 52
-            for k in range(m):
-                kpsi[k] = 1.0 + 6.3 * (1.0 - kpsi[k] * k_two_n[k])
-            for k in range(m):
-                r = as_[k] / bs[k]
-                if not (r >= _KG_MIN and r <= 1.0 / _KG_MIN):  # asymptotes, or out of range
-                    if not _AOB_MIN <= r <= _AOB_MAX:
-                        bad[c] = 1
-                        r = 1.0
-                    c11[k], c22[k], c23[k] = _kalker3(r, nus[k])
-        # Creepage geometry, friction, force and spin in short loops that the compiler
-        # vectorises (each loop touches few arrays, so that its aliasing checks stay few);
-        # contacts needing care are flagged for the scalar code below.
-        scs = np.empty(m)
-        absyc = np.empty(m)
-        ss = np.empty(m)
-        cjj = np.empty(m)
-        epsn = np.empty(m)
-        flag = np.empty(m, dtype=np.uint8)
+            qmus[k] = qs[k] * mus[k]
+        for k in range(m):  # friction gone (or NaN)
+            flag[k] = flag[k] + (0.0 if qmus[k] > 1e-300 else 1.0)
+    else:
+        for k in range(m):  # exponent of exp(-B w), w = s_C V
+            arg[k] = -bbs[k] * (scs[k] * vs[k])
+        _exp_into(arg, expo, tmp, m)
+        for k in range(m):  # Q mu, mu = mu0 ((1 - A) exp(-B w) + A); mu0 where B = 0 or A = 1
+            ba = bas[k]
+            mu = mus[k] * ((1.0 - ba) * expo[k] + ba)
+            qmus[k] = qs[k] * (mus[k] if (bbs[k] == 0.0) | (ba == 1.0) else mu)
+        for k in range(m):  # exponents below -700 (or NaN), friction gone
+            fine = (arg[k] >= -700.0) & (qmus[k] > 1e-300)
+            flag[k] = flag[k] + (0.0 if fine else 1.0)
+    for k in range(m):  # F / s_C of Polach's force law (arctan without calls)
+        qmu = qmus[k]
+        eps = min(epsn[k] / qmu, _EPS_MAX)
+        x = kas[k] * eps
+        fos[k] = _TWO_OVER_PI * qmu * (x / (1.0 + x * x) + _atan_nonneg(kss[k] * eps)) / scs[k]
+    _negated_products(fos, xs, ox, m)
+    _negated_products(fos, ys, oy, m)
+    if not spin_free:
+        for k in range(m):  # 1 + eps_psi^2
+            eps_psi = 8.0 / 3.0 * gc3[k] / as_[k] * absyc[k] / (kpsi[k] * qmus[k])
+            e2[k] = 1.0 + eps_psi * eps_psi
+        for k in range(m):  # Polach's F_yS (0 without spin)
+            e = e2[k]
+            value = gc3[k] * (ps[k] / scs[k]) * (absyc[k] / e) / e
+            fys[k] = value if ps[k] != 0.0 else 0.0
         for k in range(m):
-            y = ys[k]
-            syc = y + ps[k] * as_[k]
-            syc = syc if abs(syc) > abs(y) else y
-            absyc[k] = abs(syc)
-            scs[k] = math.sqrt(xs[k] * xs[k] + syc * syc)
-        for k in range(m):
-            ss[k] = math.sqrt(xs[k] * xs[k] + ys[k] * ys[k])
-        for k in range(m):
-            u = c11[k] * xs[k]
-            w = c22[k] * ys[k]
-            cjj[k] = math.sqrt(u * u + w * w) / ss[k] if ss[k] > 0.0 else c22[k]
-        for k in range(m):
-            epsn[k] = _PI_OVER_4 * gs[k] * as_[k] * bs[k] * cjj[k] * scs[k]
-        for k in range(m):
-            m1 = max(abs(xs[k]), absyc[k])
-            m2 = max(abs(xs[k]), abs(ys[k]))
-            m3 = max(abs(c11[k] * xs[k]), abs(c22[k] * ys[k]))
-            fine = (
-                ((m1 > 1e-150) & (m1 < 1e150))
-                & ((m2 == 0.0) | ((m2 > 1e-150) & (m2 < 1e150)))
-                & ((m3 == 0.0) | ((m3 > 1e-150) & (m3 < 1e150)))
-            )
-            flag[k] = 0 if fine else 1
-        # friction coefficient
-        qmus = np.empty(m)
-        if const_mu:
-            for k in range(m):
-                qmus[k] = qs[k] * mus[k]
-        else:  # exp(-B w) without calls: 2^n from its bits, exp(r) by its Taylor series
-            expo = np.empty(m)
-            bits = np.empty(m, dtype=np.int64)
-            two_n = bits.view(np.float64)
-            for k in range(m):
-                arg = -bbs[k] * (scs[k] * vs[k])
-                expo[k] = arg
-            for k in range(m):
-                arg = expo[k]
-                flag[k] = flag[k] | (0 if arg >= -700.0 else 1)  # NaN (0 * inf) included
-                arg = max(arg, -700.0)
-                nn = math.floor(arg * _LOG2E + 0.5)
-                r = (arg - nn * _LN2_HI) - nn * _LN2_LO
-                e = _EXP_C[13]
-                for j in range(12, -1, -1):
-                    e = e * r + _EXP_C[j]
-                expo[k] = e
-                bits[k] = (np.int64(nn) + 1023) << 52
-            for k in range(m):
-                expo[k] = expo[k] * two_n[k]
-            for k in range(m):
-                ba = bas[k]
-                mu = mus[k] * ((1.0 - ba) * expo[k] + ba)
-                qmus[k] = qs[k] * (mus[k] if (bbs[k] == 0.0) | (ba == 1.0) else mu)
-        for k in range(m):
-            flag[k] = flag[k] | (0 if qmus[k] > 1e-300 else 1)
-        # Polach's force (arctan without calls)
-        fos = np.empty(m)
-        for k in range(m):
-            qmu = qmus[k]
-            eps = min(epsn[k] / qmu, _EPS_MAX)
-            x = kas[k] * eps
-            fos[k] = _TWO_OVER_PI * qmu * (x / (1.0 + x * x) + _atan_nonneg(kss[k] * eps)) / scs[k]
-        ox = fx[lo:hi]
-        oy = fy[lo:hi]
-        for k in range(m):
-            ox[k] = -fos[k] * xs[k]
-        for k in range(m):
-            oy[k] = -fos[k] * ys[k]
-        # spin
-        if not spin_free:
-            gc3 = np.empty(m)
-            fys = np.empty(m)
-            for k in range(m):
-                aa = as_[k]
-                gc3[k] = gs[k] * aa * bs[k] * math.sqrt(aa * bs[k]) * c23[k]
-            for k in range(m):
-                eps_psi = 8.0 / 3.0 * gc3[k] / as_[k] * absyc[k] / (kpsi[k] * qmus[k])
-                fys[k] = 1.0 + eps_psi * eps_psi  # e2
-            for k in range(m):
-                e2 = fys[k]
-                value = gc3[k] * (ps[k] / scs[k]) * (absyc[k] / e2) / e2
-                fys[k] = value if ps[k] != 0.0 else 0.0
-            for k in range(m):
-                oy[k] = oy[k] - fys[k]
-            for k in range(m):
-                fxk = ox[k]
-                fyk = oy[k]
-                limit = max(qmus[k], fos[k] * ss[k])
-                total = math.sqrt(fxk * fxk + fyk * fyk)
-                cap = (fys[k] != 0.0) & (total > limit)
-                scale = limit / total if cap else 1.0
-                ox[k] = fxk * scale
-                oy[k] = fyk * scale
-            for k in range(m):
-                mf = max(abs(ox[k]), abs(oy[k]))
-                fine = (fys[k] == 0.0) | ((mf > 1e-150) & (mf < 1e150))
-                flag[k] = flag[k] | (0 if fine else 1)
-        # the careful scalar code where flagged
-        for k in range(m):
-            if flag[k] != 0:
-                t = _contact_terms(xs[k], ys[k], ps[k], as_[k], bs[k], gs[k], c11[k], c22[k],
-                                   c23[k])  # fmt: skip
-                fxi, fyi = _polach_terms(xs[k], ys[k], qs[k], vs[k], t[0], t[1], t[2], t[3],
+            oy[k] = oy[k] - fys[k]
+        for k in range(m):  # the spin cap's factor max(mu Q, |F|)/|(fx, fy)| where it is < 1
+            fxk = ox[k]
+            fyk = oy[k]
+            limit = max(qmus[k], fos[k] * ss[k])
+            total = math.sqrt(fxk * fxk + fyk * fyk)
+            cap = (fys[k] != 0.0) & (total > limit)
+            tmp[k] = limit / total if cap else 1.0
+        _scale(ox, tmp, m)
+        _scale(oy, tmp, m)
+        for k in range(m):  # forces beyond (1e-150, 1e150) where the cap's norm was taken
+            mf = max(abs(ox[k]), abs(oy[k]))
+            fine = (fys[k] == 0.0) | ((mf > 1e-150) & (mf < 1e150))
+            flag[k] = flag[k] + (0.0 if fine else 1.0)
+    for k in range(m):  # the careful scalar code where flagged
+        if flag[k] != 0.0:
+            t = _contact_terms(xs[k], ys[k], ps[k], as_[k], bs[k], gs[k], c11[k], c22[k],
+                               c23[k])  # fmt: skip
+            ox[k], oy[k] = _polach_terms(xs[k], ys[k], qs[k], vs[k], t[0], t[1], t[2], t[3],
                                          t[4], t[5], t[6], kas[k], kss[k], mus[k], bas[k],
                                          bbs[k])  # fmt: skip
-                fx[lo + k] = fxi
-                fy[lo + k] = fyi
-    return fx, fy, bad.sum() == 0
 
 
-_polach_many_par = njit(cache=True, parallel=True, error_model="numpy")(_polach_many_py)
-_polach_many_ser = njit(cache=True, error_model="numpy")(_polach_many_py)
+@njit(cache=True, error_model="numpy")
+def _outside(xs, bounds, lo, m):
+    """Number of values out of ``bounds`` among xs[lo:lo + m] (xs of n values) or xs[0] (one
+    value, broadcast)."""
+    if xs.size == 1:
+        lo, m = 0, 1
+    return _count_outside(xs[lo:], bounds, m)
 
 
-def polach_many(args, n):
-    """Run the Polach kernel on 1-d float64 arrays (length n or 1); serial for small n."""
-    kernel = _polach_many_par if n >= _PARALLEL_MIN else _polach_many_ser
-    return kernel(*args, n)
+@njit(cache=True, error_model="numpy", inline="always")
+def _shape_constants(a, b, nu):
+    """(c11, c22, c23, K_psi) of a/b and nu if all three are single values (looked up once per
+    call), else zeros; and True if a/b is then out of Kalker's range."""
+    if a.size == 1 and b.size == 1 and nu.size == 1:
+        a0, b0, nu0 = a[0], b[0], nu[0]
+        if 0.0 < a0 < math.inf and 0.0 < b0 < math.inf and 0.0 <= nu0 <= 0.5:
+            r0 = a0 / b0
+            if not _AOB_MIN <= r0 <= _AOB_MAX:
+                return (0.0, 0.0, 0.0, 0.0), True
+            c11, c22, c23 = _kalker3(r0, nu0)
+            return (c11, c22, c23, 1.0 + 6.3 * (1.0 - math.exp(-r0))), False
+    return (0.0, 0.0, 0.0, 0.0), False
 
 
 # --- WILAC ----------------------------------------------------------------------------------
@@ -691,6 +736,7 @@ def polach_many(args, n):
 #: Offset of the term counts, and of the regressions, in a packed WILAC set.
 _COUNTS = HEADER_SIZE + 1
 _TERMS = _COUNTS + 20
+_U1, _U2, _U3 = np.uint64(1), np.uint64(2), np.uint64(3)
 
 
 def pack_wilac(params):
@@ -762,11 +808,14 @@ def _condition_parameters(packed, i, fac, out):
     nterm = int(packed[HEADER_SIZE])
     for j in range(5):
         base = _TERMS + (i * 5 + j) * nterm * 4
+        terms = packed[base : base + 4 * int(packed[_COUNTS + i * 5 + j])]
         total = 0.0
-        for k in range(int(packed[_COUNTS + i * 5 + j])):
-            p = base + 4 * k
-            total = total + packed[p] * fac[int(packed[p + 1])] * fac[int(packed[p + 2])] * fac[
-                int(packed[p + 3])]  # fmt: skip
+        # unsigned positions, and factor indices masked into 0-7 (they are 0-6): the compiler
+        # then knows them non-negative and leaves out the negative-index wraparound code
+        for k in range(terms.size // 4):
+            p = np.uint64(4 * k)
+            total = total + terms[p] * fac[int(terms[p + _U1]) & 7] * fac[
+                int(terms[p + _U2]) & 7] * fac[int(terms[p + _U3]) & 7]  # fmt: skip
         out[5 * i + j] = min(max(total, packed[12 + 2 * j]), packed[13 + 2 * j])
 
 
@@ -808,8 +857,9 @@ def wilac_scalar(creep_x, creep_y, spin, normal_force, speed, a, b, water_flow, 
     if not c11 > 0.0:
         c11, c22, c23 = _kalker3(a / b, nu)
     weights = _weights(water_flow, packed)
-    fac = np.empty(7)
-    pars = np.empty(20)
+    scratch = np.empty(27)  # one allocation: the factors, then the parameters
+    fac = scratch[:7]
+    pars = scratch[7:]
     _factors(normal_force, speed, packed, fac)
     for i in range(4):
         if weights[i] != 0.0:
@@ -832,85 +882,293 @@ def wilac_checked(creep_x, creep_y, spin, normal_force, speed, a, b, water_flow,
     return fx, fy, True
 
 
-def _wilac_many_py(sx, sy, psi, q, v, a, b, w, g, nu, packed, n):
-    """WILAC over n contacts (1-d float64 arrays of length n or 1); returns (fx, fy, ok).
+# Rows of WILAC's chunk scratch after Polach's (_POLACH_ROWS): the four weights, the seven
+# regression factors (Q', v', 1/Q', 1/v', exp(Q'), exp(v'), 1), one condition's five Polach
+# parameters and its forces.
+_R_WEIGHT = _POLACH_ROWS
+_R_FACTOR = _R_WEIGHT + 4
+_R_PARAM = _R_FACTOR + 7
+_R_CX = _R_PARAM + 5
+_R_CY = _R_CX + 1
+_WILAC_ROWS = _R_CY + 1
 
-    Per chunk of contacts, the Kalker coefficients are reused while a/b and nu repeat and a
-    condition's Polach parameters while the (clamped) Q and v repeat.
+@njit(cache=True, error_model="numpy", inline="always")
+def _weight_rows(ws, packed, rows, m):
+    """The four weights of :func:`_weights` per contact (recomputed only when w changes)."""
+    w0, w1, w2, w3 = rows[_R_WEIGHT][:m], rows[_R_WEIGHT + 1][:m], rows[_R_WEIGHT + 2][:m], \
+        rows[_R_WEIGHT + 3][:m]
+    last = math.nan
+    f0 = f1 = f2 = f3 = 0.0
+    for k in range(m):
+        wk = ws[k]
+        if wk != last:
+            f0, f1, f2, f3 = _weights(wk, packed)
+            last = wk
+        w0[k] = f0
+        w1[k] = f1
+        w2[k] = f2
+        w3[k] = f3
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _factor_rows(qs, vs, packed, rows, m):
+    """The regression factors of :func:`_factors` per contact."""
+    qn, vn = rows[_R_FACTOR][:m], rows[_R_FACTOR + 1][:m]
+    q_low, q_high, q_ref, v_low, v_high, v_ref = (packed[2], packed[3], packed[0], packed[4],
+                                                  packed[5], packed[1])  # fmt: skip
+    for k in range(m):  # Q', v': clamped, normalised
+        qn[k] = min(max(qs[k], q_low), q_high) / q_ref
+        vn[k] = min(max(vs[k], v_low), v_high) / v_ref
+    iq, iv = rows[_R_FACTOR + 2][:m], rows[_R_FACTOR + 3][:m]
+    for k in range(m):
+        iq[k] = 1.0 / qn[k]
+        iv[k] = 1.0 / vn[k]
+    eq, ev = rows[_R_FACTOR + 4][:m], rows[_R_FACTOR + 5][:m]
+    _exp_into(qn, eq, rows[_R_TMP], m)
+    _exp_into(vn, ev, rows[_R_TMP], m)
+    for k in range(m):  # beyond [-700, 700] (a parameter set of huge ranges): libm's exp
+        if not (qn[k] <= 700.0 and vn[k] <= 700.0):
+            eq[k] = math.exp(qn[k])
+            ev[k] = math.exp(vn[k])
+    _fill(rows[_R_FACTOR + 6], 1.0, m)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _add_term(out, coef, f1, f2, f3, m):
+    """out += coef f1 f2 f3 (in this order, as :func:`_condition_parameters`)."""
+    for k in range(m):
+        out[k] = out[k] + coef * f1[k] * f2[k] * f3[k]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _clip(out, low, high, m):
+    for k in range(m):
+        out[k] = min(max(out[k], low), high)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _regression_row(packed, i, j, rows, out, m):
+    """Polach parameter j of condition i per contact, as :func:`_condition_parameters` (the
+    same terms in the same order)."""
+    nterm = int(packed[HEADER_SIZE])
+    base = _TERMS + (i * 5 + j) * nterm * 4
+    _fill(out, 0.0, m)
+    for t in range(int(packed[_COUNTS + i * 5 + j])):
+        p = base + 4 * t
+        _add_term(out, packed[p], rows[_R_FACTOR + int(packed[p + 1])],
+                  rows[_R_FACTOR + int(packed[p + 2])], rows[_R_FACTOR + int(packed[p + 3])],
+                  m)  # fmt: skip
+    _clip(out, packed[12 + 2 * j], packed[13 + 2 * j], m)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _count_nonzero(xs, m):
+    count = 0
+    for k in range(m):
+        count += 1 if xs[k] != 0.0 else 0
+    return count
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _blend(ox, oy, weights, cx, cy, m):
+    """(ox, oy) += weight * (cx, cy) where the weight is not zero."""
+    for k in range(m):
+        f = weights[k]
+        ox[k] = ox[k] + (f * cx[k] if f != 0.0 else 0.0)
+        oy[k] = oy[k] + (f * cy[k] if f != 0.0 else 0.0)
+
+
+# --- batched drivers --------------------------------------------------------------------------
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _batch_outside(sx, sy, psi, q, v, a, b, g, nu, mu0, k_a, k_s, big_a, big_b, w, lo, m):
+    """Number of arguments out of the ranges of polach_forces and wilac_forces among contacts
+    lo to lo + m."""
+    return (_outside(sx, _FINITE, lo, m) + _outside(sy, _FINITE, lo, m)
+            + _outside(psi, _FINITE, lo, m) + _outside(q, _POSITIVE, lo, m)
+            + _outside(v, _NONNEGATIVE, lo, m) + _outside(a, _POSITIVE, lo, m)
+            + _outside(b, _POSITIVE, lo, m) + _outside(g, _POSITIVE, lo, m)
+            + _outside(nu, _POISSON, lo, m) + _outside(mu0, _POSITIVE, lo, m)
+            + _outside(k_a, _FRACTION, lo, m) + _outside(k_s, _FRACTION, lo, m)
+            + _outside(big_a, _NONNEGATIVE, lo, m) + _outside(big_b, _NONNEGATIVE, lo, m)
+            + _outside(w, _NONNEGATIVE, lo, m))  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def _batch_chunks(sx, sy, psi, q, v, a, b, g, nu, mu0, k_a, k_s, big_a, big_b, w, packed, fx,
+                  fy, first, last, wilac):  # fmt: skip
+    """Polach's (``wilac`` False) or WILAC's forces of chunks first to last - 1 (of _BATCH
+    contacts) into fx, fy (length n). The other arguments are 1-d float64 arrays of length n
+    or 1 (broadcast); Polach ignores w and packed, WILAC the five Polach parameters (pass
+    valid single values). One function for both models: the shared stages are compiled once.
+
+    Returns the number of chunks with an argument out of range (their forces are NaN; the
+    caller then runs the reference validation to raise the error naming it).
+
+    WILAC, per chunk: the contact geometry once (shared by the conditions), the weights, the
+    regression factors, then for each condition whose weight is not zero somewhere in the
+    chunk its five parameters (vectorised regressions) and Polach's forces (the stages of
+    :func:`_polach_rows`), blended. With single values of Q and v the parameters are computed
+    once; with a single w, conditions of zero weight are skipped for the whole call.
+    """
+    n = fx.size
+    m0 = max(min(_BATCH, n), 1)
+    # arguments of one value, repeated over a chunk
+    single = np.empty((15, m0))
+    for j, x in enumerate((sx, sy, psi, q, v, a, b, g, nu, mu0, k_a, k_s, big_a, big_b, w)):
+        _fill(single[j], x[0], m0)
+    k_sx, k_sy, k_psi_, k_q, k_v = single[0], single[1], single[2], single[3], single[4]
+    k_a_, k_b, k_g, k_nu, k_mu0 = single[5], single[6], single[7], single[8], single[9]
+    k_ka, k_ks, k_ba, k_bb, k_w = single[10], single[11], single[12], single[13], single[14]
+    kalker, shape_bad = _shape_constants(a, b, nu)
+    spin_free = psi.size == 1 and psi[0] == 0.0
+    const_mu = big_a.size == 1 and big_b.size == 1 and (big_b[0] == 0.0 or big_a[0] == 1.0)
+    const_qv = q.size == 1 and v.size == 1
+    pars = np.zeros(20)  # WILAC's parameters of single Q and v
+    if wilac and const_qv:
+        fac = np.empty(7)
+        _factors(q[0], v[0], packed, fac)
+        for i in range(4):
+            _condition_parameters(packed, i, fac, pars)
+    rows = np.empty((_WILAC_ROWS if wilac else _POLACH_ROWS, _BATCH))
+    nbad = 0
+    for c in range(first, last):
+        lo = c * _BATCH
+        hi = min(lo + _BATCH, n)
+        m = hi - lo
+        xs = _chunk(sx, k_sx, lo, hi)
+        ys = _chunk(sy, k_sy, lo, hi)
+        ps = _chunk(psi, k_psi_, lo, hi)
+        qs = _chunk(q, k_q, lo, hi)
+        vs = _chunk(v, k_v, lo, hi)
+        as_ = _chunk(a, k_a_, lo, hi)
+        bs = _chunk(b, k_b, lo, hi)
+        gs = _chunk(g, k_g, lo, hi)
+        nus = _chunk(nu, k_nu, lo, hi)
+        ox = fx[lo:hi]
+        oy = fy[lo:hi]
+        bad = shape_bad or _batch_outside(sx, sy, psi, q, v, a, b, g, nu, mu0, k_a, k_s, big_a,
+                                          big_b, w, lo, m) > 0  # fmt: skip
+        bad = bad or not _contact_rows(xs, ys, ps, as_, bs, gs, nus, rows, m, kalker, spin_free)
+        if bad:
+            nbad += 1
+            _fill(ox, math.nan, m)
+            _fill(oy, math.nan, m)
+            continue
+        if wilac:
+            _weight_rows(_chunk(w, k_w, lo, hi), packed, rows, m)
+            if not const_qv:
+                _factor_rows(qs, vs, packed, rows, m)
+            _fill(ox, 0.0, m)
+            _fill(oy, 0.0, m)
+        # Polach's forces once (Polach), or per condition (WILAC): one call site, so that
+        # the stages are compiled once
+        for i in range(4 if wilac else 1):
+            if wilac:
+                if _count_nonzero(rows[_R_WEIGHT + i], m) == 0:
+                    continue
+                for j in range(5):
+                    if const_qv:
+                        _fill(rows[_R_PARAM + j], pars[5 * i + j], m)
+                    else:
+                        _regression_row(packed, i, j, rows, rows[_R_PARAM + j], m)
+                kas, kss, mus = rows[_R_PARAM], rows[_R_PARAM + 1], rows[_R_PARAM + 2]
+                bas, bbs = rows[_R_PARAM + 3], rows[_R_PARAM + 4]
+                cx, cy = rows[_R_CX], rows[_R_CY]
+                cmu = const_qv and (pars[5 * i + 4] == 0.0 or pars[5 * i + 3] == 1.0)
+            else:
+                kas, kss, mus = _chunk(k_a, k_ka, lo, hi), _chunk(k_s, k_ks, lo, hi), _chunk(
+                    mu0, k_mu0, lo, hi)  # fmt: skip
+                bas, bbs = _chunk(big_a, k_ba, lo, hi), _chunk(big_b, k_bb, lo, hi)
+                cx, cy = ox, oy
+                cmu = const_mu
+            _polach_rows(xs, ys, ps, qs, vs, as_, bs, gs, mus, kas, kss, bas, bbs, rows, cx, cy,
+                         m, cmu, spin_free)  # fmt: skip
+            if wilac:
+                _blend(ox, oy, rows[_R_WEIGHT + i], cx, cy, m)
+    return nbad
+
+
+def _read_only(x):
+    """A read-only view of x (the kernels are compiled for read-only inputs only)."""
+    if x.flags.writeable:
+        x = x.view()
+        x.flags.writeable = False
+    return x
+
+
+_ONE = _read_only(np.ones(1))
+_ZERO = _read_only(np.zeros(1))
+
+
+#: Tasks per thread of a parallel call (handed out one by one: a thread that gets ahead, or
+#: one that a busy machine holds up, is balanced by the others).
+_TASKS_PER_THREAD = 4
+_POOL: dict = {}
+
+
+def _thread_pool(nthreads: int):
+    """The process's pool of kernel threads: created on first use, anew with more threads
+    if asked, and anew in a forked child (whose copy of the pool has no threads)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    key = (os.getpid(), nthreads)
+    pool = _POOL.get("pool")
+    if _POOL.get("key") != key or pool is None:
+        if pool is not None and _POOL["key"][0] == key[0]:
+            pool.shutdown(wait=False)
+        pool = ThreadPoolExecutor(max_workers=nthreads, thread_name_prefix="railadhesion-kernel")
+        _POOL.update(pool=pool, key=key)
+    return pool
+
+
+def _run_batch(contact, params, w, packed, n, wilac, parallel_min):
+    """Allocate the outputs and run the batch kernel; returns (fx, fy, ok).
+
+    From ``parallel_min`` contacts on, the chunks are split into tasks run by
+    ``numba.get_num_threads()`` threads: the kernel releases the GIL, so plain Python threads
+    run it in parallel, and no second, parallel compilation of it is needed (numba's
+    ``parallel=True`` would compile the whole kernel again, about 15 s on a cold cache).
+
+    The outputs are allocated here, by NumPy: its allocations of large arrays are reused from
+    call to call (and use transparent huge pages), where arrays allocated inside numba code
+    are fresh pages every call (a page fault every 4 KiB: about 9 ns a contact for the two
+    outputs, measured).
     """
     fx = np.empty(n)
     fy = np.empty(n)
-    s0 = 1 if sx.size > 1 else 0
-    s1 = 1 if sy.size > 1 else 0
-    s2 = 1 if psi.size > 1 else 0
-    s3 = 1 if q.size > 1 else 0
-    s4 = 1 if v.size > 1 else 0
-    s5 = 1 if a.size > 1 else 0
-    s6 = 1 if b.size > 1 else 0
-    s7 = 1 if w.size > 1 else 0
-    s8 = 1 if g.size > 1 else 0
-    s9 = 1 if nu.size > 1 else 0
-    nchunk = (n + _CHUNK - 1) // _CHUNK
-    bad = np.zeros(nchunk, dtype=np.uint8)
-    for c in prange(nchunk):
-        lo = c * _CHUNK
-        hi = min(lo + _CHUNK, n)
-        last_r = -1.0
-        last_nu = -1.0
-        c11 = c22 = c23 = 0.0
-        fac = np.empty(7)
-        pars = np.empty(20)
-        key_q = np.full(4, math.nan)
-        key_v = np.full(4, math.nan)
-        last_q = math.nan
-        last_v = math.nan
-        for i in range(lo, hi):
-            xa = a[i * s5]
-            xb = b[i * s6]
-            xnu = nu[i * s9]
-            xq = q[i * s3]
-            xv = v[i * s4]
-            xw = w[i * s7]
-            xsx = sx[i * s0]
-            xsy = sy[i * s1]
-            xpsi = psi[i * s2]
-            xg = g[i * s8]
-            if _bad_polach(xsx, xsy, xpsi, xq, xv, xa, xb, 1.0, 1.0, 1.0, 0.0, 0.0, xg,
-                           xnu) or not (0.0 <= xw < math.inf):  # fmt: skip
-                bad[c] = 1
-                fx[i] = math.nan
-                fy[i] = math.nan
-                continue
-            r = xa / xb
-            if r != last_r or xnu != last_nu:
-                c11, c22, c23 = _kalker3(r, xnu)
-                last_r = r
-                last_nu = xnu
-            weights = _weights(xw, packed)
-            if xq != last_q or xv != last_v:
-                _factors(xq, xv, packed, fac)
-                last_q = xq
-                last_v = xv
-            for k in range(4):
-                if weights[k] != 0.0 and (key_q[k] != xq or key_v[k] != xv):
-                    _condition_parameters(packed, k, fac, pars)
-                    key_q[k] = xq
-                    key_v[k] = xv
-            t = _contact_terms(xsx, xsy, xpsi, xa, xb, xg, c11, c22, c23)
-            fxi, fyi = _wilac_blend(xsx, xsy, xq, xv, t, weights, pars)
-            fx[i] = fxi
-            fy[i] = fyi
-    return fx, fy, bad.sum() == 0
+    nchunk = (n + _BATCH - 1) // _BATCH
+    nthreads = numba.get_num_threads() if n >= parallel_min else 1
+    if nthreads <= 1 or nchunk < 2:
+        nbad = _batch_chunks(*contact, *params, w, packed, fx, fy, 0, nchunk, wilac)
+        return fx, fy, nbad == 0
+    ntask = min(nchunk, _TASKS_PER_THREAD * nthreads)
+    bounds = [nchunk * t // ntask for t in range(ntask + 1)]
+    pool = _thread_pool(nthreads)
+    tasks = [pool.submit(_batch_chunks, *contact, *params, w, packed, fx, fy, bounds[t],
+                         bounds[t + 1], wilac) for t in range(ntask)]  # fmt: skip
+    nbad = sum(task.result() for task in tasks)
+    return fx, fy, nbad == 0
 
 
-_wilac_many_par = njit(cache=True, parallel=True, error_model="numpy")(_wilac_many_py)
-_wilac_many_ser = njit(cache=True, error_model="numpy")(_wilac_many_py)
+def polach_many(args, n):
+    """Polach's forces of n contacts: ``args`` are the 14 arguments of polach_forces (order
+    of its signature) as read-only 1-d float64 arrays of length n or 1 (:func:`flatten_args`);
+    returns (fx, fy, ok), ``ok`` False if an argument is out of range. Serial below
+    _PARALLEL_MIN contacts."""
+    sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu = args
+    return _run_batch((sx, sy, psi, q, v, a, b, g, nu), (mu0, k_a, k_s, big_a, big_b), _ZERO,
+                      _ZERO, n, False, _PARALLEL_MIN)  # fmt: skip
 
 
 def wilac_many(args, packed, n):
-    """Run the WILAC kernel on 1-d float64 arrays (length n or 1); serial for small n."""
-    kernel = _wilac_many_par if n >= _PARALLEL_MIN_WILAC else _wilac_many_ser
-    return kernel(*args, packed, n)
+    """WILAC's forces of n contacts: ``args`` are the 10 arrays of wilac_forces (creepages,
+    Q, V, a, b, w, G, nu) of length n or 1, ``packed`` from :func:`pack_wilac`; returns
+    (fx, fy, ok). Serial below _PARALLEL_MIN_WILAC contacts."""
+    sx, sy, psi, q, v, a, b, w, g, nu = args
+    return _run_batch((sx, sy, psi, q, v, a, b, g, nu), (_ONE, _ONE, _ONE, _ZERO, _ZERO), w,
+                      _read_only(packed), n, True, _PARALLEL_MIN_WILAC)  # fmt: skip
 
 
 # --- helpers for the public functions ---------------------------------------------------------
@@ -920,16 +1178,29 @@ def flatten_args(arrays):
     """Broadcast float64 arrays to one shape; return (shape, n, 1-d arrays of length n or 1).
 
     Arrays of one element stay of length 1 and arrays of the full shape are raveled (no copy
-    if contiguous); only partly broadcast arrays are materialised.
+    if contiguous); only partly broadcast arrays are materialised. The 1-d arrays returned are
+    read-only views, whatever the inputs: the kernels then see one type for every call (numba
+    compiles a kernel anew for each combination of writeable and read-only arguments).
     """
-    shape = np.broadcast_shapes(*(x.shape for x in arrays))
+    shape = None
+    for x in arrays:  # the common case: the arrays that are not 0-d all have one shape
+        if x.ndim:
+            if shape is None:
+                shape = x.shape
+            elif x.shape != shape:
+                shape = np.broadcast_shapes(*(y.shape for y in arrays))
+                break
+    if shape is None:
+        shape = ()
     n = math.prod(shape)
     flat = []
     for x in arrays:
         if x.size == 1:
-            flat.append(x.reshape(1))
+            x = x.reshape(1)
         elif x.shape == shape:
-            flat.append(np.ascontiguousarray(x).reshape(-1))
+            x = np.ascontiguousarray(x).reshape(-1)
         else:
-            flat.append(np.ascontiguousarray(np.broadcast_to(x, shape)).reshape(-1))
+            x = np.ascontiguousarray(np.broadcast_to(x, shape)).reshape(-1)
+        x.flags.writeable = False  # a view: the caller's array is untouched
+        flat.append(x)
     return shape, n, flat

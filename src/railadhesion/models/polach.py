@@ -48,6 +48,7 @@ _PI_OVER_4 = math.pi / 4.0
 # eps_psi would let F_yS grow without bound at huge creepages; (1 + eps_psi^2) = inf gives 0.
 _EPS_MAX = 1e50
 _SCALAR_TYPES = (float, int, np.float64)
+_INF = math.inf
 
 
 @lru_cache(maxsize=4096)
@@ -243,13 +244,18 @@ def polach_forces(
     return np.float64(fx), np.float64(fy)
 
 
-def _scalars(values) -> list | None:
+def _scalars(values) -> tuple | list | None:
     """``values`` for the scalar fast path, or ``None`` if any of them is not a real scalar.
 
     Python and NumPy scalars and 0-d arrays qualify (no array work is then needed); ``float``
     and ``numpy.float64`` are passed through, ints, other NumPy scalars and 0-d arrays become
     floats (so that the compiled kernels see one signature).
     """
+    for v in values:  # the common case first: Python floats only
+        if type(v) is not float:
+            break
+    else:
+        return values
     scalars = []
     for v in values:
         t = type(v)
@@ -342,11 +348,17 @@ _ARG_NAMES = (
 )  # fmt: skip
 
 
+_KERNELS = []
+
+
 def _kernels():
     """The compiled kernels (:mod:`railadhesion.models.kernels`), imported on first use so
     that ``import railadhesion`` does not import numba."""
+    if _KERNELS:
+        return _KERNELS[0]
     from railadhesion.models import kernels
 
+    _KERNELS.append(kernels)
     return kernels
 
 
@@ -508,8 +520,11 @@ class PolachContact:
 
     Holds the parameter set, G, nu, the semi-axes and their Kalker coefficients (looked up
     once); :meth:`forces` then evaluates :func:`polach_forces` for new creepages (and
-    optionally a new speed or normal force) in plain Python floating point, about a
-    microsecond a call. Same numbers as :func:`polach_forces` (to rounding, about 1e-15).
+    optionally a new speed or normal force) through the compiled scalar kernel
+    (:func:`railadhesion.models.kernels.polach_scalar`, compiled for float64 arguments only:
+    ints and NumPy scalars are converted), well under a microsecond a call, and returns
+    Python floats. The same numbers as :func:`polach_forces` with scalar arguments. Building
+    one imports numba (the kernel is loaded from numba's cache, or compiled once).
 
     Parameters
     ----------
@@ -546,7 +561,7 @@ class PolachContact:
 
     __slots__ = (
         "normal_force", "speed", "a", "b", "mu0", "k_A", "k_S", "A", "B", "shear_modulus",
-        "poisson", "c11", "c22", "c23", "_eps_k", "_k_psi", "_gc3c23", "_epsp_k", "_const_mu",
+        "poisson", "c11", "c22", "c23", "_data", "_kernel",
     )  # fmt: skip
 
     def __init__(self, normal_force, speed, a, b, *, mu0, k_A=1.0, k_S=1.0, A=1.0, B=0.0,
@@ -561,13 +576,21 @@ class PolachContact:
         self.normal_force, self.speed, self.a, self.b = q, v, a, b
         self.mu0, self.k_A, self.k_S, self.A, self.B = mu0, k_a, k_s, big_a, big_b
         self.shear_modulus, self.poisson = g, nu
-        a_over_b = a / b
-        self.c11, self.c22, self.c23 = _kalker_scalar(a_over_b, nu)
-        self._eps_k = _PI_OVER_4 * g * a * b
-        self._k_psi = 1.0 + 6.3 * (1.0 - math.exp(-a_over_b))
-        self._gc3c23 = g * a * b * math.sqrt(a * b) * self.c23
-        self._epsp_k = 8.0 / 3.0 * self._gc3c23 / a
-        self._const_mu = big_b == 0.0 or big_a == 1.0
+        self.c11, self.c22, self.c23 = _kernels().kalker_scalar(a / b, nu)[:3]
+        object.__setattr__(self, "_kernel", _kernels().contact_kernel())
+        self._refresh()
+
+    def _refresh(self) -> None:
+        """The fixed data in the order of :func:`railadhesion.models.kernels.polach_scalar`."""
+        object.__setattr__(self, "_data", np.array([
+            self.a, self.b, self.shear_modulus, self.poisson, self.c11, self.c22, self.c23,
+            self.k_A, self.k_S, self.mu0, self.A, self.B,
+        ]))  # fmt: skip
+
+    def __setattr__(self, name, value) -> None:
+        object.__setattr__(self, name, value)
+        if hasattr(self, "_data"):  # a changed public value
+            self._refresh()
 
     def __repr__(self) -> str:
         return (f"PolachContact(normal_force={self.normal_force!r}, speed={self.speed!r}, "
@@ -585,46 +608,12 @@ class PolachContact:
             for name, val in (("creep_long", sx), ("creep_lat", sy), ("spin", psi)):
                 if not math.isfinite(val):
                     raise ValueError(f"{name} must be finite (no NaN or inf), got {val!r}")
-        q = self.normal_force
-        if normal_force is not None:
-            q = normal_force
-            if not 0.0 < q < math.inf:
-                raise _bad("normal_force", "(0, inf)", q)
-        v = self.speed
-        if speed is not None:
-            v = speed
-            if not 0.0 <= v < math.inf:
-                raise _bad("speed", "[0, inf)", v)
-        syc = sy + psi * self.a
-        if not abs(syc) > abs(sy):
-            syc = sy
-        sc = math.hypot(sx, syc)
-        if sc == 0.0:
-            return 0.0, 0.0
-        s = math.hypot(sx, sy)
-        cjj = math.hypot(self.c11 * sx, self.c22 * sy) / s if s > 0.0 else self.c22
-        if self._const_mu:
-            qmu = q * self.mu0
-        else:
-            big_a = self.A
-            qmu = q * (self.mu0 * ((1.0 - big_a) * math.exp(-self.B * sc * v) + big_a))
-            if qmu == 0.0:
-                return 0.0, 0.0
-        eps = self._eps_k * cjj * sc / qmu
-        if eps > _EPS_MAX:
-            eps = _EPS_MAX
-        x = self.k_A * eps
-        f_over_sc = _TWO_OVER_PI * qmu * (x / (1.0 + x * x) + math.atan(self.k_S * eps)) / sc
-        if psi == 0.0:
-            return -f_over_sc * sx, -f_over_sc * sy
-        abs_syc = abs(syc)
-        eps_psi = self._epsp_k * abs_syc / (self._k_psi * qmu)
-        e2 = 1.0 + eps_psi * eps_psi
-        fys = self._gc3c23 * (psi / sc) * (abs_syc / e2) / e2
-        fx, fy = -f_over_sc * sx, -(f_over_sc * sy + fys)
-        if fys != 0.0:
-            limit = max(qmu, f_over_sc * s)
-            total = math.hypot(fx, fy)
-            if total > limit:
-                fx, fy = fx * (limit / total), fy * (limit / total)
-        return fx, fy
+        if normal_force is None:
+            normal_force = self.normal_force
+        elif not 0.0 < normal_force < _INF:
+            raise _bad("normal_force", "(0, inf)", normal_force)
+        if speed is None:
+            speed = self.speed
+        elif not 0.0 <= speed < _INF:
+            raise _bad("speed", "[0, inf)", speed)
+        return self._kernel(sx, sy, psi, normal_force, speed, self._data)

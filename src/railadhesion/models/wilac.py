@@ -209,6 +209,7 @@ def _packed(params: WilacParameters) -> np.ndarray:
     packed = params.__dict__.get("_packed_kernel_arrays")
     if packed is None:
         packed = _kernels().pack_wilac(params)
+        packed.flags.writeable = False  # the kernels are compiled for read-only arrays
         object.__setattr__(params, "_packed_kernel_arrays", packed)
     return packed
 
