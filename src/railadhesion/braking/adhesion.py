@@ -24,7 +24,7 @@ Shipped models:
   over distance or time (:class:`WaterFlowProfile`), optional adhesion recovery along the
   train.
 * :class:`CallableAdhesion` — a user function ``mu(creep, speed)`` (e.g. a Fletcher-type
-  2D curve or a measured table).
+  2D curve or a measured table); a numba ``@njit`` one runs compiled.
 
 Polach-family curves (pure longitudinal creep, no spin, no lateral creep) are the closed form
 of :func:`railadhesion.models.polach.polach_forces` (Polach 2005, section 2): with s = |ξ|,
@@ -103,7 +103,7 @@ class ContactGeometry:
         return self._k0 * (q / self.reference_load) ** (2.0 / 3.0) / q
 
 
-def polach_family_curve(creep, speed, weights, params, stiffness):
+def polach_family_curve(creep, speed, weights, params, stiffness, speed_slope=False):
     """μ(ξ) and dμ/dξ of a weighted sum of Polach sets (pure longitudinal creepage).
 
     Parameters
@@ -118,11 +118,14 @@ def polach_family_curve(creep, speed, weights, params, stiffness):
         k_A, k_S, mu0, A, B per axle and set.
     stiffness : ndarray (n,)
         (π/4) G a b C11 / Q per axle [-].
+    speed_slope : bool
+        Also return dμ/dV.
 
     Returns
     -------
     mu, dmu : ndarray (n,)
-        Adhesion coefficient (retarding, sign of ξ) and its slope with respect to ξ.
+        Adhesion coefficient (retarding, sign of ξ) and its slope with respect to ξ; with
+        ``speed_slope``, a third array dμ/dV [s/m].
     """
     xi = np.asarray(creep, float)
     s = np.abs(xi)[:, None]
@@ -141,7 +144,15 @@ def polach_family_curve(creep, speed, weights, params, stiffness):
     df = _TWO_OVER_PI * (dmu_k * bracket + mu_k * dbracket)
     mu = np.sum(weights * f, axis=1)
     dmu = np.sum(weights * df, axis=1)
-    return np.sign(xi) * mu, dmu
+    if not speed_slope:
+        return np.sign(xi) * mu, dmu
+    # dμ_k/dV = dμ_k/ds · s/V (μ_k depends on s V only); ε = K s/μ_k
+    dmu_k_dv = -mu0 * (1.0 - big_a) * big_b * s * e
+    deps_dmu = -eps / mu_k  # ∂ε/∂μ_k
+    dbr_deps = k_a * (1.0 - x * x) / (1.0 + x * x) ** 2 + k_s / (1.0 + y * y)
+    dfv = _TWO_OVER_PI * (bracket + mu_k * dbr_deps * deps_dmu) * dmu_k_dv
+    dmv = np.sum(weights * dfv, axis=1)
+    return np.sign(xi) * mu, dmu, np.sign(xi) * dmv
 
 
 def _peak(curve, speed, n):
@@ -167,6 +178,15 @@ class AxleAdhesion:
 
     def evaluate(self, creep, speed):
         raise NotImplementedError
+
+    def slopes(self, creep, speed):
+        """``(mu, dmu_dcreep, dmu_dspeed)`` per axle (the Newton solve of the simulator uses
+        all three). By default the speed slope is a forward difference of :meth:`evaluate`
+        (step 1e-6 of the speed, at least 1e-6 m/s)."""
+        mu, dmu = self.evaluate(creep, speed)
+        h = 1e-6 * max(float(speed), 1.0)
+        mu2, _ = self.evaluate(creep, speed + h)
+        return mu, dmu, (np.asarray(mu2, float) - np.asarray(mu, float)) / h
 
     def available(self, speed) -> np.ndarray:
         """Peak adhesion coefficient available to each axle at the prepared conditions."""
@@ -259,23 +279,41 @@ class _PolachFamily(AxleAdhesion):
         self.weights = None
         self.params = None
         self.stiffness = None
+        self._work = None
 
     def bind(self, n_axles, wheel_radius):
         super().bind(n_axles, wheel_radius)
         if self.contact is None:
             self.contact = ContactGeometry(wheel_radius=wheel_radius)
 
-    def evaluate(self, creep, speed):
+    def _scratch(self):
+        from railadhesion.braking._layout import new_work
+
+        n, k = self.weights.shape
+        if self._work is None or self._work.shape[1] < max(n * k, n, 1):
+            self._work = new_work(n, k)
+        return self._work
+
+    def slopes(self, creep, speed):
+        """μ, dμ/dξ and dμ/dV per axle (the compiled lane evaluation of the simulator)."""
         from railadhesion.braking._kernels import family_evaluate
 
-        return family_evaluate(np.asarray(creep, float), float(speed), self.weights,
-                               np.ascontiguousarray(self.params), self.stiffness)
+        return family_evaluate(np.ascontiguousarray(creep, dtype=float), float(speed),
+                               np.ascontiguousarray(self.weights, dtype=float),
+                               np.ascontiguousarray(self.params, dtype=float),
+                               np.ascontiguousarray(self.stiffness, dtype=float),
+                               self._scratch())
+
+    def evaluate(self, creep, speed):
+        mu, dmu, _ = self.slopes(creep, speed)
+        return mu, dmu
 
     def available(self, speed):
         from railadhesion.braking._kernels import family_peak
 
-        return family_peak(float(speed), self.weights, np.ascontiguousarray(self.params),
-                           self.stiffness)
+        return family_peak(float(speed), np.ascontiguousarray(self.weights, dtype=float),
+                           np.ascontiguousarray(self.params, dtype=float),
+                           np.ascontiguousarray(self.stiffness, dtype=float), self._scratch())
 
 
 def _as_polach(p) -> PolachParameters:
@@ -358,6 +396,7 @@ class WilacAdhesion(_PolachFamily):
         self.recovery = recovery
         self.current_water_flow = None
         self._packed = None
+        self._program = None
 
     def prepare(self, speed, normal_loads, positions, time, dissipation=None):
         w = np.broadcast_to(np.asarray(self.water_flow(positions, time), float),
@@ -371,12 +410,18 @@ class WilacAdhesion(_PolachFamily):
             from railadhesion.models.kernels import pack_wilac
 
             self._packed = pack_wilac(self.parameters)
+        if self._program is None:
+            from railadhesion.braking._layout import wilac_program
+
+            self._program = wilac_program(self._packed)
         n = self.n_axles
         if self.weights is None:
             self.weights = np.empty((n, len(WILAC_CONDITIONS)))
             self.params = np.empty((n, len(WILAC_CONDITIONS), 5))
         q = np.ascontiguousarray(normal_loads, dtype=float)
-        wilac_table(self._packed, q, max(float(speed), 0.0), w, self.weights, self.params)
+        wilac_table(self._packed, self._program, q, max(float(speed), 0.0), w, self.weights,
+                    self.params, np.empty(7),
+                    np.empty(max(1, int(self._program[0]))))
         self.stiffness = self.contact.stiffness_over_load(q)
 
     def describe(self):
@@ -393,6 +438,10 @@ class CallableAdhesion(AxleAdhesion):
     called as ``mu(creep, speed, normal_load)`` (wheel load [N] per axle). The slope is a
     central difference with step ``h``. Non-finite values stop the simulation with an error
     naming the time and the axle.
+
+    A numba ``@njit`` function that also works on scalars (``mu(0.01, 30.0) -> float``) runs
+    in the simulator's compiled loop (compiled once as a C callback; the same differences, the
+    same numbers as the Python path); anything else runs in the Python path.
     """
 
     name = "callable"

@@ -82,14 +82,22 @@ class BrakeCylinders:
         return np.repeat([v[:k].max(), v[k:].max()], k)
 
     def advance(self, pressure, valves, command, dt):
-        """New pressures, mean pressures over the step, and pressure vented [Pa] per axle."""
+        """New pressures, mean pressures over the step, and pressure vented [Pa] per axle.
+
+        The same operations as the compiled step (``exp`` of the two time constants, the mean
+        factor ``(τ/dt)(1 − e)``), so both give the same numbers.
+        """
         p0 = np.asarray(pressure, float)
-        cmd = np.minimum(np.broadcast_to(np.asarray(command, float), p0.shape), self.max_pressure)
-        cmd = np.maximum(cmd, 0.0)
+        cmd = np.broadcast_to(np.asarray(command, float), p0.shape)
+        cmd = np.minimum(np.maximum(cmd, 0.0), self.max_pressure)
         target = np.where(valves == VENT, 0.0, np.where(valves == HOLD, p0, cmd))
-        tau = np.where(target > p0, self.fill_time_constant, self.vent_time_constant)
-        e = np.exp(-dt / tau)
+        fill = target > p0
+        e_fill = math.exp(-dt / self.fill_time_constant)
+        e_vent = math.exp(-dt / self.vent_time_constant)
+        e = np.where(fill, e_fill, e_vent)
+        mean_factor = np.where(fill, (self.fill_time_constant / dt) * (1.0 - e_fill),
+                               (self.vent_time_constant / dt) * (1.0 - e_vent))
         p1 = target + (p0 - target) * e
-        mean = target + (p0 - target) * (tau / dt) * (1.0 - e)
+        mean = target + (p0 - target) * mean_factor
         vented = np.where(valves == VENT, p0 - p1, 0.0)
         return p1, mean, vented

@@ -11,9 +11,6 @@ import pandas as pd
 
 from railadhesion.braking.adhesion import (
     AxleAdhesion,
-    PolachAdhesion,
-    WaterFlowProfile,
-    WilacAdhesion,
 )
 from railadhesion.braking.cylinders import ATMOSPHERIC_PRESSURE, BrakeCylinders
 from railadhesion.braking.simulator import BrakingSimulator
@@ -225,10 +222,12 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
     progress : callable, optional
         Called now and then with the fraction of the initial speed lost (0 … 1).
     compiled : bool
-        Use the compiled whole-run loop when possible (Polach or WILAC with a
-        :class:`WaterFlowProfile`, a :class:`BrakeDemand`, no WSP or the default
-        :class:`WheelSlideProtection`); otherwise, or with ``False``, the same steps run in
-        Python (any adhesion model, any controller). Both give the same results.
+        Use the compiled whole-run loop when possible (Polach, WILAC with a
+        :class:`WaterFlowProfile` or a :class:`CallableAdhesion` of a numba ``@njit``
+        function; a :class:`BrakeDemand`; no WSP or the default
+        :class:`WheelSlideProtection`); with another demand or controller the compiled step
+        runs inside a Python loop; with ``False`` the same steps run in Python (any adhesion
+        model, any controller). All give the same results.
 
     Returns
     -------
@@ -254,7 +253,7 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
     if not (math.isfinite(max_time) and max_time > 0):
         raise ValueError(f"max_time must be in (0, inf) s, got {max_time!r}")
     nmax = int(math.ceil(max_time / dt))
-    if compiled and _fast_path_possible(adhesion, demand, controller):
+    if compiled and sim._use_compiled and _fast_path_possible(demand, controller):
         _run_compiled(sim, demand, controller, ratio, nmax, dt, progress, initial_speed)
     else:
         _run_python(sim, demand, controller, ratio, nmax, dt, progress, initial_speed)
@@ -273,8 +272,8 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
 
 def _run_python(sim, demand, controller, ratio, nmax, dt, progress, initial_speed):
     n = sim.vehicle.n_axles
-    valves = np.zeros(n, dtype=np.int64)
     report_every = max(1, int(round(1.0 / dt)))
+    command = sim.inputs.pressure_command
     for k in range(nmax):
         t = k * dt
         cmd = float(demand(t))
@@ -286,47 +285,22 @@ def _run_python(sim, demand, controller, ratio, nmax, dt, progress, initial_spee
             if np.any((valves < 0) | (valves > 2)):
                 raise ValueError(f"the controller returned valve states {out} at t = {t:.6g} s;"
                                  " allowed: 0 (apply), 1 (hold), 2 (vent)")
-        sim.pressure_command = cmd
-        sim._run(dt, valves)
+            sim.inputs.valves[:] = valves
+        command[:] = cmd
+        sim.advance(dt)
         if progress is not None and k % report_every == 0:
             progress(1.0 - sim.speed / initial_speed)
         if sim.stopped:
             break
 
 
-def _fast_path_possible(adhesion, demand, controller) -> bool:
-    kind = type(adhesion)
-    if kind is WilacAdhesion:
-        ok = isinstance(adhesion.water_flow, WaterFlowProfile)
-    else:
-        ok = kind is PolachAdhesion
-    return (ok and type(demand) is BrakeDemand
-            and (controller is None or type(controller) is WheelSlideProtection))
+def _fast_path_possible(demand, controller) -> bool:
+    """The compiled loop runs the brake demand and the default WSP itself."""
+    return type(demand) is BrakeDemand and (
+        controller is None or type(controller) is WheelSlideProtection)
 
 
 def _run_compiled(sim, demand, controller, ratio, nmax, dt, progress, initial_speed):
     """The loop of _run_python in one compiled kernel (same operations, same results)."""
-    from railadhesion.braking import _kernels as kern
-
-    c = sim._compiled_state(controller)
-    sc = c.sc
-    c.demand[:] = (demand.pressure, demand.start_time, demand.ramp_time)
-    c.cmd_axle[0] = -1.0
-    chunk = int(min(nmax, max(1000, round(5.0 / dt))))
-    ncols = len(sim.history_columns())
-    blocks = []
-    status = 0
-    while True:
-        rows = np.empty((chunk, ncols))
-        k_end = min(nmax, int(sc[kern.K_]) + chunk)
-        nrow, status = kern.run_family(k_end, dt, *c.args(ratio), rows, 1e-10, c.cmd_axle)
-        blocks.append(rows[:nrow])
-        if progress is not None:
-            progress(1.0 - sc[kern.V_] / initial_speed)
-        if status == 2:
-            sim._sync_from_compiled()
-            sim._fail(0, " in the compiled loop")
-        if status == 1 or int(sc[kern.K_]) >= nmax:
-            break
-    sim._sync_from_compiled()
-    sim._row_array = np.concatenate(blocks) if blocks else np.empty((0, ncols))
+    sim._configure_run(controller, demand, ratio)
+    sim._run_compiled(nmax, dt, progress, initial_speed)

@@ -29,6 +29,7 @@ from railadhesion.braking._fields import (
 from railadhesion.braking.adhesion import (
     AdhesionRecovery,
     AxleAdhesion,
+    CallableAdhesion,
     ContactGeometry,
     PolachAdhesion,
     WaterFlowProfile,
@@ -121,11 +122,15 @@ def _adhesion(doc: Mapping, base: Path, wheel_radius: float):
     tab = table(doc, where)
     keys(tab, where, ("model",), ("parameters", "water_flow_ul_s", "over", "sections",
                                   "table", "recovery_energy_J_per_m", "rail_lateral_radius_m",
-                                  "dry_parameters"))
+                                  "dry_parameters", "file"))
     model = string(tab["model"], "adhesion.model")
-    if model not in ("polach", "wilac"):
-        raise FieldError("adhesion.model", f"unknown model {model!r}; allowed: polach, wilac "
-                         "(user functions: use the Python API, CallableAdhesion)")
+    if model not in ("polach", "wilac", "law"):
+        raise FieldError("adhesion.model", f"unknown model {model!r}; allowed: polach, wilac, "
+                         "law (user functions: use the Python API, CallableAdhesion)")
+    if model == "law":
+        return _identified_law(tab, base, wheel_radius)
+    if "file" in tab:
+        raise FieldError("adhesion.file", "only for model = 'law'")
     rail = number(tab.get("rail_lateral_radius_m", 0.3), "adhesion.rail_lateral_radius_m",
                   0.05, 10.0)
     over = string(tab.get("over", "distance"), "adhesion.over")
@@ -202,6 +207,37 @@ def _adhesion(doc: Mapping, base: Path, wheel_radius: float):
     return (lambda: WilacAdhesion(profile, params, recovery, contact_copy()),
             lambda: WilacAdhesion(0.0, params, None, contact_copy()),
             {"model": "wilac", "water_flow_ul_s": w0, "over": over})
+
+
+def _identified_law(tab: Mapping, base: Path, wheel_radius: float):
+    """``model = "law"``: an adhesion law identified from braking-test logs
+    (:func:`railadhesion.identification.load_adhesion_law`, the ``adhesion_law.toml`` that
+    ``railadhesion identify`` writes), the same on every axle and all along the track; the dry
+    reference is a named Polach set (``dry_parameters``, default ``polach2005_dry``)."""
+    from railadhesion.identification.curves import load_adhesion_law
+
+    for k in ("parameters", "water_flow_ul_s", "sections", "table", "recovery_energy_J_per_m",
+              "over"):
+        if k in tab:
+            raise FieldError(f"adhesion.{k}", "not for model = 'law' (the law file holds the "
+                             "adhesion; give adhesion.file)")
+    if "file" not in tab:
+        raise FieldError("adhesion.file", "required for model = 'law': an adhesion-law TOML "
+                         "file (as written by 'railadhesion identify')")
+    text = string(tab["file"], "adhesion.file")
+    path = Path(text) if Path(text).is_absolute() else base / text
+    try:
+        law = load_adhesion_law(path)
+    except ValueError as exc:
+        raise FieldError("adhesion.file", f"cannot load the adhesion law: {exc}") from None
+    dry_set = _polach_name(tab.get("dry_parameters", "polach2005_dry"), "adhesion.dry_parameters")
+    rail = number(tab.get("rail_lateral_radius_m", 0.3), "adhesion.rail_lateral_radius_m",
+                  0.05, 10.0)
+    contact = ContactGeometry(wheel_radius=wheel_radius, rail_lateral_radius=rail)
+    label = f"identified law {path.name}"
+    return (lambda: CallableAdhesion(law, label=label),
+            lambda: PolachAdhesion(dry_set, (), contact),
+            {"model": "law", "file": str(path), "slip": law.slip_kind})
 
 
 def _scenario_from_document(doc: Mapping, base: Path) -> BrakeScenario:

@@ -1,0 +1,229 @@
+"""The braking integrator (Newton on the arrow-shaped backward-Euler system, the safeguarded
+solve it falls back on, the adhesion-available tracking, the WILAC parameter program) and the
+hardware-in-the-loop stepping API (``advance``, in-place inputs, live state)."""
+
+import numpy as np
+import pytest
+
+from railadhesion.braking import (
+    BrakeCylinders,
+    BrakingSimulator,
+    PolachAdhesion,
+    Vehicle,
+    WaterFlowProfile,
+    WheelSlideProtection,
+    WilacAdhesion,
+)
+from railadhesion.braking import _layout as L
+from railadhesion.braking.adhesion import polach_family_curve
+from railadhesion.braking.run import BrakeDemand
+
+VEHICLE = Vehicle(name="test coach")
+CYL = BrakeCylinders(max_pressure=6e5)
+DAMP = WaterFlowProfile.sections([(10.0, 400.0, 25.0)])
+
+
+def _stop(newton_tol, compiled=True, v0=15.0, dt=2e-3):
+    """A damp-rail stop with WSP; ``newton_tol`` 0 forces the safeguarded solve every step."""
+    sim = BrakingSimulator(VEHICLE, WilacAdhesion(DAMP), v0, cylinders=CYL, max_step=dt,
+                           compiled=compiled)
+    sim._buf[L.NEWTON_TOL_] = newton_tol
+    wsp = WheelSlideProtection(period=4e-3)
+    wsp.reset(4, VEHICLE.wheel_radius)
+    sim._configure_run(wsp, BrakeDemand(5.5e5), int(round(wsp.period / dt)))
+    sim._run_compiled(int(100 / dt), dt, None, v0)
+    return sim
+
+
+def test_newton_and_safeguarded_solve_reach_the_same_backward_euler_solution():
+    newton = _stop(5e-6)
+    safe = _stop(0.0)  # no Newton update is ever accepted: every step by the nested solve
+    cn, cs = newton.solver_counts, safe.solver_counts
+    assert cs["safeguarded_steps"] == cs["steps"]
+    assert cn["safeguarded_steps"] < 0.01 * cn["steps"]
+    assert cn["newton_iterations"] < 1.5 * cn["steps"]  # mostly one iteration per step
+    assert np.sum(newton.vent_actions) > 3  # WSP at work: slides and recoveries
+    a, b = newton.histories(), safe.histories()
+    assert a.shape == b.shape
+    assert newton.stop_distance == pytest.approx(safe.stop_distance, rel=1e-9)
+    # the solvers' tolerances differ (accepted Newton update 5e-6 v, nested solve 1e-10 m/s);
+    # a sliding wheel on the falling branch of its curve amplifies such differences a little
+    speeds = [f"wheel_speed_{i}" for i in range(1, 5)] + ["train_speed"]
+    np.testing.assert_allclose(a[speeds].to_numpy(), b[speeds].to_numpy(), rtol=0, atol=1e-5)
+
+
+def test_one_newton_iteration_per_step_on_a_smooth_stop():
+    res = BrakingSimulator(VEHICLE, PolachAdhesion("polach2005_dry"), 30.0, max_step=1e-3)
+    res.inputs.pressure_command[:] = 3e5
+    while not res.stopped:
+        res.advance(1e-3)
+    c = res.solver_counts
+    assert c["safeguarded_steps"] == 0
+    assert c["newton_iterations"] <= 1.05 * c["steps"]
+
+
+def test_advance_equals_step_and_its_live_state_is_a_read_only_view():
+    def make():
+        return BrakingSimulator(VEHICLE, WilacAdhesion(DAMP), 12.0, cylinders=CYL,
+                                max_step=1e-3, record=False)
+
+    a, b = make(), make()
+    live = a.advance(1e-3)  # nothing commanded yet: coasting
+    b.step(1e-3)
+    for k in range(1, 600):
+        valves = [0, 0, 0, 0] if (k // 150) % 2 == 0 else [2, 1, 0, 2]
+        a.inputs.pressure_command[:] = [5e5, 5e5, 4e5, 4e5]
+        a.inputs.valves[:] = valves
+        state = a.advance(1e-3)
+        snap = b.step(1e-3, {"pressure_command": [5e5, 5e5, 4e5, 4e5], "valves": valves})
+        assert state is live
+        assert state.train_speed == snap.train_speed and state.distance == snap.distance
+        np.testing.assert_array_equal(state.wheel_speeds, snap.wheel_speeds)
+        np.testing.assert_array_equal(state.valves, snap.valves)
+    kept = live.snapshot()
+    a.advance(1e-3)
+    assert live.time > kept.time and kept.time == pytest.approx(0.6)  # the view moved on
+    with pytest.raises(ValueError, match="read-only"):
+        live.wheel_speeds[0] = 0.0
+    np.testing.assert_array_equal(a.vent_actions, b.vent_actions)
+
+
+def test_advance_checks_its_inputs_and_names_the_axle():
+    sim = BrakingSimulator(VEHICLE, PolachAdhesion("polach2005_dry"), 10.0)
+    sim.advance(1e-3)
+    t = sim.time
+    sim.inputs.pressure_command[2] = np.nan
+    with pytest.raises(ValueError, match="pressure_command.*axle 3"):
+        sim.advance(1e-3)
+    sim.inputs.pressure_command[2] = 1e5
+    sim.inputs.valves[1] = 3
+    with pytest.raises(ValueError, match="valves.*axle 2"):
+        sim.advance(1e-3)
+    sim.inputs.valves[1] = 1
+    with pytest.raises(ValueError, match="dt"):
+        sim.advance(-1e-3)
+    assert sim.time == t  # a refused step changes nothing
+    sim.advance(1e-3)
+    assert sim.time == pytest.approx(t + 1e-3)
+
+
+def test_python_path_takes_the_same_newton_iterations():
+    runs = []
+    for compiled in (True, False):
+        sim = BrakingSimulator(VEHICLE, WilacAdhesion(DAMP), 8.0, cylinders=CYL, max_step=2e-3,
+                               compiled=compiled)
+        for k in range(300):
+            sim.step(2e-3, {"pressure_command": 5.5e5,
+                            "valves": [0, 0, 0, 0] if (k // 60) % 2 == 0 else [2, 2, 1, 0]})
+        runs.append(sim)
+    fast, slow = runs
+    assert fast._use_compiled and not slow._use_compiled
+    assert fast.solver_counts == slow.solver_counts
+    assert fast.solver_counts["newton_iterations"] > fast.solver_counts["steps"]
+    np.testing.assert_allclose(fast.omega, slow.omega, rtol=1e-10)
+    assert fast.distance == pytest.approx(slow.distance, rel=1e-12)
+
+
+def test_adhesion_available_tracking_matches_a_full_search():
+    # slowly changing conditions: the tracked peak stays within 1e-7 of a fresh full search
+    q = np.array([31e3, 31e3, 26e3, 26e3])
+    tracked = WilacAdhesion(25.0)
+    tracked.bind(4, 0.46)
+    for k in range(30):
+        speed, loads = 40.0 - 0.05 * k, q * (1.0 + 0.002 * k)
+        tracked.prepare(speed, loads, np.zeros(4), 0.01 * k)
+        got = tracked.available(speed)
+        fresh = WilacAdhesion(25.0)
+        fresh.bind(4, 0.46)
+        fresh.prepare(speed, loads, np.zeros(4), 0.01 * k)
+        np.testing.assert_allclose(got, fresh.available(speed), rtol=1e-7)
+    assert tracked._work[L.R_PK_N, 0] == 30  # 29 of 30 calls tracked
+    # and a brute-force maximum on a fine grid agrees
+    grid = np.geomspace(1e-4, 1.0, 20001)
+    mu, _ = polach_family_curve(np.repeat(grid, 4), speed, np.tile(fresh.weights, (grid.size, 1)),
+                                np.tile(fresh.params, (grid.size, 1, 1)),
+                                np.tile(fresh.stiffness, grid.size))
+    np.testing.assert_allclose(got, mu.reshape(grid.size, 4).max(axis=0), rtol=1e-6)
+
+
+def test_wilac_parameters_equal_the_library_regressions():
+    from railadhesion.braking._kernels import wilac_table
+    from railadhesion.models.kernels import _condition_parameters, _factors, pack_wilac
+    from railadhesion.models.wilac import default_wilac_parameters
+
+    packed = pack_wilac(default_wilac_parameters())
+    program = L.wilac_program(packed)
+    loads = np.array([36e3, 36e3, 21e3, 52e3])  # a bogie pair (reused), then distinct
+    water = np.array([0.0, 12.0, 25.0, 60.0])
+    weights, params = np.empty((4, 4)), np.empty((4, 4, 5))
+    wilac_table(packed, program, loads, 31.0, water, weights, params, np.empty(7),
+                np.empty(int(program[0])))
+    fac, ref = np.empty(7), np.empty(20)
+    for a in range(4):
+        _factors(loads[a], 31.0, packed, fac)
+        for i in range(4):
+            _condition_parameters(packed, i, fac, ref)
+        np.testing.assert_allclose(params[a].ravel(), ref, rtol=1e-13, atol=1e-15)
+
+
+def test_new_parameters_before_the_first_step_rebuild_the_simulator():
+    sim = BrakingSimulator(VEHICLE, PolachAdhesion("polach2005_dry"), 10.0)
+    sim.max_step = 1e-3
+    sim.adhesion = PolachAdhesion("polach2005_wet")
+    sim.step(0.01, {"pressure_command": 3e5})
+    assert sim.solver_counts["steps"] == 10
+    with pytest.raises(AttributeError, match="parameter"):
+        sim.max_step = 2e-3
+
+
+def test_numba_adhesion_function_runs_compiled_with_the_python_path_numbers():
+    from numba import njit
+
+    from railadhesion.braking import CallableAdhesion, SimulationError, simulate
+
+    @njit
+    def mu(creep, speed, load):  # a smooth law with a maximum, falling with speed and load
+        return 0.3 * np.tanh(200.0 * creep) * (1.0 - 0.5 * creep) / (1.0 + 0.01 * speed) * (
+            1.2 - load / 1.5e5)
+
+    runs = [simulate(VEHICLE, CallableAdhesion(mu, needs_load=True), 15.0, 6e5, cylinders=CYL,
+                     wsp=WheelSlideProtection(period=4e-3), dt=2e-3, compiled=flag)
+            for flag in (True, False)]
+    assert BrakingSimulator(VEHICLE, CallableAdhesion(mu, needs_load=True), 15.0).compiled
+    a, b = (r.histories.to_numpy() for r in runs)
+    assert runs[0].summary["vent_actions"] > 0
+    assert a.shape == b.shape
+    np.testing.assert_allclose(a[1:], b[1:], rtol=1e-9, atol=1e-9)  # row 0: NaN available
+
+    @njit
+    def bad(creep, speed):
+        return np.nan if speed < 5.5 else 0.4 * np.tanh(100.0 * creep)
+
+    with pytest.raises(SimulationError, match=r"axle 1 at t = [0-9.]+ s"):
+        simulate(VEHICLE, CallableAdhesion(bad), 6.0, 3e5, dt=4e-3)
+
+    @njit
+    def arrays_only(creep, speed):
+        return 0.3 * np.tanh(200.0 * creep) + 0.0 * creep.sum()
+
+    with pytest.warns(UserWarning, match="Python path"):
+        sim = BrakingSimulator(VEHICLE, CallableAdhesion(arrays_only), 10.0)
+    assert not sim._use_compiled
+
+
+def test_stale_layout_cache_is_purged(tmp_path):
+    """The kernels freeze _layout's constants at compile time while numba keys its cache on
+    _kernels.py alone: cached code built against another layout must be dropped."""
+    from railadhesion.braking import _kernels as kern
+    from railadhesion.braking import _layout
+
+    assert kern._compiled_layout_fingerprint() == _layout.fingerprint()
+    names = ["_kernels.step-1072.py311.nbi", "_kernels.step-1072.py311.1.nbc",
+             "_kernels._advance-918.py311.nbi", "simulator.cpython-311.pyc",
+             "kernels.polach-10.py311.nbi"]
+    for name in names:
+        (tmp_path / name).write_text("x")
+    assert kern.purge_stale_cache(tmp_path, 7, 7) == []  # same layout: nothing touched
+    gone = kern.purge_stale_cache(tmp_path, 7, 8)
+    assert sorted(p.name for p in gone) == sorted(names[:3])
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(names[3:])
