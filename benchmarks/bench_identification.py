@@ -1,21 +1,32 @@
 """Benchmark: identification of 1 hour of a 4-axle braking log at 2.4 ms (1.5 M samples).
 
-End to end = read the log + identify_adhesion (filters, eq. 14, loads, mu, windows) + the
-40 x 40 surface + the fitted mu(slip) curves per speed band. Figures are not included (they
-thin long logs and take about a second on their own).
+End to end = what ``railadhesion identify`` produces except the figures: read the log,
+identify_adhesion (filters, eq. 14, loads, mu, windows), the 40 x 40 surfaces against absolute
+and relative slip, the fitted curves (4 speed bands + all speeds against both slips; loss and
+recovery windows), and writing summary.json, the two NetCDF surfaces, the two law files and
+windows.csv (:func:`railadhesion.identification.pipeline.run_identification`).
 
-The log is synthetic: 3 minutes of braking with wheel-slide-protection cycles, simulated once
-with a small simulator written here (semi-implicit Euler, a falling adhesion law), repeated to
-one hour with time running on and small sensor noise. Prints the median of ``--repeat`` runs
-per stage. The machine is shared: quote medians and say so.
+The log is synthetic and continuous: a 104 s cycle (three brakings with wheel-slide-protection
+venting, coasting, re-acceleration back to the first speed) simulated once with a small
+simulator written here (semi-implicit Euler, a falling adhesion law), repeated to one hour with
+time running on and sensor noise (0.01 m/s, 0.02 rad/s, 0.01 bar).
 
-Run: ``PYTHONPATH=src python3 benchmarks/bench_identification.py [--repeat 3]``
+Prints, per stage and end to end (from Parquet and from CSV), the median of ``--repeat`` runs
+(wall and process CPU time) with one thread and with every core, after one warm-up run (numba
+kernels loaded); then the whole CLI command in a fresh process (imports, kernel loading,
+page faults included) with and without figures. The machine is shared: the load average is
+printed beside the figures.
+
+Run: ``PYTHONPATH=src python3 benchmarks/bench_identification.py [--repeat 3] [--keep DIR]``
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
+import subprocess
+import sys
 import tempfile
 import time
 import warnings
@@ -31,6 +42,8 @@ from railadhesion.identification import (
     identify_adhesion,
     read_braking_log,
 )
+from railadhesion.identification.braking import _worker_count
+from railadhesion.identification.pipeline import run_identification
 
 PERIOD = 2.4e-3
 VEH = Vehicle(name="bench coach", body_mass=32600.0, bogie_mass=3200.0, wheelset_mass=1500.0,
@@ -38,39 +51,55 @@ VEH = Vehicle(name="bench coach", body_mass=32600.0, bogie_mass=3200.0, wheelset
 
 
 def _law(w):
-    w = np.maximum(w, 0.0)
-    return 0.12 * -np.expm1(-w / 0.15) * (0.45 + 0.55 * np.exp(-0.35 * w))
+    """The falling law mu(slip velocity) of the synthetic log, odd in the slip."""
+    s = np.abs(w)
+    return np.sign(w) * 0.12 * -np.expm1(-s / 0.15) * (0.45 + 0.55 * np.exp(-0.35 * s))
 
 
-def _braking(v0, duration, seed):
-    """One braking from v0 with WSP cycles, vectorised over nothing: a plain Euler loop."""
+#: One cycle of the synthetic test run: braking (with WSP) for a time, coasting while the
+#: cylinders empty, then accelerating (a traction force on the body, wheels rolling) up to the
+#: speed the next braking starts from. The last acceleration returns to the first speed, so
+#: cycles repeat without a jump.
+CYCLE = (("brake", 20.0), ("coast", 3.0), ("accel", 28.0), ("brake", 15.0), ("coast", 3.0),
+         ("accel", 20.0), ("brake", 10.0), ("coast", 3.0), ("accel", 35.0))
+
+
+def _cycle(v0=35.0, substeps=4):
+    """One cycle sampled every 2.4 ms: columns v, omega_1..4, p_1..4 [Pa] (semi-implicit Euler,
+    loads with pitch transfer, bang-bang WSP venting above 3 m/s of slip, refilling below 0.8)."""
     r, j, c, m = VEH.wheel_radius, VEH.wheelset_inertia, VEH.brake_coefficient, VEH.total_mass
-    sub = 4
-    h = PERIOD / sub
+    h = PERIOD / substeps
     v, om, p, vent = v0, np.full(4, v0 / r), np.zeros(4), np.zeros(4, bool)
-    n = int(duration / PERIOD)
-    out = np.empty((n, 9))
-    d = 0.0
-    for k in range(n):
-        out[k, 0], out[k, 1:5], out[k, 5:] = v, om, p
-        for _ in range(sub):
-            w = v - r * om
-            f = _law(w) * VEH.axle_normal_loads(d)
-            om = np.maximum(om + h * (f * r - np.where(om > 0, c * p, 0.0)) / j, 0.0)
-            d = f.sum() / m
-            v = max(v - h * d, 0.0)
-            vent = np.where(w > 3.0, True, np.where(w < 0.8, False, vent))
-            p = p + (np.where(vent, 0.0, 3.8e5) - p) * (1 - np.exp(-h / np.where(vent, 0.15,
-                                                                                   0.6)))
-    return out
+    rows, d = [], 0.0
+    for kind, until in CYCLE:
+        k = 0
+        while (v < until) if kind == "accel" else (k * PERIOD < until):
+            rows.append(np.r_[v, om, p])
+            k += 1
+            for _ in range(substeps):
+                w = v - r * om
+                f = _law(w) * VEH.axle_normal_loads(d)
+                om = np.maximum(om + h * (f * r - np.where(om > 0, c * p, 0.0)) / j, 0.0)
+                traction = 0.8 * m if kind == "accel" else 0.0
+                d = (f.sum() - traction) / m
+                v = max(v - h * d, 0.0)
+                if kind == "brake":
+                    vent = np.where(w > 3.0, True, np.where(w < 0.8, False, vent))
+                else:
+                    vent[:] = False
+                target = np.where(vent | (kind != "brake"), 0.0, 3.8e5)
+                tau = np.where(vent, 0.15, 0.6)
+                p = p + (target - p) * (1 - np.exp(-h / tau))
+    return np.array(rows)
 
 
 def make_log(path: Path, hours: float = 1.0, seed: int = 0) -> int:
-    base = np.concatenate([_braking(v0, 20.0, seed) for v0 in (35.0, 28.0, 20.0)])
-    reps = int(np.ceil(hours * 3600 / PERIOD / base.shape[0]))
-    data = np.tile(base, (reps, 1))[: int(hours * 3600 / PERIOD)]
+    """Write ``hours`` of log (cycles repeated, time running on, sensor noise 0.01 m/s,
+    0.02 rad/s, 0.01 bar) as ``path``.parquet and ``path``.csv; the number of samples."""
+    base = _cycle()
+    n = int(round(hours * 3600 / PERIOD))
+    data = np.tile(base, (int(np.ceil(n / base.shape[0])), 1))[:n]
     rng = np.random.default_rng(seed)
-    n = data.shape[0]
     cols = {"time": np.arange(n) * PERIOD,
             "train_speed": data[:, 0] + rng.normal(0, 0.01, n)}
     for i in range(4):
@@ -83,12 +112,78 @@ def make_log(path: Path, hours: float = 1.0, seed: int = 0) -> int:
     return n
 
 
+def _load() -> str:
+    one, five, _ = os.getloadavg()
+    return f"load average {one:.2f} (1 min), {five:.2f} (5 min)"
+
+
+def _timed(fn):
+    """fn(), its wall time and the process's user and system CPU time [s]."""
+    t, c = time.perf_counter(), os.times()
+    out = fn()
+    d = os.times()
+    return out, time.perf_counter() - t, d.user - c.user, d.system - c.system
+
+
+def _fits(ident):
+    ident._cache.clear()  # the binning is part of the stage
+    fit_adhesion_curves(ident)
+    fit_adhesion_curves(ident, slip="relative")
+    for phase in ("loss", "recovery"):
+        fit_adhesion_curves(ident, phase=phase, per_band=False)
+
+
+def _stages(base: Path, out: Path, threads: int, repeat: int) -> dict:
+    """Median wall, user and system time [s] of each stage, run ``repeat`` times in a row."""
+    rows: dict[str, list[tuple[float, float, float]]] = {}
+
+    def record(name, fn):
+        res = None
+        for _ in range(repeat):
+            res = None  # free the previous result first, as a fresh run would
+            res, wall, user, system = _timed(fn)
+            rows.setdefault(name, []).append((wall, user, system))
+        return res
+
+    csv, parquet = base.with_suffix(".csv"), base.with_suffix(".parquet")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        record("read CSV", lambda: read_braking_log(csv, warn=False))
+        log = record("read Parquet", lambda: read_braking_log(parquet, warn=False))
+    ident = record("identify (filters, eq. 14, loads, mu, windows)",
+                   lambda: identify_adhesion(log, VEH, threads=threads))
+    record("surfaces 40 x 40 x 3 phases, both slips", lambda: (
+        adhesion_surface(ident), adhesion_surface(ident, slip="relative")))
+    record("fits with their binning (4 bands + all, 2 slips; loss, recovery)",
+           lambda: _fits(ident))
+    ident = log = None  # noqa: F841 - free them before the end-to-end runs
+    for src, path in (("Parquet", parquet), ("CSV", csv)):
+        record(f"end to end from {src} (run_identification)",
+               lambda p=path: run_identification(p, VEH, out, threads=threads))
+    return {k: tuple(statistics.median(r[i] for r in v) for i in range(3))
+            for k, v in rows.items()}
+
+
+def _cli(log: Path, veh: Path, out: Path, figures: bool):
+    """Wall, user and system time [s] of the CLI command in a fresh process."""
+    cmd = [sys.executable, "-m", "railadhesion", "identify", str(log), "--vehicle", str(veh),
+           "--out", str(out), "--figures" if figures else "--no-figures"]
+    env = dict(os.environ, MPLBACKEND="Agg")
+    c = os.times()
+    t = time.perf_counter()
+    subprocess.run(cmd, check=True, capture_output=True, env=env)
+    wall = time.perf_counter() - t
+    d = os.times()
+    return wall, d.children_user - c.children_user, d.children_system - c.children_system
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--hours", type=float, default=1.0)
     ap.add_argument("--keep", type=Path, default=None,
                     help="Write the log here (log.csv/log.parquet) and reuse it if present.")
+    ap.add_argument("--no-cli", action="store_true", help="Skip the CLI timings.")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         base = (args.keep or Path(tmp)) / "log"
@@ -99,39 +194,47 @@ def main() -> None:
         n = len(pd.read_parquet(base.with_suffix(".parquet"), columns=["time"]))
         print(f"log: {n} samples x 4 axles ({n * PERIOD / 3600:g} h at 2.4 ms), ready in "
               f"{time.perf_counter() - t0:.1f} s")
-        times: dict[str, list[float]] = {}
-        cpu: dict[str, list[float]] = {}
-
-        def timed(name, fn):
-            t, c = time.perf_counter(), time.process_time()
-            out = fn()
-            times.setdefault(name, []).append(time.perf_counter() - t)
-            cpu.setdefault(name, []).append(time.process_time() - c)
-            return out
-
-        for _ in range(args.repeat):
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                timed("read CSV", lambda: read_braking_log(base.with_suffix(".csv"), warn=False))
-                log = timed("read Parquet",
-                            lambda: read_braking_log(base.with_suffix(".parquet"), warn=False))
-            ident = timed("identify (filters, eq. 14, mu, windows)",
-                          lambda: identify_adhesion(log, VEH))  # noqa: B023
-            timed("surface 40 x 40 x 3 phases", lambda: adhesion_surface(ident))  # noqa: B023
-            timed("fit mu(slip), 4 bands + all", lambda: fit_adhesion_curves(ident))  # noqa: B023
-        med = {k: statistics.median(v) for k, v in times.items()}
-        mcpu = {k: statistics.median(v) for k, v in cpu.items()}
-        print(f"median of {args.repeat} runs, wall and process CPU time [s] "
-              "(machine shared with other jobs: noisy)")
-        for k in med:
-            print(f"  {k:<42} {med[k]:7.3f} {mcpu[k]:7.3f}")
-        core = sum(med[k] for k in med if not k.startswith("read"))
-        ccore = sum(mcpu[k] for k in mcpu if not k.startswith("read"))
-        print(f"  {'processing (identify + surface + fit)':<42} {core:7.3f} {ccore:7.3f}")
-        print(f"  {'end to end from Parquet':<42} {core + med['read Parquet']:7.3f} "
-              f"{ccore + mcpu['read Parquet']:7.3f}")
-        print(f"  {'end to end from CSV':<42} {core + med['read CSV']:7.3f} "
-              f"{ccore + mcpu['read CSV']:7.3f}")
+        out = Path(tmp) / "out"
+        cores = _worker_count(None)
+        print(f"cores available: {cores}; {_load()}")
+        warm, wall, _, _ = _timed(lambda: run_identification(base.with_suffix(".parquet"),
+                                                              VEH, out))
+        b = warm.ident.brake
+        print(f"warm-up run (kernels loaded): {wall:.2f} s; c = {b.mean * 1e5:.1f} N m/bar "
+              f"(true {VEH.brake_coefficient * 1e5:.0f}), fitted mu(slip) R^2 = "
+              f"{warm.law.overall.r_squared:.3f}")
+        del warm
+        results = {}
+        for threads in sorted({1, cores}):
+            results[threads] = _stages(base, out, threads, args.repeat)
+        print(f"\nmedian of {args.repeat} runs in a row: wall / user / system CPU [s]; "
+              f"{_load()}")
+        head = "".join(f"  {t} thread{'s' if t > 1 else ' '}: wall / user / sys" for t in results)
+        print(f"  {'stage':<66}{head}")
+        for name in results[1]:
+            cells = "".join("  {:13.3f} / {:5.3f} / {:5.3f}".format(*results[t][name])
+                            for t in results)
+            print(f"  {name:<66}{cells}")
+        if not args.no_cli:
+            veh = Path(tmp) / "vehicle.toml"
+            VEH.to_toml(veh)
+            print(f"\nCLI 'railadhesion identify' in a fresh process (imports, kernel loading "
+                  f"and first touch of memory included; every core), median of "
+                  f"{args.repeat}: wall / user / sys [s]; {_load()}")
+            for src in ("parquet", "csv"):
+                for figures in (False, True):
+                    runs = [_cli(base.with_suffix("." + src), veh, Path(tmp) / "cli", figures)
+                            for _ in range(args.repeat)]
+                    wall, user, system = (statistics.median(r[i] for r in runs)
+                                          for i in range(3))
+                    label = f"from {src} {'with' if figures else 'without'} figures"
+                    print(f"  {label:<32} {wall:7.2f} / {user:5.2f} / {system:5.2f}")
+            start = [sys.executable, "-c", "import railadhesion.cli, "
+                     "railadhesion.identification.pipeline"]
+            t = time.perf_counter()
+            subprocess.run(start, check=True, env=dict(os.environ))
+            print(f"  {'(imports alone)':<32} {time.perf_counter() - t:7.2f}")
+        print(f"\n{_load()}")
 
 
 if __name__ == "__main__":

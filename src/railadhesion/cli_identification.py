@@ -77,88 +77,33 @@ def identify(
     figures: bool = typer.Option(True, help="Write the figures (PNG)."),
 ) -> None:
     """Identify adhesion from a braking-test log: c, mu, surface (NetCDF), fitted law, figures."""
-    import json
-
-    import numpy as np
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from railadhesion.braking import load_vehicle
-    from railadhesion.identification import (
-        adhesion_surface,
-        fit_adhesion_curves,
-        identify_adhesion,
-        read_braking_log,
-        save_surface,
-    )
+    from railadhesion.identification.pipeline import STAGES, run_identification
 
     try:
         bands = [float(x) for x in speed_bands.split(",") if x.strip()]
     except ValueError:
         _fail(f"--speed-bands: expected numbers separated by commas, got {speed_bands!r}")
-    stages = ["read the log", "derivatives and filters", "brake coefficient (eq. 14)",
-              "normal loads and adhesion (eqs. 10-13)", "identification windows",
-              "surface", "fitted curves", "figures", "summary"]
-    import warnings
-
-    from railadhesion.identification.logs import BrakingLogWarning
-
     with Progress(TextColumn("{task.description:<42}"), BarColumn(), TimeElapsedColumn(),
                   console=console, transient=False) as bar:
-        task = bar.add_task("read the log", total=len(stages))
+        task = bar.add_task(STAGES[0], total=len(STAGES))
 
         def step(name):
             bar.update(task, advance=1, description=name)
 
         try:
             veh = load_vehicle(vehicle)
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", BrakingLogWarning)
-                data = read_braking_log(log)
-            ident = identify_adhesion(
-                data, veh, filter_mode=filter_mode, vehicle_cutoff=vehicle_cutoff,
-                wheel_cutoff=wheel_cutoff, progress=step,
+            run = run_identification(
+                log, veh, out, filter_mode=filter_mode, vehicle_cutoff=vehicle_cutoff,
+                wheel_cutoff=wheel_cutoff, speed_bands=bands, figures=figures, progress=step,
             )
-            step("surface")
-            out.mkdir(parents=True, exist_ok=True)
-            surface = adhesion_surface(ident)
-            save_surface(surface, out / "surface.nc")
-            surface_rel = adhesion_surface(ident, slip="relative")
-            save_surface(surface_rel, out / "surface_relative.nc")
-            step("fitted curves")
-            law = fit_adhesion_curves(ident, speed_bands=bands)
-            law.save(out / "adhesion_law.toml")
-            law_rel = fit_adhesion_curves(ident, slip="relative", speed_bands=bands)
-            law_rel.save(out / "adhesion_law_relative.toml")
-            ident.windows.to_csv(out / "windows.csv", index=False)
-            step("figures")
-            if figures:
-                from railadhesion.identification.figures import save_identification_figures
-
-                save_identification_figures(ident, out / "figures", surface=surface, law=law,
-                                            law_relative=law_rel)
-            step("summary")
-            summary = ident.summary_dict()
-            summary["curves_absolute_slip"] = law.to_frame().replace({np.nan: None}).to_dict(
-                orient="records")
-            summary["curves_relative_slip"] = law_rel.to_frame().replace(
-                {np.nan: None}).to_dict(orient="records")
-            summary["curve_form"] = "mu_s * (1 - exp(-s/s0)) * (A + (1 - A) * exp(-B*s))"
-            by_phase = {}
-            for phase in ("loss", "recovery"):
-                try:
-                    fitted = fit_adhesion_curves(ident, speed_bands=bands, phase=phase).overall
-                except ValueError as exc:  # too few samples in that phase
-                    by_phase[phase] = {"error": str(exc)}
-                    continue
-                by_phase[phase] = {**fitted.params, "n_samples": fitted.n_samples,
-                                   "r_squared": fitted.r_squared,
-                                   "slip_range_m_s": list(fitted.slip_range)}
-            summary["curves_by_phase_absolute_slip"] = by_phase
-            (out / "summary.json").write_text(json.dumps(summary, indent=2), encoding="utf-8")
-            bar.update(task, completed=len(stages), description="done")
+            bar.update(task, completed=len(STAGES), description="done")
         except (ValueError, OSError) as exc:
             _fail(exc)
-    b = ident.brake
+    data, law = run.log, run.law
+    b = run.ident.brake
     console.print(f"log: {data.n_samples} samples, {data.n_axles} axles, "
                   f"{len(data.issues)} defect(s)", markup=False)
     for issue in data.issues:

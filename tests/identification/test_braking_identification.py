@@ -138,3 +138,45 @@ def test_pitch_angle_eq13_when_the_secondary_stiffness_is_given():
     assert res.pitch_angle[k] == pytest.approx(-32600 * 0.8 * d / (2 * 1.2e6 * 90.25))
     assert res.pitch_angle[k] < 0
     assert identify_adhesion(braking_log_from_frame(frame), Vehicle()).pitch_angle is None
+
+
+def test_threads_do_not_change_the_results(mini_run, mini_vehicle):
+    # the channels and axles run in threads; each is computed alone, so 1 or 2 threads give
+    # the same bits; a gap makes two segments (jobs per segment)
+    t, v, om, p, _ = mini_run
+    frame = minisim.log_frame(t, v, om, p, noise=(0.01, 0.02, 0.01), seed=5)
+    frame = frame.drop(index=range(3000, 3100)).reset_index(drop=True)
+    log = braking_log_from_frame(frame, warn=False)
+    assert log.segment.max() == 1
+    one = identify_adhesion(log, mini_vehicle, threads=1)
+    two = identify_adhesion(log, mini_vehicle, threads=2)
+    for name in ("speed", "deceleration", "angular_acceleration", "pressure", "normal_load",
+                 "mu", "slip", "relative_slip", "slip_rate", "relative_slip_rate", "use",
+                 "phase"):
+        assert np.array_equal(getattr(one, name), getattr(two, name), equal_nan=True), name
+    assert one.brake.mean == two.brake.mean
+    pd.testing.assert_frame_equal(one.windows, two.windows)
+    with pytest.raises(ValueError, match="threads"):
+        identify_adhesion(log, mini_vehicle, threads=0)
+
+
+def test_loads_of_a_vehicle_that_is_not_affine_in_d(mini_run, mini_vehicle):
+    # a vehicle whose loads are not affine in the deceleration is evaluated sample by sample
+    class Curved:
+        def __init__(self, veh):
+            self.veh = veh
+
+        def __getattr__(self, name):
+            return getattr(self.veh, name)
+
+        def axle_normal_loads(self, d):
+            return self.veh.axle_normal_loads(d) * (1.0 + 0.01 * np.asarray(d)[..., None] ** 2)
+
+    t, v, om, p, _ = mini_run
+    log = braking_log_from_frame(minisim.log_frame(t, v, om, p), warn=False)
+    ident = identify_adhesion(log, Curved(mini_vehicle))
+    expected = Curved(mini_vehicle).axle_normal_loads(ident.deceleration)
+    assert np.allclose(ident.normal_load, expected, rtol=1e-14)
+    plain = identify_adhesion(log, mini_vehicle)
+    assert np.allclose(plain.normal_load, mini_vehicle.axle_normal_loads(plain.deceleration),
+                       rtol=1e-14)

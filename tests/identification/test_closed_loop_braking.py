@@ -6,12 +6,17 @@ Polach set (not the identification's own functional form), so the fitted form mu
 flexible enough. The identified law is then run back through the simulator.
 """
 
+import json
+
 import numpy as np
 import pytest
+from typer.testing import CliRunner
 
-from railadhesion.braking import Vehicle, write_braking_log
+from railadhesion.braking import BrakingFileError, Vehicle, write_braking_log
 from railadhesion.braking.adhesion import CallableAdhesion, PolachAdhesion, polach_family_curve
 from railadhesion.braking.run import simulate
+from railadhesion.braking.scenario import load_scenario
+from railadhesion.cli import app
 from railadhesion.identification import (
     fit_adhesion_curves,
     identify_adhesion,
@@ -73,3 +78,44 @@ def test_identified_law_drives_the_braking_simulator(loop, tmp_path):
     h = result.histories
     assert len(h) > 100 and np.all(np.isfinite(h.train_speed))
     assert h.train_speed.iloc[-1] < 25.0
+    # the same through the law's own adapter
+    direct = simulate(veh, loaded.braking_adhesion(), 25.0, brake=3.8e5, wsp=True, dt=2.5e-3,
+                      max_time=1.0)
+    assert np.allclose(direct.histories.train_speed, h.train_speed)
+
+
+def test_identified_law_file_in_a_brake_scenario(loop, tmp_path):
+    """From test data to simulation without Python: the law file that ``identify`` writes is
+    the adhesion model of a scenario TOML, run by ``railadhesion brake``."""
+    veh, _, _, law = loop
+    law.save(tmp_path / "adhesion_law.toml")
+    veh.to_toml(tmp_path / "vehicle.toml")
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(
+        'format = "railadhesion-brake-scenario"\nversion = 1\n'
+        '[vehicle]\nfile = "vehicle.toml"\n'
+        "[run]\ninitial_speed_m_s = 5.0\ntime_step_s = 0.0025\nmax_time_s = 20.0\n"
+        "[brake]\npressure_Pa = 3.8e5\n"
+        '[adhesion]\nmodel = "law"\nfile = "adhesion_law.toml"\n'
+        "[wsp]\nperiod_s = 0.005\n")
+    sc = load_scenario(scenario)
+    assert sc.source["adhesion"]["model"] == "law"
+    from_file = sc.simulate()
+    direct = simulate(veh, law.braking_adhesion(), 5.0, brake=3.8e5, wsp=True, dt=2.5e-3,
+                      max_time=20.0)
+    assert np.allclose(from_file.histories.train_speed, direct.histories.train_speed,
+                       rtol=0, atol=1e-9)
+    out = tmp_path / "out"
+    res = CliRunner().invoke(app, ["brake", str(scenario), "--out", str(out), "--quiet",
+                                   "--no-figures"])
+    assert res.exit_code == 0, res.output
+    assert json.loads((out / "summary.json").read_text())["stopping_distance_m"] > 0
+    # a scenario naming a missing law file, or a law with WILAC-only fields, names the field
+    for old, new, field in (('file = "adhesion_law.toml"', 'file = "nope.toml"',
+                             r"adhesion\.file"),
+                            ('model = "law"', 'model = "law"\nwater_flow_ul_s = 25.0',
+                             r"adhesion\.water_flow_ul_s")):
+        bad = tmp_path / "bad.toml"
+        bad.write_text(scenario.read_text().replace(old, new))
+        with pytest.raises(BrakingFileError, match=field):
+            load_scenario(bad)

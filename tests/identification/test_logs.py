@@ -154,3 +154,29 @@ def test_malformed_logs_raise(mutate, match):
 def test_missing_file(tmp_path):
     with pytest.raises(ValueError, match="no such file"):
         read_braking_log(tmp_path / "none.csv")
+
+
+def test_parquet_reports_the_same_defects_as_csv(tmp_path):
+    # the messy log without its text cell (a Parquet column holds one type)
+    df = messy_frame()
+    df.loc[df["train_speed"] == "abc", "train_speed"] = np.nan
+    df = df.astype(float)
+    df.to_csv(tmp_path / "m.csv", index=False)
+    df.to_parquet(tmp_path / "m.parquet", index=False)
+    a = read_braking_log(tmp_path / "m.csv", warn=False)
+    b = read_braking_log(tmp_path / "m.parquet", warn=False)
+    assert [str(i) for i in a.issues] == [str(i) for i in b.issues]
+    kinds = {i.kind for i in b.issues}
+    assert {"missing-time", "unsorted", "duplicate-time", "gap", "stuck-channel",
+            "missing-values"} <= kinds
+    assert np.array_equal(a.rows, b.rows) and np.array_equal(a.valid, b.valid)
+    assert np.allclose(a.wheel_speed, b.wheel_speed)
+
+
+def test_parquet_without_pyarrow_is_a_clear_error(tmp_path, monkeypatch):
+    import sys
+
+    clean_frame(n=50).to_parquet(tmp_path / "a.parquet", index=False)
+    monkeypatch.setitem(sys.modules, "pyarrow.parquet", None)  # import fails
+    with pytest.raises(ValueError, match="needs pyarrow"):
+        read_braking_log(tmp_path / "a.parquet")

@@ -75,3 +75,29 @@ def test_derivative_matches_numpy_gradient():
     t = np.cumsum(rng.uniform(1e-3, 3e-3, 500))
     x = rng.normal(size=(500, 3))
     assert np.allclose(derivative(x, t), np.gradient(x, t, axis=0), rtol=1e-12, atol=1e-9)
+
+
+def test_coefficients_are_scipy_butter_to_the_last_bit():
+    # written out to avoid importing scipy.signal; they must not differ from it
+    from scipy import signal
+
+    from railadhesion.identification.signals import _coefficients, _steady_state
+
+    rng = np.random.default_rng(3)
+    for fs in (FS, 400.0, 1000.0, 100.0):
+        for fc in [0.5, 2.0, 0.777, 10.0, *rng.uniform(1e-3, 0.49 * fs, 50)]:
+            b, a = signal.butter(1, fc, btype="low", fs=fs)
+            b2, a2 = _coefficients(fc, fs)
+            assert np.array_equal(b, b2) and np.array_equal(a, a2)
+            assert _steady_state(b2, a2) == signal.lfilter_zi(b, a)[0]
+
+
+def test_importing_the_identification_does_not_import_scipy_signal():
+    import subprocess
+    import sys
+
+    code = ("import sys, railadhesion.identification.pipeline; "
+            "print('scipy.signal' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    assert out.stdout.strip() == "False"

@@ -21,14 +21,25 @@ after filtering: in eq. 14 the deceleration, the angular accelerations and the p
 all filtered at the vehicle cut-off (0.5 Hz); in eq. 10 the angular accelerations and the
 pressures at the wheel cut-off (2 Hz), and the slip that mu is paired with is filtered at 2 Hz
 too, so mu and slip are smoothed alike. With noise-free data eq. 14 then returns the true c
-exactly, whatever the filter. The running resistance ``F_res`` is the vehicle's Davis
+exactly, whatever the filter. (Eq. 14 needs only the sums over the axles of the angular
+accelerations and pressures: those sums are filtered, which the filter's linearity makes the
+same as summing the filtered channels, to rounding.)
+
+The channels (per segment: speed and deceleration, the eq. 14 sums, each axle's filters and
+derivatives) and then the axles (loads, eq. 10, windows) run in compiled kernels that release
+the GIL, in threads (``threads=``); each is computed alone, so the results do not depend on
+the number of threads. The running resistance ``F_res`` is the vehicle's Davis
 resistance (0 unless given): the paper neglects it (eq. 7).
 """
 
 from __future__ import annotations
 
+import os
+import threading
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 from numba import njit
@@ -39,8 +50,9 @@ from railadhesion.identification.signals import (
     FILTER_MODES,
     VEHICLE_CUTOFF,
     WHEEL_CUTOFF,
-    derivative,
-    lowpass,
+    FirstOrderFilter,
+    _gradient_weighted,
+    gradient_coefficients,
 )
 
 __all__ = [
@@ -192,13 +204,22 @@ class BrakingIdentification:
 
     def summary_dict(self) -> dict:
         """JSON-ready summary: c, counts, slip range, windows per phase, settings."""
-        speed, slip, _, mu, _ = self.samples()
         w = self.windows
+        any_use = bool(self.use.any())
+
+        def usable_range(x):
+            if not any_use:
+                return None
+            lo = np.min(x, where=self.use, initial=np.inf)
+            hi = np.max(x, where=self.use, initial=-np.inf)
+            return [float(lo), float(hi)]
+
+        rows = self.use.any(axis=1)
         out = {
             "samples": int(self.time.size),
             "axles": self.n_axles,
             "duration_s": float(self.time[-1] - self.time[0]),
-            "usable_samples": int(self.use.sum()),
+            "usable_samples": int(np.count_nonzero(self.use)),
             "brake_coefficient": {
                 "mean_N_m_per_Pa": self.brake.mean,
                 "mean_N_m_per_bar": self.brake.mean_n_m_per_bar,
@@ -209,10 +230,10 @@ class BrakingIdentification:
                 "window_samples": self.brake.n_samples,
                 "used_N_m_per_Pa": self.brake_coefficient,
             },
-            "slip_range_m_s": [float(np.min(slip)), float(np.max(slip))] if slip.size else None,
-            "speed_range_m_s": [float(np.min(speed)), float(np.max(speed))] if speed.size
-            else None,
-            "mu_range": [float(np.min(mu)), float(np.max(mu))] if mu.size else None,
+            "slip_range_m_s": usable_range(self.slip),
+            "speed_range_m_s": [float(np.min(self.speed[rows])), float(np.max(self.speed[rows]))]
+            if any_use else None,
+            "mu_range": usable_range(self.mu),
             "pitch_angle_range_rad": None if self.pitch_angle is None else
             [float(np.min(self.pitch_angle)), float(np.max(self.pitch_angle))],
             "windows": {
@@ -228,7 +249,7 @@ class BrakingIdentification:
 def _segments(seg: np.ndarray):
     cut = np.flatnonzero(np.diff(seg)) + 1
     bounds = np.concatenate(([0], cut, [seg.size]))
-    return list(zip(bounds[:-1], bounds[1:], strict=True))
+    return list(zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True))
 
 
 def brake_coefficient(
@@ -295,9 +316,13 @@ def brake_coefficient(
     force = float(vehicle.total_mass) * d - j * wd.sum(axis=1) / r
     if speed is not None and hasattr(vehicle, "running_resistance"):
         force = force - np.asarray(vehicle.running_resistance(np.asarray(speed, float)))
-    psum = p.sum(axis=1) / r
-    pmean = p.mean(axis=1)
     ok = np.ones(t.size, bool) if mask is None else np.asarray(mask, bool).copy()
+    return _brake_from_force(t, force, p.sum(axis=1) / r, p.mean(axis=1), ok, min_pressure)
+
+
+def _brake_from_force(t, force, psum, pmean, ok, min_pressure):
+    """Eq. 14 from its numerator (``M_tot d - F_res - sum J w_dot / R``) and denominator
+    (``sum p / R``) per sample, the mean pressure and the allowed samples."""
     applied = pmean >= max(float(min_pressure), 1e-9)
     c = np.full(t.size, np.nan)
     c[applied] = force[applied] / psum[applied]
@@ -342,7 +367,7 @@ def identification_windows(time, speed, slip_rate, use, segment, *, speed_tolera
     deadband : float, default 0.05 m/s^2
         |slip_rate| below this has no sign (neither loss nor recovery).
     mu, slip : ndarray (n,), optional
-        Adhesion and slip, for the window statistics.
+        Not used (kept for compatibility).
 
     Returns
     -------
@@ -351,58 +376,225 @@ def identification_windows(time, speed, slip_rate, use, segment, *, speed_tolera
     sign : ndarray of int8
         +1 loss of adhesion (slip growing), -1 recovery.
     """
-    key = np.where(slip_rate > deadband, 1, np.where(slip_rate < -deadband, -1, 0))
-    key = np.where(use, key, 0).astype(np.int8)
-    n = key.size
+    n = np.shape(slip_rate)[0]
     if n == 0:
         z = np.zeros(0, np.int64)
         return z, z, np.zeros(0, np.int8)
-    change2 = _window_starts(key, np.ascontiguousarray(segment, dtype=np.int64),
-                             np.ascontiguousarray(speed, dtype=float), float(speed_tolerance))
-    starts = np.flatnonzero(change2)
-    stops = np.concatenate((starts[1:], [n]))
-    sign = key[starts]
-    dur = time[stops - 1] - time[starts]
-    keep = (sign != 0) & (dur >= min_duration)
-    return starts[keep], stops[keep], sign[keep]
+    phase = np.zeros(n, np.int8)
+    return _windows(
+        np.asarray(time, dtype=float), np.asarray(speed, dtype=float),
+        np.asarray(slip_rate, dtype=float), np.asarray(use, dtype=np.bool_),
+        np.asarray(segment, dtype=np.int64), float(speed_tolerance), float(min_duration),
+        float(deadband), phase,
+    )
 
 
-@njit(cache=True)
-def _adhesion(wd, p, loads, slip, v, wheel, train, valid, sub, edge, j, c, r,
-              min_speed):  # pragma: no cover - compiled
-    """Eq. 10 per axle and sample, the relative slip and the usable-sample mask, in one pass:
-    mu = (J w_dot + c p) / (R N); usable = valid, v >= min_speed, wheel turning
-    (R w > 0.05 v), finite mu, not in a filter start-up zone, axle not substituted."""
-    n, m = wd.shape
-    mu = np.empty((n, m))
-    rel = np.empty((n, m))
-    use = np.empty((n, m), np.bool_)
+@njit(cache=True, nogil=True)
+def _windows(time, speed, slip_rate, use, segment, tolerance, min_duration, deadband,
+             phase):  # pragma: no cover - compiled
+    """Windows of one axle (see :func:`identification_windows`); marks ``phase`` (+1 loss,
+    -1 recovery) inside the windows kept. A run starts where the sign of the slip derivative
+    (0 inside the dead band or on unusable samples) or the segment changes, or where the
+    speed has moved ``tolerance`` from its value at the run's start."""
+    n = slip_rate.size
+    key = np.empty(n, np.int8)
     for k in range(n):
-        fast = v[k] >= min_speed
-        vr = max(train[k], 1e-9)
-        for a in range(m):
-            x = (j * wd[k, a] + c * p[k, a]) / (r * loads[k, a])
-            mu[k, a] = x
-            rel[k, a] = slip[k, a] / v[k] if fast else np.nan
-            use[k, a] = (valid[k, a] and not sub[a] and fast and wheel[k, a] * r > 0.05 * vr
-                         and np.isfinite(x) and not edge[k])
-    return mu, rel, use
-
-
-@njit(cache=True)
-def _window_starts(key, segment, speed, tolerance):  # pragma: no cover - compiled
-    """Start flags of the runs: a new run where the key or the segment changes, or where the
-    speed has moved ``tolerance`` from its value at the current run's start."""
-    n = key.size
-    start = np.zeros(n, np.bool_)
+        x = slip_rate[k]
+        key[k] = (1 if x > deadband else (-1 if x < -deadband else 0)) if use[k] else 0
+    start = np.empty(n, np.bool_)
     start[0] = True
     v0 = speed[0]
+    runs = 1
     for k in range(1, n):
         if key[k] != key[k - 1] or segment[k] != segment[k - 1] or \
                 abs(speed[k] - v0) >= tolerance:
             start[k] = True
             v0 = speed[k]
-    return start
+            runs += 1
+        else:
+            start[k] = False
+    s0 = np.empty(runs, np.int64)
+    m = 0
+    for k in range(n):
+        if start[k]:
+            s0[m] = k
+            m += 1
+    s1 = np.empty(runs, np.int64)
+    s1[:runs - 1] = s0[1:]
+    s1[runs - 1] = n
+    keep = np.zeros(runs, np.bool_)
+    kept = 0
+    for q in range(runs):
+        sg = key[s0[q]]
+        if sg != 0 and time[s1[q] - 1] - time[s0[q]] >= min_duration:
+            keep[q] = True
+            kept += 1
+    starts = np.empty(kept, np.int64)
+    stops = np.empty(kept, np.int64)
+    sign = np.empty(kept, np.int8)
+    m = 0
+    for q in range(runs):
+        if keep[q]:
+            starts[m] = s0[q]
+            stops[m] = s1[q]
+            sign[m] = key[s0[q]]
+            for k in range(s0[q], s1[q]):
+                phase[k] = key[s0[q]]
+            m += 1
+    return starts, stops, sign
+
+
+@njit(cache=True, nogil=True)
+def _window_sums(s0, s1, v, mu):  # pragma: no cover - compiled
+    """Running sums of v, v^2 and mu (``numpy.cumsum`` with a leading 0, the same additions)
+    read at the window starts ``s0`` and ends ``s1`` (sorted, not overlapping): the window
+    means are differences of them."""
+    m = s0.size
+    out = np.empty((6, m))
+    sv = 0.0
+    sq = 0.0
+    sm = 0.0
+    q0 = 0
+    q1 = 0
+    n = v.size
+    for k in range(n + 1):
+        while q0 < m and s0[q0] == k:
+            out[0, q0] = sv
+            out[2, q0] = sq
+            out[4, q0] = sm
+            q0 += 1
+        while q1 < m and s1[q1] == k:
+            out[1, q1] = sv
+            out[3, q1] = sq
+            out[5, q1] = sm
+            q1 += 1
+        if k < n:
+            sv += v[k]
+            sq += v[k] * v[k]
+            sm += mu[k]
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _column_sums(w, p, a, b, wsum, psum):  # pragma: no cover - compiled
+    """Sums over the axles of the wheel speeds and of the pressures, samples [a, b)."""
+    m = w.shape[1]
+    for k in range(a, b):
+        sw = 0.0
+        sp = 0.0
+        for i in range(m):
+            sw += w[k, i]
+            sp += p[k, i]
+        wsum[k - a] = sw
+        psum[k - a] = sp
+
+
+@njit(cache=True, nogil=True)
+def _brake_mask(wheel, train, valid, sub, edge, v_f, min_speed, r, out):  # pragma: no cover
+    """Samples allowed in the window of eq. 14: every axle valid (or substituted), every wheel
+    turning (R w > 0.05 v), not near a segment's end, v >= min_speed."""
+    n, m = wheel.shape
+    for k in range(n):
+        vk = train[k]
+        vr = 0.05 * (vk if (vk > 1e-9 or vk != vk) else 1e-9)  # np.maximum(v, 1e-9)
+        ok = (not edge[k]) and v_f[k] >= min_speed
+        if ok:
+            for i in range(m):
+                if not (wheel[k, i] * r > vr) or not (valid[k, i] or sub[i]):
+                    ok = False
+                    break
+        out[k] = ok
+
+
+@njit(cache=True, nogil=True)
+def _finite(x):  # pragma: no cover - compiled
+    """numpy.nan_to_num of one value."""
+    if x != x:
+        return 0.0
+    if x == np.inf:
+        return 1.7976931348623157e308
+    if x == -np.inf:
+        return -1.7976931348623157e308
+    return x
+
+
+@njit(cache=True, nogil=True)
+def _axle_adhesion(i, wd, p, slip, v, d, wheel, train, valid, substituted, edge, t, gc,
+                   seg_a, seg_b, j, c, r, min_speed, load0, load1, affine, loads, mu, rel,
+                   rel_rate, use):  # pragma: no cover - compiled
+    """Axle ``i``: loads (eqs. 11-12, affine in d when ``affine``), eq. 10
+    mu = (J w_dot + c p) / (R N), the relative slip dv / v (NaN below ``min_speed``), the
+    usable-sample mask (valid, v >= min_speed, wheel turning R w > 0.05 v, finite mu, not in a
+    filter start-up zone, axle not substituted) and d(dv / v)/dt per segment (of the relative
+    slip with NaN read as 0, as numpy.nan_to_num; NaN below ``min_speed``)."""
+    n = v.size
+    for k in range(n):
+        if affine:
+            x = load0 + load1 * d[k]
+            loads[k, i] = x if x > 0.0 else 0.0
+        fast = v[k] >= min_speed
+        vr = max(train[k], 1e-9)
+        x = (j * wd[k, i] + c * p[k, i]) / (r * loads[k, i])
+        mu[k, i] = x
+        rel[k, i] = slip[k, i] / v[k] if fast else np.nan
+        use[k, i] = (valid[k, i] and not substituted and fast and wheel[k, i] * r > 0.05 * vr
+                     and np.isfinite(x) and not edge[k])
+    for q in range(seg_a.size):
+        a = seg_a[q]
+        b = seg_b[q]
+        if b - a < 2:
+            for k in range(a, b):
+                rel_rate[k, i] = 0.0
+            continue
+        rel_rate[a, i] = (_finite(rel[a + 1, i]) - _finite(rel[a, i])) / (t[a + 1] - t[a])
+        rel_rate[b - 1, i] = (_finite(rel[b - 1, i]) - _finite(rel[b - 2, i])) / (
+            t[b - 1] - t[b - 2])
+        for k in range(a + 1, b - 1):
+            rel_rate[k, i] = (gc[0, k] * _finite(rel[k - 1, i]) + gc[1, k] * _finite(rel[k, i])
+                              + gc[2, k] * _finite(rel[k + 1, i]))
+    for k in range(n):
+        if not v[k] >= min_speed:
+            rel_rate[k, i] = np.nan
+
+
+def _worker_count(threads) -> int:
+    if threads is None:
+        try:
+            return max(1, len(os.sched_getaffinity(0)))
+        except AttributeError:  # pragma: no cover - not Linux
+            return max(1, os.cpu_count() or 1)
+    threads = int(threads)
+    if threads < 1:
+        raise ValueError(f"threads must be >= 1 (or None for every core), got {threads}")
+    return threads
+
+
+def _run_jobs(pool, jobs) -> None:
+    """Run zero-argument callables, in the pool's threads if there is one; re-raise errors."""
+    if pool is None:
+        for job in jobs:
+            job()
+        return
+    for future in [pool.submit(job) for job in jobs]:
+        future.result()
+
+
+def _affine_loads(vehicle, d):
+    """(N(0), dN/dd) if the vehicle's axle loads are affine in the deceleration over the range
+    of ``d`` (eqs. 11-12; checked at its ends and middle), else None."""
+    lo, hi = float(np.min(d)), float(np.max(d))
+    if not (np.isfinite(lo) and np.isfinite(hi)):
+        return None
+    probe = np.array([0.0, 1.0, lo, hi, 0.5 * (lo + hi)])
+    loads = np.asarray(vehicle.axle_normal_loads(probe), dtype=float)
+    if loads.ndim != 2 or loads.shape[0] != probe.size:
+        return None
+    base, slope = loads[0], loads[1] - loads[0]
+    pred = np.maximum(base[None, :] + slope[None, :] * probe[:, None], 0.0)
+    scale = max(float(np.max(np.abs(loads))), 1.0)
+    if not np.allclose(pred, loads, rtol=1e-12, atol=1e-12 * scale):
+        return None
+    return base, slope
 
 
 def identify_adhesion(
@@ -419,6 +611,7 @@ def identify_adhesion(
     min_window: float = 0.1,
     slip_rate_deadband: float = 0.05,
     progress: Callable[[str], None] | None = None,
+    threads: int | None = None,
 ) -> BrakingIdentification:
     """Identify the adhesion coefficient from a braking-test log (seed 002, §5).
 
@@ -444,6 +637,9 @@ def identify_adhesion(
         Window rules (:func:`identification_windows`): 1 m/s, 0.1 s, 0.05 m/s^2.
     progress : callable, optional
         Called with the name of each stage (for progress bars).
+    threads : int, optional
+        Threads for the channels and axles (compiled kernels that release the GIL); default:
+        every core available. The results do not depend on it.
 
     Returns
     -------
@@ -454,14 +650,13 @@ def identify_adhesion(
     ValueError
         Bad options (named), a log whose axle count differs from the vehicle's, no braking.
     """
-    import pandas as pd
-
     check_choice(filter_mode, "filter_mode", FILTER_MODES)
     check_positive(vehicle_cutoff, "vehicle_cutoff")
     check_positive(wheel_cutoff, "wheel_cutoff")
     check_nonnegative(min_speed, "min_speed")
     check_nonnegative(min_pressure, "min_pressure")
     check_positive(speed_tolerance, "speed_tolerance")
+    workers = _worker_count(threads)
     step = progress or (lambda _stage: None)
     n_ax = log.n_axles
     if int(getattr(vehicle, "n_axles", n_ax)) != n_ax:
@@ -469,114 +664,176 @@ def identify_adhesion(
             f"the log has {n_ax} axles but the vehicle {getattr(vehicle, 'name', '')!r} has "
             f"{vehicle.n_axles}"
         )
+    if workers > 1:
+        with ThreadPoolExecutor(max_workers=workers) as pool:
+            return _identify(log, vehicle, pool, step, filter_mode, vehicle_cutoff,
+                             wheel_cutoff, brake_coefficient_value, min_speed, min_pressure,
+                             speed_tolerance, min_window, slip_rate_deadband)
+    return _identify(log, vehicle, None, step, filter_mode, vehicle_cutoff, wheel_cutoff,
+                     brake_coefficient_value, min_speed, min_pressure, speed_tolerance,
+                     min_window, slip_rate_deadband)
+
+
+def _per_axle(n, n_ax, dtype=float):
+    """An (n, n_ax) array whose axle columns are contiguous (Fortran order): threads working
+    on different axles never write to the same cache line."""
+    return np.empty((n_ax, n), dtype=dtype).T
+
+
+def _identify(log, vehicle, pool, step, filter_mode, vehicle_cutoff, wheel_cutoff,
+              brake_coefficient_value, min_speed, min_pressure, speed_tolerance, min_window,
+              slip_rate_deadband):
+    import pandas as pd
+
+    n_ax = log.n_axles
     r = float(vehicle.wheel_radius)
     j = float(vehicle.wheelset_inertia)
-    t = log.time
+    t = np.ascontiguousarray(log.time, dtype=float)
     n = t.size
+    train = np.ascontiguousarray(log.train_speed, dtype=float)
+    wheel = np.asarray(log.wheel_speed, dtype=float)
+    press = np.asarray(log.brake_pressure, dtype=float)
     step("derivatives and filters")
     v_f = np.empty(n)
     d_f = np.empty(n)
-    wd2 = np.empty((n, n_ax))
-    wd05 = np.empty((n, n_ax))
-    p2 = np.empty((n, n_ax))
-    p05 = np.empty((n, n_ax))
-    slip = np.empty((n, n_ax))
-    slip_rate = np.empty((n, n_ax))
+    jsum = np.empty(n)   # sum_i w_dot_i at the vehicle cut-off (eq. 14)
+    psum = np.empty(n)   # sum_i p_i at the vehicle cut-off (eq. 14)
+    wd2 = _per_axle(n, n_ax)
+    p2 = _per_axle(n, n_ax)
+    slip = _per_axle(n, n_ax)
+    slip_rate = _per_axle(n, n_ax)
     edge = np.zeros(n, bool)
     edge_fast = np.zeros(n, bool)
-    for a, b in _segments(log.segment):
+    segments = _segments(log.segment)
+    gc = gradient_coefficients(t)  # shared by every derivative (weights depend on t only)
+    longest = max(b - a for a, b in segments)
+    local = threading.local()
+
+    def scratch(k, m):
+        """Work array k (0 or 1) of the calling thread, m samples long."""
+        bufs = getattr(local, "bufs", None)
+        if bufs is None:
+            bufs = local.bufs = np.empty((2, longest))
+        return bufs[k, :m]
+
+    jobs = []
+    for a, b in segments:
         ts = t[a:b]
         if b - a < 8:
             edge[a:b] = True
             edge_fast[a:b] = True
-            v_f[a:b] = log.train_speed[a:b]
+            v_f[a:b] = train[a:b]
             d_f[a:b] = 0.0
-            wd2[a:b] = wd05[a:b] = 0.0
-            p2[a:b] = p05[a:b] = log.brake_pressure[a:b]
-            slip[a:b] = log.train_speed[a:b, None] - r * log.wheel_speed[a:b]
+            jsum[a:b] = 0.0
+            psum[a:b] = press[a:b].sum(axis=1)
+            wd2[a:b] = 0.0
+            p2[a:b] = press[a:b]
+            slip[a:b] = train[a:b, None] - r * wheel[a:b]
             slip_rate[a:b] = 0.0
             continue
         fs = 1.0 / float(np.median(np.diff(ts)))
-        vs = log.train_speed[a:b]
-        ws = log.wheel_speed[a:b]
-        ps = log.brake_pressure[a:b]
-        # one filter call per cut-off on stacked channels
-        d_raw = -derivative(vs, ts)
-        wd_raw = derivative(ws, ts)
-        slow = lowpass(np.column_stack([d_raw, wd_raw, ps]), vehicle_cutoff, fs, filter_mode)
-        d_f[a:b] = slow[:, 0]
-        wd05[a:b] = slow[:, 1:1 + n_ax]
-        p05[a:b] = slow[:, 1 + n_ax:]
-        sl_raw = vs[:, None] - r * ws
-        fast = lowpass(np.column_stack([vs, wd_raw, ps, sl_raw]), wheel_cutoff, fs, filter_mode)
-        v_f[a:b] = fast[:, 0]
-        wd2[a:b] = fast[:, 1:1 + n_ax]
-        p2[a:b] = fast[:, 1 + n_ax:1 + 2 * n_ax]
-        slip[a:b] = fast[:, 1 + 2 * n_ax:]
-        slip_rate[a:b] = derivative(slip[a:b], ts)
+        slow = FirstOrderFilter(vehicle_cutoff, fs, filter_mode)
+        fast = FirstOrderFilter(wheel_cutoff, fs, filter_mode)
         edge[a:b] = (ts - ts[0] < _EDGE_TIME) | (ts[-1] - ts < _EDGE_TIME)
         # filter start-up / end effects of the fast filter: 1/fc either side
         tf = 1.0 / wheel_cutoff
         edge_fast[a:b] = (ts - ts[0] < tf) | (ts[-1] - ts < tf)
+
+        def vehicle_job(a=a, b=b, slow=slow, fast=fast):
+            buf = scratch(0, b - a)
+            _gradient_weighted(train, t, gc, a, b, buf, -1.0)  # d = -dv/dt
+            slow.apply(buf, d_f[a:b])
+            fast.apply(train[a:b], v_f[a:b])
+
+        def eq14_job(a=a, b=b, slow=slow):
+            ws, ps = scratch(0, b - a), scratch(1, b - a)
+            _column_sums(wheel, press, a, b, ws, ps)
+            slow.apply(ps, psum[a:b])
+            _gradient_weighted(ws, t[a:b], gc[:, a:b], 0, b - a, ps, 1.0)
+            slow.apply(ps, jsum[a:b])
+
+        def axle_job(i, a=a, b=b, fast=fast):
+            w = wheel[:, i]
+            buf = scratch(0, b - a)
+            _gradient_weighted(w, t, gc, a, b, buf, 1.0)
+            fast.apply(buf, wd2[a:b, i])
+            fast.apply(press[a:b, i], p2[a:b, i])
+            np.multiply(w[a:b], r, out=buf)
+            np.subtract(train[a:b], buf, out=buf)
+            fast.apply(buf, slip[a:b, i])
+            _gradient_weighted(slip[:, i], t, gc, a, b, slip_rate[a:b, i], 1.0)
+
+        jobs += [vehicle_job, eq14_job] + [partial(axle_job, i) for i in range(n_ax)]
+    _run_jobs(pool, jobs)
     step("brake coefficient (eq. 14)")
-    turning = np.all(log.wheel_speed * r > 0.05 * np.maximum(log.train_speed, 1e-9)[:, None],
-                     axis=1)
     sub = getattr(log, "substituted", None)
     sub = np.ascontiguousarray(np.zeros(n_ax, bool) if sub is None else sub, dtype=np.bool_)
-    c_ok = np.all(log.valid | sub[None, :], axis=1) & ~edge & turning & (v_f >= min_speed)
-    brake = brake_coefficient(t, d_f, wd05, p05, vehicle, speed=v_f, mask=c_ok,
-                              min_pressure=min_pressure)
+    valid = np.asarray(log.valid, dtype=np.bool_)
+    c_ok = np.empty(n, np.bool_)
+    _brake_mask(wheel, train, valid, sub, edge, v_f, float(min_speed), r, c_ok)
+    # M_tot d - sum J w_dot / R (- F_res), the same arithmetic in place
+    force = np.multiply(d_f, float(vehicle.total_mass))
+    inertia = np.multiply(jsum, j)
+    np.divide(inertia, r, out=inertia)
+    np.subtract(force, inertia, out=force)
+    if hasattr(vehicle, "running_resistance"):
+        np.subtract(force, np.asarray(vehicle.running_resistance(v_f), dtype=float), out=force)
+    np.divide(psum, r, out=inertia)  # sum p / R
+    brake = _brake_from_force(t, force, inertia, psum / n_ax, c_ok, min_pressure)
+    del force, inertia
     c = brake.mean if brake_coefficient_value is None else float(
         check_positive(brake_coefficient_value, "brake_coefficient_value"))
     step("normal loads and adhesion (eqs. 10-13)")
-    loads = np.ascontiguousarray(vehicle.axle_normal_loads(d_f), dtype=float)
-    mu, rel, use = _adhesion(
-        wd2, p2, loads, slip, v_f, np.ascontiguousarray(log.wheel_speed),
-        np.ascontiguousarray(log.train_speed), np.ascontiguousarray(log.valid), sub,
-        edge_fast, j, c, r, float(min_speed),
-    )
+    affine = _affine_loads(vehicle, d_f)
+    if affine is None:  # a vehicle whose loads are not affine in d: evaluate them all
+        loads = np.asfortranarray(vehicle.axle_normal_loads(d_f), dtype=float)
+        load0 = load1 = np.zeros(n_ax)
+    else:
+        loads = _per_axle(n, n_ax)
+        load0, load1 = affine
+    mu = _per_axle(n, n_ax)
+    rel = _per_axle(n, n_ax)
+    rel_rate = _per_axle(n, n_ax)
+    use = _per_axle(n, n_ax, np.bool_)
+    phase = np.zeros((n_ax, n), np.int8).T
+    seg_a = np.array([s[0] for s in segments], dtype=np.int64)
+    seg_b = np.array([s[1] for s in segments], dtype=np.int64)
+    segment_index = np.ascontiguousarray(log.segment, dtype=np.int64)
+    found = [None] * n_ax
+
+    def adhesion_job(i):
+        _axle_adhesion(i, wd2, p2, slip, v_f, d_f, wheel, train, valid, bool(sub[i]),
+                       edge_fast, t, gc, seg_a, seg_b, j, c, r, float(min_speed),
+                       float(load0[i]), float(load1[i]), affine is not None, loads, mu, rel,
+                       rel_rate, use)
+        s0, s1, sign = _windows(t, v_f, slip_rate[:, i], use[:, i], segment_index,
+                                float(speed_tolerance), float(min_window),
+                                float(slip_rate_deadband), phase[:, i])
+        found[i] = (s0, s1, sign, _window_sums(s0, s1, v_f, mu[:, i]))
+
+    _run_jobs(pool, [partial(adhesion_job, i) for i in range(n_ax)])
     pitch = None
     if getattr(vehicle, "secondary_stiffness", None) is not None:
         pitch = np.asarray(vehicle.pitch_angle(d_f), dtype=float)
-    fast_ok = v_f >= min_speed
-    rel_rate = np.empty((n, n_ax))
-    for a, b in _segments(log.segment):
-        if b - a >= 2:
-            rel_rate[a:b] = derivative(np.nan_to_num(rel[a:b]), t[a:b])
-        else:
-            rel_rate[a:b] = 0.0
-    rel_rate[~fast_ok] = np.nan
     step("identification windows")
-    phase = np.zeros((n, n_ax), np.int8)
-    rows = []
-    for i in range(n_ax):
-        s0, s1, sign = identification_windows(
-            t, v_f, slip_rate[:, i], use[:, i], log.segment, speed_tolerance=speed_tolerance,
-            min_duration=min_window, deadband=slip_rate_deadband,
-        )
+    parts = []
+    for i, (s0, s1, sign, sums) in enumerate(found):
         if s0.size == 0:
             continue
-        marks = np.zeros(n + 1, np.int64)
-        np.add.at(marks, s0, sign)
-        np.add.at(marks, s1, -sign)
-        phase[:, i] = np.cumsum(marks[:-1]).astype(np.int8)
         cnt = (s1 - s0).astype(float)
-        cs_v = np.concatenate(([0.0], np.cumsum(v_f)))
-        cs_v2 = np.concatenate(([0.0], np.cumsum(v_f * v_f)))
-        cs_mu = np.concatenate(([0.0], np.cumsum(mu[:, i])))
-        vm = (cs_v[s1] - cs_v[s0]) / cnt
-        vv = np.maximum((cs_v2[s1] - cs_v2[s0]) / cnt - vm * vm, 0.0)
-        rows.append(pd.DataFrame({
-            "axle": i + 1,
-            "phase": np.where(sign > 0, "loss", "recovery"),
-            "start_time": t[s0], "end_time": t[s1 - 1], "n_samples": (s1 - s0),
-            "speed_mean": vm, "speed_std": np.sqrt(vv),
-            "slip_start": slip[s0, i], "slip_end": slip[s1 - 1, i],
-            "mu_mean": (cs_mu[s1] - cs_mu[s0]) / cnt,
-        }))
+        v0, v1, q0, q1, m0, m1 = sums
+        vm = (v1 - v0) / cnt
+        vv = np.maximum((q1 - q0) / cnt - vm * vm, 0.0)
+        parts.append((np.full(s0.size, i + 1, np.int64), sign, t[s0], t[s1 - 1], s1 - s0, vm,
+                      np.sqrt(vv), slip[s0, i], slip[s1 - 1, i], (m1 - m0) / cnt))
     cols = ["axle", "phase", "start_time", "end_time", "n_samples", "speed_mean", "speed_std",
             "slip_start", "slip_end", "mu_mean"]
-    windows = pd.concat(rows, ignore_index=True) if rows else pd.DataFrame(columns=cols)
+    if parts:
+        data = [np.concatenate(col) for col in zip(*parts, strict=True)]
+        data[1] = np.where(data[1] > 0, "loss", "recovery")
+        windows = pd.DataFrame(dict(zip(cols, data, strict=True)))
+    else:
+        windows = pd.DataFrame(columns=cols)
     settings = {
         "filter_mode": filter_mode, "vehicle_cutoff_Hz": float(vehicle_cutoff),
         "wheel_cutoff_Hz": float(wheel_cutoff), "min_speed_m_s": float(min_speed),

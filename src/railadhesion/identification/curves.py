@@ -39,6 +39,7 @@ from numba import njit
 from scipy import optimize
 
 from railadhesion._validate import check_choice
+from railadhesion.identification.surface import _cell
 
 __all__ = [
     "LAW_FORMAT",
@@ -108,48 +109,325 @@ class CurveFit:
 #: Fine slip bins per curve (statistics); the fit itself uses groups of 10 of them.
 _FINE = 2000
 _GROUP = 10
+#: Local minima of the coarse grid searched further, and the grid's size (per axis).
+GLOBAL_CANDIDATES = 2
+GLOBAL_GRID = 48
 
 
-@njit(cache=True)
-def _band_stats(speed, x, mu, mask, edges):  # pragma: no cover - compiled
-    """Per speed band (last row: all bands together) and fine slip bin of width max/_FINE:
-    count, sum of slip, sum of mu, sum of mu^2; and the largest slip per band."""
+@njit(cache=True, nogil=True)
+def _band_stats(speed, x, mu, use, phase, edges):  # pragma: no cover - compiled
+    """For each phase (0 all usable samples, 1 loss windows, 2 recovery windows), speed band
+    (last row: all bands together) and fine slip bin of width max/_FINE: count, sum of slip,
+    sum of mu, sum of mu^2. Samples: usable, finite slip >= 0 and finite mu. Also, per phase
+    and band (last: every row, whatever its speed), the number of rows with at least one such
+    sample and the sum of their speeds (for the bands' mean speeds)."""
     n, na = mu.shape
     nb = edges.size - 1
-    top = np.zeros(nb + 1)
+    top = np.zeros((3, nb + 1))
+    rows = np.zeros((3, nb + 1))
+    vsum = np.zeros((3, nb + 1))
+    band = np.empty(n, np.int64)
     for k in range(n):
         v = speed[k]
-        if not (v >= edges[0] and v < edges[nb]):
-            continue
-        b = np.searchsorted(edges, v, side="right") - 1
+        b = _cell(v, edges) if v < edges[nb] else -1  # bands are [low, high)
+        band[k] = b
+        h0 = False
+        h1 = False
+        h2 = False
         for a in range(na):
-            if mask[k, a]:
-                xv = x[k, a]
-                if xv > top[b]:
-                    top[b] = xv
-                if xv > top[nb]:
-                    top[nb] = xv
-    width = np.empty(nb + 1)
-    for b in range(nb + 1):
-        width[b] = (top[b] if top[b] > 0 else 1.0) * (1.0 + 1e-9) / _FINE
-    stats = np.zeros((nb + 1, 4, _FINE))
-    for k in range(n):
-        v = speed[k]
-        if not (v >= edges[0] and v < edges[nb]):
-            continue
-        b = np.searchsorted(edges, v, side="right") - 1
-        for a in range(na):
-            if not mask[k, a]:
+            xv = x[k, a]
+            if not (use[k, a] and xv >= 0.0 and np.isfinite(xv) and np.isfinite(mu[k, a])):
                 continue
+            p = phase[k, a]
+            h0 = True
+            if b >= 0:
+                if xv > top[0, b]:
+                    top[0, b] = xv
+                if xv > top[0, nb]:
+                    top[0, nb] = xv
+            if p != 0:
+                q = 1 if p > 0 else 2
+                if q == 1:
+                    h1 = True
+                else:
+                    h2 = True
+                if b >= 0:
+                    if xv > top[q, b]:
+                        top[q, b] = xv
+                    if xv > top[q, nb]:
+                        top[q, nb] = xv
+        for q in range(3):
+            if (h0, h1, h2)[q]:
+                rows[q, nb] += 1.0
+                vsum[q, nb] += v
+                if b >= 0:
+                    rows[q, b] += 1.0
+                    vsum[q, b] += v
+    width = np.empty((3, nb + 1))
+    for q in range(3):
+        for b in range(nb + 1):
+            width[q, b] = (top[q, b] if top[q, b] > 0 else 1.0) * (1.0 + 1e-9) / _FINE
+    acc = np.zeros((3, nb + 1, _FINE, 4))  # the four sums of a bin side by side
+    for k in range(n):
+        b = band[k]
+        if b < 0:
+            continue
+        for a in range(na):
             xv = x[k, a]
             y = mu[k, a]
+            if not (use[k, a] and xv >= 0.0 and np.isfinite(xv) and np.isfinite(y)):
+                continue
+            p = phase[k, a]
+            q = 1 if p > 0 else (2 if p < 0 else 0)
+            yy = y * y
             for bb in (b, nb):
-                j = min(int(xv / width[bb]), _FINE - 1)
-                stats[bb, 0, j] += 1.0
-                stats[bb, 1, j] += xv
-                stats[bb, 2, j] += y
-                stats[bb, 3, j] += y * y
-    return stats
+                j = min(int(xv / width[0, bb]), _FINE - 1)
+                acc[0, bb, j, 0] += 1.0
+                acc[0, bb, j, 1] += xv
+                acc[0, bb, j, 2] += y
+                acc[0, bb, j, 3] += yy
+                if q != 0:
+                    j = min(int(xv / width[q, bb]), _FINE - 1)
+                    acc[q, bb, j, 0] += 1.0
+                    acc[q, bb, j, 1] += xv
+                    acc[q, bb, j, 2] += y
+                    acc[q, bb, j, 3] += yy
+    stats = np.empty((3, nb + 1, 4, _FINE))
+    for q in range(3):
+        for b in range(nb + 1):
+            for j in range(_FINE):
+                for c in range(4):
+                    stats[q, b, c, j] = acc[q, b, j, c]
+    return stats, rows, vsum
+
+
+def band_statistics(ident, slip: str = "absolute", speed_bands=None):
+    """Fine-bin sums of mu per phase and speed band (:func:`_band_stats`), computed once per
+    identification, slip kind and band edges and kept with the identification.
+
+    Returns ``(edges, stats, rows, speed_sums)``; ``stats`` has shape
+    ``(3 phases, bands + 1, 4, _FINE)`` (phases all, loss, recovery; last band: all speeds).
+    """
+    edges = np.asarray([0.0, 10.0, 20.0, 30.0, 40.0] if speed_bands is None else speed_bands,
+                       dtype=float)
+    if edges.size < 2 or np.any(np.diff(edges) <= 0):
+        raise ValueError("speed_bands must be at least 2 strictly increasing speeds [m/s]")
+    cache = getattr(ident, "_cache", None)
+    key = ("band_stats", slip, tuple(edges.tolist()))
+    if cache is not None and key in cache:
+        return cache[key]
+    x = ident.slip if slip == "absolute" else ident.relative_slip
+    out = _band_stats(
+        np.asarray(ident.speed, dtype=float), np.asarray(x, dtype=float),
+        np.asarray(ident.mu, dtype=float), np.asarray(ident.use, dtype=np.bool_),
+        np.asarray(ident.phase, dtype=np.int8), edges,
+    )
+    out = (edges, *out)
+    if cache is not None:
+        cache[key] = out
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _linear_part(suu, suv, svv, sut, svt, stt, top):  # pragma: no cover - compiled
+    """min over c1, c2 >= 0, c1 + c2 <= top of |t - c1 u - c2 v|^2 from the sums of products
+    (a convex quadratic on a triangle: the unconstrained minimum if it lies inside, else the
+    best point of the three edges). Returns (cost, c1, c2)."""
+    best = np.inf
+    b1 = 0.0
+    b2 = 0.0
+    det = suu * svv - suv * suv
+    cands = np.zeros((6, 2))
+    m = 0
+    if det > 1e-12 * suu * svv:
+        c1 = (sut * svv - svt * suv) / det
+        c2 = (svt * suu - sut * suv) / det
+        if c1 >= 0.0 and c2 >= 0.0 and c1 + c2 <= top:
+            cands[m, 0] = c1
+            cands[m, 1] = c2
+            m += 1
+    if suu > 0.0:  # edge c2 = 0
+        cands[m, 0] = min(max(sut / suu, 0.0), top)
+        m += 1
+    if svv > 0.0:  # edge c1 = 0
+        cands[m, 1] = min(max(svt / svv, 0.0), top)
+        m += 1
+    # edge c1 + c2 = top: c1 = top - c2
+    curv = suu - 2.0 * suv + svv
+    if curv > 0.0:
+        c2 = ((svt - sut) - top * (suv - suu)) / curv
+        c2 = min(max(c2, 0.0), top)
+        cands[m, 0] = top - c2
+        cands[m, 1] = c2
+        m += 1
+    cands[m, 0] = top  # corners
+    m += 1
+    cands[m, 1] = top
+    m += 1
+    for k in range(m):
+        c1 = cands[k, 0]
+        c2 = cands[k, 1]
+        cost = stt - 2.0 * (c1 * sut + c2 * svt) + c1 * c1 * suu + 2.0 * c1 * c2 * suv \
+            + c2 * c2 * svv
+        if cost < best:
+            best = cost
+            b1 = c1
+            b2 = c2
+    return best, b1, b2
+
+
+@njit(cache=True, nogil=True)
+def _grid_search(xb, yb, sw, s0_grid, b_grid, top):  # pragma: no cover - compiled
+    """For each (s0, B) of the grid the linear parameters c1 = mu_s A and c2 = mu_s (1 - A) are
+    solved exactly (variable projection): half the cost and (mu_s, A) at every grid point,
+    shape (len(s0_grid), len(b_grid), 3)."""
+    m = xb.size
+    ns = s0_grid.size
+    nb = b_grid.size
+    rise = np.empty((ns, m))
+    fall = np.empty((nb, m))
+    for i in range(m):
+        s = max(xb[i], 0.0)
+        for a in range(ns):
+            rise[a, i] = -np.expm1(-s / s0_grid[a]) * sw[i]
+        for b in range(nb):
+            fall[b, i] = np.exp(-b_grid[b] * s)
+    t = yb * sw
+    stt = 0.0
+    for i in range(m):
+        stt += t[i] * t[i]
+    out = np.empty((ns, nb, 3))
+    for a in range(ns):
+        suu = 0.0
+        sut = 0.0
+        for i in range(m):
+            u = rise[a, i]
+            suu += u * u
+            sut += u * t[i]
+        for b in range(nb):
+            suv = 0.0
+            svv = 0.0
+            svt = 0.0
+            for i in range(m):
+                u = rise[a, i]
+                v = u * fall[b, i]
+                suv += u * v
+                svv += v * v
+                svt += v * t[i]
+            cost, c1, c2 = _linear_part(suu, suv, svv, sut, svt, stt, top)
+            mu_s = c1 + c2
+            out[a, b, 0] = 0.5 * cost
+            out[a, b, 1] = mu_s
+            out[a, b, 2] = c1 / mu_s if mu_s > 0 else 0.5
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _projected(xb, yb, sw, s0, b_rate, top):  # pragma: no cover - compiled
+    """Half the cost of the best linear pair at (s0, B), and that pair as (mu_s, A)."""
+    suu = 0.0
+    suv = 0.0
+    svv = 0.0
+    sut = 0.0
+    svt = 0.0
+    stt = 0.0
+    for i in range(xb.size):
+        s = max(xb[i], 0.0)
+        u = -np.expm1(-s / s0) * sw[i]
+        v = u * np.exp(-b_rate * s)
+        t = yb[i] * sw[i]
+        suu += u * u
+        suv += u * v
+        svv += v * v
+        sut += u * t
+        svt += v * t
+        stt += t * t
+    cost, c1, c2 = _linear_part(suu, suv, svv, sut, svt, stt, top)
+    mu_s = c1 + c2
+    return 0.5 * cost, mu_s, (c1 / mu_s if mu_s > 0 else 0.5)
+
+
+@njit(cache=True, nogil=True)
+def _pattern_search(xb, yb, sw, s0, b_rate, lo, hi, step, top, h_min):  # pragma: no cover
+    """Local minimum of the projected cost over (log s0, log B) from a start: a pattern
+    search (8 directions; a successful direction is followed with doubled steps; the step is
+    halved when no direction improves, down to ``h_min``). B is kept >= 1e-9 (B = 0 and
+    B = 1e-9 give the same curve to 1e-8). Returns (cost, mu_s, s0, A, B)."""
+    b_min = 1e-9
+    u_lo, u_hi = np.log(lo[1]), np.log(hi[1])
+    w_lo, w_hi = np.log(b_min), np.log(hi[3])
+    u = min(max(np.log(s0), u_lo), u_hi)
+    w = min(max(np.log(max(b_rate, b_min)), w_lo), w_hi)
+    f, mu_s, a_r = _projected(xb, yb, sw, np.exp(u), np.exp(w), top)
+    dirs = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0],
+                     [0.7071, 0.7071], [-0.7071, -0.7071], [0.7071, -0.7071], [-0.7071, 0.7071]])
+    h = step
+    while h > h_min:
+        moved = False
+        for k in range(8):
+            du = dirs[k, 0] * h
+            dw = dirs[k, 1] * h
+            u2 = min(max(u + du, u_lo), u_hi)
+            w2 = min(max(w + dw, w_lo), w_hi)
+            f2, m2, a2 = _projected(xb, yb, sw, np.exp(u2), np.exp(w2), top)
+            if f2 < f:
+                u, w, f, mu_s, a_r = u2, w2, f2, m2, a2
+                moved = True
+                while True:  # keep going that way, faster
+                    du *= 2.0
+                    dw *= 2.0
+                    u2 = min(max(u + du, u_lo), u_hi)
+                    w2 = min(max(w + dw, w_lo), w_hi)
+                    f2, m2, a2 = _projected(xb, yb, sw, np.exp(u2), np.exp(w2), top)
+                    if not f2 < f:
+                        break
+                    u, w, f, mu_s, a_r = u2, w2, f2, m2, a2
+                break
+        if not moved:
+            h *= 0.5
+    return np.array([f, mu_s, np.exp(u), a_r, np.exp(w)])
+
+
+def _grid_best(xb, yb, sw, s0_grid, b_grid, top, count=1):
+    """The ``count`` best local minima of the grid (each better than its 8 neighbours), as
+    rows (cost, mu_s, s0, A, B), best first."""
+    g = _grid_search(xb, yb, sw, s0_grid, b_grid, top)
+    cost = g[:, :, 0]
+    if count == 1:
+        a, b = np.unravel_index(int(np.argmin(cost)), cost.shape)
+        picks = [(a, b)]
+    else:
+        pad = np.pad(cost, 1, constant_values=np.inf)
+        lower = np.ones(cost.shape, bool)
+        for da in (-1, 0, 1):
+            for db in (-1, 0, 1):
+                if da or db:
+                    lower &= cost <= pad[1 + da:1 + da + cost.shape[0],
+                                         1 + db:1 + db + cost.shape[1]]
+        idx = np.flatnonzero(lower.ravel())
+        idx = idx[np.argsort(cost.ravel()[idx], kind="stable")][:count]
+        picks = [np.unravel_index(int(k), cost.shape) for k in idx]
+    return [np.array([g[a, b, 0], g[a, b, 1], s0_grid[a], g[a, b, 2], b_grid[b]])
+            for a, b in picks]
+
+
+def _global_start(xb, yb, sw, lo_b, hi_b, candidates: int = GLOBAL_CANDIDATES,
+                  grid: int = GLOBAL_GRID, h_min: float = 1e-6):
+    """Parameters (mu_s, s0, A, B) near the global minimum of the weighted least squares.
+
+    For fixed s0 and B the law is linear in c1 = mu_s A and c2 = mu_s (1 - A) (c1, c2 >= 0,
+    c1 + c2 <= mu_s's bound), so the search runs over (s0, B) only with the linear pair solved
+    exactly (variable projection): a ``grid`` x ``grid`` log grid over the whole box, then a
+    compiled pattern search from each of its ``candidates`` best local minima (down to steps
+    of ``h_min`` in log s0 and log B); the best point found."""
+    s0_grid = np.geomspace(lo_b[1], hi_b[1], grid)
+    b_grid = np.r_[0.0, np.geomspace(1e-3, hi_b[3], grid - 1)]
+    starts = _grid_best(xb, yb, sw, s0_grid, b_grid, hi_b[0], candidates)
+    step = float(np.log(s0_grid[1] / s0_grid[0]))
+    found = [_pattern_search(xb, yb, sw, row[2], row[4], lo_b, hi_b, step, hi_b[0], h_min)
+             for row in starts]
+    best = min(found, key=lambda row: row[0])
+    return best[1:]
 
 
 def _fit_one(stats, n_eff, slip_kind):
@@ -170,10 +448,7 @@ def _fit_one(stats, n_eff, slip_kind):
     xf = sx_f[okf] / cnt_f[okf]
     cf = cum[okf]
     lo_x = float(xf[np.searchsorted(cf, 0.01)])
-    med = float(xf[min(np.searchsorted(cf, 0.5), xf.size - 1)])
     hi_x = float(xf[min(np.searchsorted(cf, 0.99), xf.size - 1)])
-    peak_i = int(np.argmax(yb))
-    peak = float(yb[peak_i])
     s0_hi = 5.0 if slip_kind == "absolute" else 1.0
     b_hi = 50.0 if slip_kind == "absolute" else 500.0
     lo_b = np.array([1e-4, 1e-5, 0.0, 0.0])
@@ -182,18 +457,10 @@ def _fit_one(stats, n_eff, slip_kind):
     def resid(p):
         return sw * (falling_adhesion(xb, *p) - yb)
 
-    best = None
-    s_peak = max(float(xb[peak_i]), 1e-4)
-    for s0 in (0.2 * s_peak, 0.05 * s_peak, 0.5 * s_peak):
-        for a_r, b in ((0.5, 1.0 / max(med, 1e-4)), (0.8, 0.3 / max(med, 1e-4)),
-                       (0.2, 3.0 / max(med, 1e-4))):
-            p0 = np.clip([1.2 * peak, s0, a_r, b], lo_b + 1e-9, hi_b - 1e-9)
-            try:
-                res = optimize.least_squares(resid, p0, bounds=(lo_b, hi_b), x_scale="jac")
-            except ValueError:
-                continue
-            if best is None or res.cost < best.cost:
-                best = res
+    x0 = _global_start(np.ascontiguousarray(xb), np.ascontiguousarray(yb),
+                       np.ascontiguousarray(sw), lo_b, hi_b)
+    best = optimize.least_squares(resid, np.clip(x0, lo_b + 1e-12, hi_b - 1e-12),
+                                  bounds=(lo_b, hi_b), x_scale="jac")
     p = best.x
     # goodness of fit on the fine bins: between-bin residuals + within-bin spread of mu
     yf = sy_f[okf] / cnt_f[okf]
@@ -216,7 +483,7 @@ def _fit_one(stats, n_eff, slip_kind):
 
 
 def fit_adhesion_curves(ident, *, slip: str = "absolute", speed_bands=None, phase: str = "all",
-                        min_samples: int = 200):
+                        min_samples: int = 200, per_band: bool = True):
     """Fit mu(slip) per speed band (and over all speeds) to an identification's samples.
 
     Parameters
@@ -233,6 +500,8 @@ def fit_adhesion_curves(ident, *, slip: str = "absolute", speed_bands=None, phas
         Samples used (windows of growing or falling slip, or all).
     min_samples : int, default 200
         Smallest number of samples a band needs.
+    per_band : bool, default True
+        Fit each speed band; ``False``: only the curve over all speeds (``bands`` empty).
 
     Returns
     -------
@@ -246,31 +515,24 @@ def fit_adhesion_curves(ident, *, slip: str = "absolute", speed_bands=None, phas
     """
     check_choice(slip, "slip", ("absolute", "relative"))
     check_choice(phase, "phase", ("all", "loss", "recovery"))
-    edges = np.asarray([0.0, 10.0, 20.0, 30.0, 40.0] if speed_bands is None else speed_bands,
-                       dtype=float)
-    if edges.size < 2 or np.any(np.diff(edges) <= 0):
-        raise ValueError("speed_bands must be at least 2 strictly increasing speeds [m/s]")
-    x = np.ascontiguousarray(ident.slip if slip == "absolute" else ident.relative_slip,
-                             dtype=float)
-    mu = np.ascontiguousarray(ident.mu, dtype=float)
-    mask = ident.use & np.isfinite(x) & np.isfinite(mu) & (x >= 0)
-    if phase == "loss":
-        mask &= ident.phase == 1
-    elif phase == "recovery":
-        mask &= ident.phase == -1
-    speed = np.ascontiguousarray(ident.speed, dtype=float)
-    stats = _band_stats(speed, x, mu, np.ascontiguousarray(mask), edges)
+    edges, all_stats, all_rows, all_vsum = band_statistics(ident, slip, speed_bands)
+    q = {"all": 0, "loss": 1, "recovery": 2}[phase]
+    stats, rows, vsum = all_stats[q], all_rows[q], all_vsum[q]
     total = int(stats[-1, 0].sum())
     if total < min_samples:
         raise ValueError(
             f"only {total} usable samples with slip >= 0 (phase {phase!r}) within the speed "
             f"bands; at least {min_samples} are needed to fit a curve"
         )
-    dt = float(np.median(np.diff(ident.time))) if ident.time.size > 1 else 1.0
+    cache = getattr(ident, "_cache", None)
+    if cache is not None and "period" in cache:
+        dt = cache["period"]
+    else:
+        dt = float(np.median(np.diff(ident.time))) if ident.time.size > 1 else 1.0
+        if cache is not None:
+            cache["period"] = dt
     fc = float(ident.settings.get("wheel_cutoff_Hz", 2.0))
     corr = max(1.0 / (2.0 * fc) / dt, 1.0)  # samples per correlation time
-    rows = np.flatnonzero(mask.any(axis=1))
-    vm_all = float(speed[rows].mean()) if rows.size else float("nan")
 
     def fit(st, band, vmean):
         nb = int(st[0].sum())
@@ -280,13 +542,15 @@ def fit_adhesion_curves(ident, *, slip: str = "absolute", speed_bands=None, phas
             n_samples=nb, r_squared=r2, rmse=rmse, speed_mean=vmean,
         )
 
+    def mean_speed(b):
+        return float(vsum[b] / rows[b]) if rows[b] > 0 else float("nan")
+
     bands = []
-    for b, (lo, hi) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
-        if stats[b, 0].sum() >= min_samples:
-            sel = rows[(speed[rows] >= lo) & (speed[rows] < hi)]
-            vmean = float(speed[sel].mean()) if sel.size else float("nan")
-            bands.append(fit(stats[b], (float(lo), float(hi)), vmean))
-    overall = fit(stats[-1], (float(edges[0]), float(edges[-1])), vm_all)
+    if per_band:
+        for b, (lo, hi) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
+            if stats[b, 0].sum() >= min_samples:
+                bands.append(fit(stats[b], (float(lo), float(hi)), mean_speed(b)))
+    overall = fit(stats[-1], (float(edges[0]), float(edges[-1])), mean_speed(-1))
     return AdhesionLaw(
         slip_kind=slip, bands=tuple(bands), overall=overall, phase=phase,
         provenance={
@@ -353,6 +617,16 @@ class AdhesionLaw:
         v = np.asarray(speed, dtype=float)
         slip = xi * np.abs(v) if self.slip_kind == "absolute" else xi
         return self.of_slip(slip, v)
+
+    def braking_adhesion(self, label: str | None = None):
+        """This law as the braking simulator's adhesion model: a
+        :class:`railadhesion.braking.adhesion.CallableAdhesion` calling ``law(creep, speed)``
+        (``simulate(vehicle, law.braking_adhesion(), v0, ...)``)."""
+        from railadhesion.braking.adhesion import CallableAdhesion
+
+        where = self.provenance.get("log", "") if self.provenance else ""
+        return CallableAdhesion(self, label=label or f"identified law ({self.slip_kind} slip"
+                                + (f", from {where})" if where else ")"))
 
     def to_frame(self):
         """One row per curve (bands, then ``overall``): band, parameters, errors, fit quality."""

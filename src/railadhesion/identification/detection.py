@@ -27,7 +27,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import optimize, stats
+from scipy import optimize
 
 from railadhesion._validate import check_choice, check_positive, check_range
 
@@ -149,6 +149,8 @@ def _profile_interval(xi, y, g, mu_hat, ka_hat, ssr_min, dof):
     """
     # floor: exact (noise-free) data still get a finite, tiny interval
     s2 = max(ssr_min / dof, (1e-6 * float(np.max(y))) ** 2, 1e-300)
+    from scipy import stats  # imported when needed (scipy.stats takes 0.5 s to import)
+
     limit = ssr_min + s2 * stats.chi2.ppf(_LEVEL, 1)
 
     def profile(mu):
@@ -307,6 +309,8 @@ def detect_low_adhesion(
         )
         mu_hat = fit.params["mu0"]
         stderr = float(fit.stderr.get("mu0", math.inf))
+        from scipy import stats
+
         z = stats.norm.ppf(0.5 + _LEVEL / 2)
         lo = max(mu_hat - z * stderr, 0.0) if math.isfinite(stderr) else 0.0
         hi = mu_hat + z * stderr if math.isfinite(stderr) else math.inf

@@ -1,10 +1,17 @@
 """Figures of an identification, after seed 002 (Allotta, Malvezzi, Toni) Figs. 4 and 6-10.
 
-Each function returns a matplotlib Figure. Long logs are thinned for drawing (at most
-``max_points`` points per line); the statistics are always computed on every sample.
+Each function returns a matplotlib Figure. Long logs are thinned for drawing; the statistics
+are always computed on every sample. Time histories are drawn as their envelope: the log is
+cut into ``max_points / 2`` buckets of consecutive samples and each bucket is drawn as a
+vertical stroke from its smallest to its largest value (NaN ignored), which keeps every peak
+(a WSP cycle, a spike) that plain decimation would drop, at a few thousand points per line.
+Scatter plots of mu against slip take every k-th sample row so that at most ``max_points``
+points are drawn.
 """
 
 from __future__ import annotations
+
+import warnings
 
 import numpy as np
 
@@ -21,23 +28,56 @@ __all__ = [
 ]
 
 
-def _thin(n, max_points):
-    step = max(1, int(np.ceil(n / max_points)))
-    return slice(None, None, step)
+def _envelope(t, y, max_points):
+    """(x, y) to draw ``y(t)`` with at most ``max_points`` points: per bucket of consecutive
+    samples its smallest and largest value at the bucket's middle time (``y`` as it is when
+    short enough)."""
+    t = np.asarray(t)
+    y = np.asarray(y, dtype=float)
+    n = t.size
+    buckets = max(max_points // 2, 1)
+    if n <= max_points or n < 2 * buckets:
+        return t, y
+    starts = np.linspace(0, n, buckets + 1).astype(np.int64)[:-1]
+    stops = np.r_[starts[1:], n]
+    mid = 0.5 * (t[starts] + t[stops - 1])
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        lo = np.fmin.reduceat(y, starts)
+        hi = np.fmax.reduceat(y, starts)
+    return np.repeat(mid, 2), np.column_stack([lo, hi]).ravel()
 
 
-def plot_log(ident, max_points: int = 20000):
+def _sample_rows(ident, phase, max_points):
+    """(speed, slip, relative slip, mu, number of samples) of the usable samples of a phase,
+    every k-th row taken so that at most about ``max_points`` are returned."""
+    mask = ident.use
+    if phase == "loss":
+        mask = mask & (ident.phase == 1)
+    elif phase == "recovery":
+        mask = mask & (ident.phase == -1)
+    total = int(np.count_nonzero(mask))
+    step = max(1, int(np.ceil(total / max_points)))
+    rows, axles = np.nonzero(mask[::step])
+    rows = rows * step
+    return (ident.speed[rows], ident.slip[rows, axles], ident.relative_slip[rows, axles],
+            ident.mu[rows, axles], total)
+
+
+def plot_log(ident, max_points: int = 2000):
     """Train speed, wheel peripheral speeds R omega and brake pressures over time (Fig. 4)."""
     import matplotlib.pyplot as plt
 
     log = ident.log
-    k = _thin(log.n_samples, max_points)
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
-    ax1.plot(log.time[k], log.train_speed[k], color="k", lw=1.2, label="train speed")
+    ax1.plot(*_envelope(log.time, log.train_speed, max_points), color="k", lw=1.2,
+             label="train speed")
     r = ident.vehicle.wheel_radius
     for i in range(log.n_axles):
-        ax1.plot(log.time[k], r * log.wheel_speed[k, i], lw=0.7, label=f"axle {i + 1} R omega")
-        ax2.plot(log.time[k], log.brake_pressure[k, i] / BAR, lw=0.8, label=f"axle {i + 1}")
+        ax1.plot(*_envelope(log.time, r * log.wheel_speed[:, i], max_points), lw=0.7,
+                 label=f"axle {i + 1} R omega")
+        ax2.plot(*_envelope(log.time, log.brake_pressure[:, i] / BAR, max_points), lw=0.8,
+                 label=f"axle {i + 1}")
     ax1.set_ylabel("speed [m/s]")
     ax1.legend(fontsize=7, ncol=2)
     ax2.set_ylabel("brake-cylinder pressure [bar]")
@@ -50,17 +90,17 @@ def plot_log(ident, max_points: int = 20000):
     return fig
 
 
-def plot_brake_coefficient(ident, max_points: int = 20000):
+def plot_brake_coefficient(ident, max_points: int = 2000):
     """Brake coefficient c per sample (eq. 14) and its mean over the window (Fig. 6)."""
     import matplotlib.pyplot as plt
 
     b = ident.brake
-    k = _thin(ident.time.size, max_points)
     fig, ax = plt.subplots(figsize=(8, 4))
     c = b.per_sample * BAR
-    ax.plot(ident.time[k], c[k], lw=0.7, color="0.5", label="c evaluated (eq. 14)")
+    ax.plot(*_envelope(ident.time, c, max_points), lw=0.7, color="0.5",
+            label="c evaluated (eq. 14)")
     inw = np.where(b.in_window, c, np.nan)
-    ax.plot(ident.time[k], inw[k], lw=0.9, color="C0", label="in the window")
+    ax.plot(*_envelope(ident.time, inw, max_points), lw=0.9, color="C0", label="in the window")
     ax.axhline(b.mean * BAR, color="C3", lw=1.5,
                label=f"mean {b.mean * BAR:.0f} N m/bar (sd {b.std * BAR:.0f})")
     finite = c[b.in_window]
@@ -77,23 +117,28 @@ def plot_brake_coefficient(ident, max_points: int = 20000):
     return fig
 
 
-def plot_slip_and_adhesion(ident, axle: int = 1, max_points: int = 20000):
+def plot_slip_and_adhesion(ident, axle: int = 1, max_points: int = 2000):
     """Absolute slip and adhesion coefficient of one axle over time (Fig. 7)."""
     import matplotlib.pyplot as plt
 
     i = int(axle) - 1
     if not 0 <= i < ident.n_axles:
         raise ValueError(f"axle must be in [1, {ident.n_axles}], got {axle}")
-    k = _thin(ident.time.size, max_points)
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 5), sharex=True)
-    ax1.plot(ident.time[k], ident.slip[k, i], lw=0.8)
+    ax1.plot(*_envelope(ident.time, ident.slip[:, i], max_points), lw=0.8)
     ax1.set_ylabel("absolute slip [m/s]")
     mu = np.where(ident.use[:, i], ident.mu[:, i], np.nan)
-    ax2.plot(ident.time[k], mu[k], lw=0.8, color="C1")
-    for sign, colour in ((1, "C3"), (-1, "C2")):
-        shade = ident.phase[:, i] == sign
-        ax2.fill_between(ident.time[k], 0, 1, where=shade[k], color=colour, alpha=0.12,
-                         transform=ax2.get_xaxis_transform(), lw=0)
+    ax2.plot(*_envelope(ident.time, mu, max_points), lw=0.8, color="C1")
+    w = ident.windows
+    if len(w):
+        w = w[w["axle"] == axle]
+        for phase, colour in (("loss", "C3"), ("recovery", "C2")):
+            sel = w[w["phase"] == phase]
+            spans = list(zip(sel["start_time"], sel["end_time"] - sel["start_time"],
+                             strict=True))
+            if spans:
+                ax2.broken_barh(spans, (0, 1), facecolors=colour, alpha=0.12, lw=0,
+                                transform=ax2.get_xaxis_transform())
     ax2.set_ylabel("adhesion mu [-]")
     ax2.set_xlabel("time [s] (shaded: loss red, recovery green)")
     for ax in (ax1, ax2):
@@ -109,10 +154,9 @@ def plot_adhesion_vs_slip(ident, law=None, max_points: int = 30000):
 
     fig, ax = plt.subplots(figsize=(7, 5))
     for phase, colour in (("loss", "C3"), ("recovery", "C2")):
-        v, dv, _, mu, _ = ident.samples(phase)
-        k = _thin(dv.size, max_points)
-        ax.plot(dv[k], mu[k], ".", ms=1.5, color=colour, alpha=0.4,
-                label=f"{phase} of adhesion ({dv.size} samples)")
+        _, dv, _, mu, total = _sample_rows(ident, phase, max_points)
+        ax.plot(dv, mu, ".", ms=1.5, color=colour, alpha=0.4,
+                label=f"{phase} of adhesion ({total} samples)")
     if law is not None:
         c = law.overall
         s = np.linspace(0.0, max(c.slip_range[1], 1e-3), 300)
@@ -134,9 +178,8 @@ def plot_relative_slip(ident, law=None, max_points: int = 30000):
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 5))
-    v, _, rel, mu, _ = ident.samples()
-    k = _thin(rel.size, max_points)
-    ax.plot(rel[k], mu[k], ".", ms=1.2, color="0.6", alpha=0.4, label="samples")
+    _, _, rel, mu, _ = _sample_rows(ident, "all", max_points)
+    ax.plot(rel, mu, ".", ms=1.2, color="0.6", alpha=0.4, label="samples")
     if law is not None:
         for b in law.bands:
             s = np.linspace(0.0, max(b.slip_range[1], 1e-4), 300)

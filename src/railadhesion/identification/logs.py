@@ -1,4 +1,4 @@
-"""Braking-test logs: reader with defect reports (format: ``docs/braking-logs.md``).
+"""Braking-test logs: reader with defect reports (format: ``docs/braking-log.md``).
 
 A log holds, per sample, the time [s], the train speed [m/s] and, per axle ``i = 1..N``, the
 wheelset angular speed ``wheel_speed_i`` [rad/s] and the brake-cylinder pressure
@@ -225,12 +225,44 @@ def braking_log_from_frame(
     ValueError
         No ``time`` or ``train_speed`` column, no axle channel, fewer than 3 usable rows.
     """
+    names = [str(c).strip() for c in frame.columns]
+    columns = {}
+    for name, col in zip(names, frame.columns, strict=True):
+        columns.setdefault(name, col)
+    return _log_from_columns(
+        names, lambda name: frame[columns[name]], len(frame), source=source,
+        max_fill=max_fill, gap_factor=gap_factor, stuck_time=stuck_time,
+        stuck_pressure_time=stuck_pressure_time, warn=warn, stacklevel=4,
+    )
+
+
+def _as_float(col, name, rows, issues):
+    """A column as float64 (a view when it already is): numbers as they are; anything else
+    converted, with the cells that are not numbers reported as unparseable."""
     import pandas as pd
 
+    if isinstance(col, np.ndarray) and col.dtype.kind in "fiu":
+        return col.astype(float, copy=False)
+    if not isinstance(col, pd.Series):
+        col = pd.Series(col)
+    if col.dtype.kind in "fiu":
+        return col.to_numpy(dtype=float)
+    num = pd.to_numeric(col, errors="coerce")
+    arr = num.to_numpy(dtype=float)
+    bad = np.flatnonzero(np.isnan(arr) & col.notna().to_numpy()
+                         & (col.astype(str).str.strip() != "").to_numpy())
+    if bad.size:
+        issues.append(LogIssue("unparseable", name, rows[bad], "read as missing"))
+    return arr
+
+
+def _log_from_columns(
+    cols, get, n_rows, *, source="", max_fill=0.05, gap_factor=3.0, stuck_time=1.0,
+    stuck_pressure_time=5.0, warn=True, stacklevel=3,
+) -> BrakingLog:
+    """The reader's rules (module notes) on columns: ``cols`` the column names (stripped),
+    ``get(name)`` one column (NumPy array or pandas Series), ``n_rows`` the number of rows."""
     where = f"{source}: " if source else ""
-    cols = [str(c).strip() for c in frame.columns]
-    frame = frame.copy()
-    frame.columns = cols
     for req in ("time", "train_speed"):
         if req not in cols:
             raise ValueError(f"{where}the log has no {req!r} column (columns: {cols[:12]})")
@@ -246,55 +278,64 @@ def braking_log_from_frame(
     if extra:
         issues.append(LogIssue("unknown-columns", ", ".join(extra), np.zeros(0, int),
                                "ignored"))  # fmt: skip
-    rows = np.arange(len(frame))
+    rows = np.arange(n_rows)
     names = ["time", "train_speed"]
     names += [wheels.get(i, f"wheel_speed_{i}") for i in range(1, n_ax + 1)]
     names += [pressures.get(i, f"brake_pressure_{i}") for i in range(1, n_ax + 1)]
+    present = set(cols)
     data = {}
     for name in names:
-        if name not in frame.columns:
-            data[name] = np.full(len(frame), np.nan)
+        if name not in present:
+            data[name] = None
             continue
-        col = frame[name]
-        if col.dtype.kind in "fiu":
-            arr = col.to_numpy(dtype=float)
-        else:
-            num = pd.to_numeric(col, errors="coerce")
-            arr = num.to_numpy(dtype=float)
-            bad = np.flatnonzero(np.isnan(arr) & col.notna().to_numpy()
-                                 & (col.astype(str).str.strip() != "").to_numpy())
-            if bad.size:
-                issues.append(LogIssue("unparseable", name, rows[bad], "read as missing"))
-        data[name] = arr
+        data[name] = _as_float(get(name), name, rows, issues)
     t = data["time"]
     # -- missing time: the row cannot be placed
     bad_t = ~np.isfinite(t)
-    if bad_t.any():
+    any_bad_t = bool(bad_t.any())
+    if any_bad_t:
         issues.append(LogIssue("missing-time", "time", rows[bad_t], "rows removed"))
-    keep = ~bad_t
+        keep = ~bad_t
+        kept_rows = rows[keep]
+        tk = t[keep]
+    else:
+        kept_rows = rows
+        tk = t
     # -- unsorted: sort by time (stable)
-    tk = t[keep]
-    order = np.argsort(tk, kind="stable")
-    if np.any(np.diff(tk) < 0):
-        back = np.flatnonzero(np.diff(tk) < 0) + 1
-        issues.append(LogIssue("unsorted", "time", rows[keep][back],
+    steps = np.diff(tk)
+    unsorted = bool(np.any(steps < 0))
+    if unsorted:
+        back = np.flatnonzero(steps < 0) + 1
+        issues.append(LogIssue("unsorted", "time", kept_rows[back],
                                "rows sorted by time"))  # fmt: skip
-    idx = np.flatnonzero(keep)[order]
-    ts = t[idx]
-    dup = np.concatenate(([False], np.diff(ts) == 0))
-    if dup.any():
+        idx = kept_rows[np.argsort(tk, kind="stable")]
+        ts = t[idx]
+        dup = np.concatenate(([False], np.diff(ts) == 0))
+    else:
+        idx = kept_rows
+        dup = np.concatenate(([False], steps == 0))
+    has_dup = bool(dup.any())
+    if has_dup:
         issues.append(LogIssue("duplicate-time", "time", rows[idx[dup]],
                                "first row kept, these rows removed"))  # fmt: skip
-    idx = idx[~dup]
+        idx = idx[~dup]
     if idx.size < 3:
         raise ValueError(f"{where}fewer than 3 rows with a valid time ({idx.size})")
-    t = t[idx]
-    src_rows = rows[idx]
+    identity = not (any_bad_t or unsorted or has_dup)  # every row, in the file's order
+
+    def take(x):
+        return x if identity else x[idx]
+
+    t = np.array(take(t), dtype=float)  # an array of its own (not a view of the file's)
+    src_rows = rows if identity else rows[idx]
     n = t.size
-    valid = np.ones((n, n_ax), dtype=bool)
+    valid = np.ones((n_ax, n), dtype=bool).T
     channels = {}
     for name in names[1:]:
-        x = data[name][idx]
+        if data[name] is None:
+            channels[name] = None
+            continue
+        x = take(data[name])
         ok = np.isfinite(x)
         if not ok.any():
             channels[name] = None
@@ -322,7 +363,7 @@ def braking_log_from_frame(
         channels[name] = x
     if channels["train_speed"] is None:
         raise ValueError(f"{where}the train_speed column holds no numeric value")
-    v = channels["train_speed"]
+    v = np.array(channels["train_speed"], dtype=float)  # its own array
     # -- time gaps: split into segments
     dt = np.diff(t)
     med = float(np.median(dt))
@@ -336,18 +377,18 @@ def braking_log_from_frame(
             f"(longest {float(dt[g].max()):.4g} s): log split into {int(segment[-1]) + 1} "
             "segments, processed separately",
         ))
-    # -- missing channels, substitutes for eq. 14
-    wheel = np.empty((n, n_ax))
-    press = np.empty((n, n_ax))
+    # -- missing channels, substitutes for eq. 14 (axle columns contiguous in memory)
+    wheel = np.empty((n_ax, n)).T
+    press = np.empty((n_ax, n)).T
     substituted = np.zeros(n_ax, bool)
     for kind, arr, unit in (("wheel_speed", wheel, 1.0), ("brake_pressure", press, BAR)):
-        present = [i for i in range(n_ax) if channels[f"{kind}_{i + 1}"] is not None]
+        present_ax = [i for i in range(n_ax) if channels[f"{kind}_{i + 1}"] is not None]
         for i in range(n_ax):
             x = channels[f"{kind}_{i + 1}"]
             if x is None:
-                if not present:
+                if not present_ax:
                     raise ValueError(f"{where}no {kind}_i channel holds a numeric value")
-                others = [f"{kind}_{j + 1}" for j in present]
+                others = [f"{kind}_{j + 1}" for j in present_ax]
                 arr[:, i] = np.mean([channels[o] for o in others], axis=0) * unit
                 valid[:, i] = False
                 substituted[i] = True
@@ -357,7 +398,7 @@ def braking_log_from_frame(
                     "substituted for the brake coefficient (eq. 14)",
                 ))
             else:
-                arr[:, i] = x * unit
+                np.multiply(x, unit, out=arr[:, i])
     # -- stuck channels
     min_w = max(int(round(stuck_time / med)), 3)
     min_p = max(int(round(stuck_pressure_time / med)), 3)
@@ -376,11 +417,13 @@ def braking_log_from_frame(
                     f"samples invalid for axle {i + 1}",
                 ))
         if channels[f"brake_pressure_{i + 1}"] is not None and n_ax > 1:
-            others = np.delete(press, i, axis=1).mean(axis=1)
+            runs = _constant_runs(press[:, i], min_p)
             flagged = []
-            for a, b in _constant_runs(press[:, i], min_p):
-                if np.ptp(others[a:b]) > 0.5 * BAR:
-                    flagged.append(np.arange(a, b))
+            if runs.size:  # the other axles' mean pressure, over the constant runs only
+                others = [j for j in range(n_ax) if j != i]
+                for a, b in runs:
+                    if np.ptp(press[a:b, others].mean(axis=1)) > 0.5 * BAR:
+                        flagged.append(np.arange(a, b))
             if flagged:
                 r = np.concatenate(flagged)
                 valid[r, i] = False
@@ -397,13 +440,39 @@ def braking_log_from_frame(
     if warn and issues:
         warnings.warn(
             f"{where}{len(issues)} defect(s) in the braking log:\n{log.report()}",
-            BrakingLogWarning, stacklevel=3,
+            BrakingLogWarning, stacklevel=stacklevel,
         )
     return log
 
 
+def _read_parquet(path: Path):
+    """Column names and a getter from a Parquet file (pyarrow: numbers straight to NumPy)."""
+    try:
+        import pyarrow.parquet as pq
+    except ImportError:
+        raise ValueError(
+            f"{path}: reading Parquet needs pyarrow (pip install pyarrow), or convert the log "
+            "to CSV"
+        ) from None
+    table = pq.read_table(path)
+    names = [str(c).strip() for c in table.column_names]
+    index = {}
+    for k, name in enumerate(names):
+        index.setdefault(name, k)
+
+    def get(name):
+        col = table.column(index[name])
+        import pyarrow as pa
+
+        if pa.types.is_floating(col.type) or pa.types.is_integer(col.type):
+            return col.to_numpy()  # nulls become NaN
+        return col.to_pandas()
+
+    return names, get, table.num_rows
+
+
 def read_braking_log(path, **kwargs) -> BrakingLog:
-    """Read a braking-test log from CSV or Parquet (format: ``docs/braking-logs.md``).
+    """Read a braking-test log from CSV or Parquet (format: ``docs/braking-log.md``).
 
     Parameters
     ----------
@@ -423,7 +492,7 @@ def read_braking_log(path, **kwargs) -> BrakingLog:
     Raises
     ------
     ValueError
-        Unreadable or malformed file (the message names it).
+        Unreadable or malformed file (the message names it), Parquet without pyarrow.
     """
     import pandas as pd
 
@@ -432,12 +501,16 @@ def read_braking_log(path, **kwargs) -> BrakingLog:
         raise ValueError(f"{p}: no such file")
     try:
         if p.suffix.lower() in (".parquet", ".pq"):
-            frame = pd.read_parquet(p)
-        else:
-            try:
-                frame = pd.read_csv(p, engine="pyarrow", comment=None)
-            except Exception:  # noqa: BLE001 - pyarrow refuses some messy files: use the C engine
-                frame = pd.read_csv(p, skipinitialspace=True)
-    except (OSError, ValueError, pd.errors.ParserError) as exc:
+            names, get, n_rows = _read_parquet(p)
+            return _log_from_columns(names, get, n_rows, source=str(p), **kwargs)
+        try:
+            frame = pd.read_csv(p, engine="pyarrow", comment=None)
+        except Exception:  # noqa: BLE001 - pyarrow refuses some messy files: use the C engine
+            frame = pd.read_csv(p, skipinitialspace=True)
+    except (OSError, pd.errors.ParserError) as exc:
+        raise ValueError(f"{p}: cannot read the log: {exc}") from exc
+    except ValueError as exc:
+        if str(exc).startswith(str(p)):
+            raise
         raise ValueError(f"{p}: cannot read the log: {exc}") from exc
     return braking_log_from_frame(frame, source=str(p), **kwargs)

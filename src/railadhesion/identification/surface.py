@@ -28,32 +28,41 @@ def _edges(edges, name):
     return e
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _cell(x, edges):  # pragma: no cover - compiled
-    """Cell of x for increasing edges (-1 outside; the last edge belongs to the last cell)."""
+    """Cell of x for increasing edges (-1 outside; the last edge belongs to the last cell):
+    ``searchsorted(edges, x, "right") - 1``, found from the cell a uniform grid would give and
+    corrected against the edges (exact for any increasing edges)."""
     m = edges.size - 1
     if not (x >= edges[0] and x <= edges[m]):  # also False for NaN
         return -1
-    k = np.searchsorted(edges, x, side="right") - 1
-    return min(k, m - 1)
+    k = int((x - edges[0]) / (edges[m] - edges[0]) * m)
+    k = min(max(k, 0), m - 1)
+    while k > 0 and edges[k] > x:
+        k -= 1
+    while k < m - 1 and edges[k + 1] <= x:
+        k += 1
+    return k
 
 
-@njit(cache=True)
-def _accumulate(speed, slip, mu, use, phase, se, le):  # pragma: no cover - compiled
+@njit(cache=True, nogil=True)
+def _accumulate(speed, slip, mu, use, phase, se, le, cells):  # pragma: no cover - compiled
     """Counts, sums and sums of squared deviations of mu per (phase, speed, slip) cell.
 
     Phase 0 = all usable samples, 1 = loss windows (phase +1), 2 = recovery (phase -1).
     Two passes: the sums give the means, the second pass the squared deviations from them
-    (numerically safe).
+    (numerically safe); ``cells`` (integers, shape of ``mu``) keeps each sample's cell
+    between the passes.
     """
     n, na = mu.shape
     ns, nl = se.size - 1, le.size - 1
     counts = np.zeros((3, ns, nl), np.int64)
     sums = np.zeros((3, ns, nl))
     sq = np.zeros((3, ns, nl))
-    cells = np.full((n, na), -1, np.int64)
     for k in range(n):
         i = _cell(speed[k], se)
+        for a in range(na):
+            cells[k, a] = -1
         if i < 0:
             continue
         for a in range(na):
@@ -119,10 +128,13 @@ def adhesion_surface(ident, *, speed_edges=None, slip_edges=None, slip: str = "a
         slip_edges = np.linspace(0.0, 10.0, 41) if slip == "absolute" else np.linspace(0, 1, 41)
     le = _edges(slip_edges, "slip_edges")
     x = ident.slip if slip == "absolute" else ident.relative_slip
+    mu = np.asarray(ident.mu, dtype=float)
+    n_cells = (se.size - 1) * (le.size - 1)
+    cells = np.empty(mu.shape, np.int16 if n_cells < 2**15 else np.int64)
     counts, sums, sq = _accumulate(
-        np.ascontiguousarray(ident.speed, dtype=float), np.ascontiguousarray(x, dtype=float),
-        np.ascontiguousarray(ident.mu, dtype=float), np.ascontiguousarray(ident.use),
-        np.ascontiguousarray(ident.phase, dtype=np.int8), se, le,
+        np.asarray(ident.speed, dtype=float), np.asarray(x, dtype=float), mu,
+        np.asarray(ident.use, dtype=np.bool_), np.asarray(ident.phase, dtype=np.int8), se, le,
+        cells,
     )
     with np.errstate(invalid="ignore", divide="ignore"):
         means = np.where(counts > 0, sums / np.maximum(counts, 1), np.nan)
