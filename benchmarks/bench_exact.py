@@ -1,26 +1,95 @@
-"""Benchmark of the exact steady-rolling solver (``railadhesion.contact.exact_rolling``).
+"""Benchmark of the exact steady-rolling solver and of its table model.
 
 Run with ``PYTHONPATH=src python3 benchmarks/bench_exact.py`` (``--quick``: fewer repeats).
-Prints the wall-clock time per case (median of the repeats, after compilation) at 30 x 30 and
-60 x 60 elements, for CONTACT's ``fastsim`` example (a/b = 2, lateral creepage and spin,
-partial slip) and for a longitudinal creepage on a circular contact, plus the number of
-Gauss-Seidel sweeps. CONTACT (Fortran) needs about 26 ms and 0.6 s per case at these sizes
-(issue 12). Timings vary with the load of the machine: quote medians.
+Prints:
+
+* the exact solver's wall-clock time per case (median of the repeats, after compilation) at
+  30 x 30 and 60 x 60 elements, for CONTACT's ``fastsim`` example (a/b = 2, lateral creepage
+  and spin, partial slip) and for a longitudinal creepage on a circular contact, with
+  Coulomb friction and with falling friction (Polach's dry law at 30 m/s), plus the number
+  of Gauss-Seidel sweeps (and friction updates). CONTACT (Fortran) needs about 26 ms and
+  0.6 s per case at these sizes (issue 12);
+* the table model's cost per contact, vectorised over 200 000 contacts with spin, beside
+  the package's vectorised Polach on the same contacts in the same run (issue 12 target:
+  at most 10x Polach), with Coulomb friction, with falling friction, and at nu = 0.25.
+
+Timings vary with the load of the machine: quote medians and ratios, with ``uptime``.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import platform
 import statistics
 import time
 
+import numpy as np
+
 from railadhesion.contact.exact import exact_rolling
+from railadhesion.contact.table import exact_table_forces
+from railadhesion.models.polach import polach_forces
 
 CASES = {
     "fastsim example (a/b=2, eta+spin)": (0.0, -0.000625, 0.625, 82e3, 8e-3, 4e-3, 0.3),
     "circle, xi = 1e-3": (1e-3, 0.0, 0.0, 1e5, 5e-3, 5e-3, 0.3),
 }
+#: Polach's dry set (A = 0.4, B = 0.6 s/m) at 30 m/s
+FALLING = dict(speed=30.0, friction_ratio=0.4, friction_decay=0.6)
+
+
+def bench_solver(repeat: int) -> None:
+    exact_rolling(*CASES["circle, xi = 1e-3"], nx=8, ny=8)  # compile / load the cache
+    exact_rolling(*CASES["circle, xi = 1e-3"], nx=8, ny=8, **FALLING)
+    print(f"{'case':<36} {'friction':<9} {'grid':>7} {'median [s]':>11} {'min [s]':>9} "
+          f"{'sweeps':>7} {'updates':>8}")  # fmt: skip
+    for name, case in CASES.items():
+        for law_name, law in (("Coulomb", {}), ("falling", FALLING)):
+            for n in (30, 60):
+                times = []
+                for _ in range(repeat):
+                    t0 = time.perf_counter()
+                    r = exact_rolling(*case, nx=n, ny=n, **law)
+                    times.append(time.perf_counter() - t0)
+                print(
+                    f"{name:<36} {law_name:<9} {n:>3}x{n:<3} {statistics.median(times):>11.3f} "
+                    f"{min(times):>9.3f} {int(r.iterations):>7} {int(r.friction_iterations):>8}"
+                )
+
+
+def bench_table(repeat: int) -> None:
+    n = 200_000
+    rng = np.random.default_rng(0)
+    xs = rng.uniform(-3e-3, 3e-3, n)
+    ys = rng.uniform(-3e-3, 3e-3, n)
+    ps = rng.uniform(-1, 1, n)
+    fz, mu, v, a, b = 1e5, 0.3, 30.0, 5e-3, 6e-3
+
+    def best(f):
+        f()
+        out = []
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            f()
+            out.append(time.perf_counter() - t0)
+        return min(out)
+
+    rows = [
+        ("Coulomb",
+         lambda: exact_table_forces(xs, ys, ps, fz, a, b, mu),
+         lambda: polach_forces(xs, ys, ps, fz, v, a, b, mu0=mu)),
+        ("falling (A 0.4, B 0.6)",
+         lambda: exact_table_forces(xs, ys, ps, fz, a, b, mu, **FALLING),
+         lambda: polach_forces(xs, ys, ps, fz, v, a, b, mu0=mu, A=0.4, B=0.6)),
+        ("Coulomb, nu = 0.25",
+         lambda: exact_table_forces(xs, ys, ps, fz, a, b, mu, poisson=0.25),
+         lambda: polach_forces(xs, ys, ps, fz, v, a, b, mu0=mu, poisson=0.25)),
+    ]  # fmt: skip
+    print(f"\ntable model vs Polach, {n:,} contacts with spin (best of {repeat}):")
+    print(f"{'friction':<24} {'table [us]':>11} {'Polach [us]':>12} {'ratio':>7}")
+    for name, ft, fp in rows:
+        tt, tp = best(ft), best(fp)
+        print(f"{name:<24} {tt / n * 1e6:>11.3f} {tp / n * 1e6:>12.3f} {tt / tp:>7.1f}")
 
 
 def main(argv=None) -> None:
@@ -28,20 +97,10 @@ def main(argv=None) -> None:
     parser.add_argument("--quick", action="store_true", help="one repeat (smoke run)")
     args = parser.parse_args(argv)
     repeat = 1 if args.quick else 5
-    print(f"python {platform.python_version()}, {platform.machine()}")
-    exact_rolling(*CASES["circle, xi = 1e-3"], nx=8, ny=8)  # compile / load the cache
-    print(f"{'case':<36} {'grid':>7} {'median [s]':>11} {'min [s]':>9} {'sweeps':>7}")
-    for name, case in CASES.items():
-        for n in (30, 60):
-            times = []
-            for _ in range(repeat):
-                t0 = time.perf_counter()
-                r = exact_rolling(*case, nx=n, ny=n)
-                times.append(time.perf_counter() - t0)
-            print(
-                f"{name:<36} {n:>3}x{n:<3} {statistics.median(times):>11.3f} "
-                f"{min(times):>9.3f} {int(r.iterations):>7}"
-            )
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    print(f"python {platform.python_version()}, {platform.machine()}, load average {load:.2f}")
+    bench_solver(repeat)
+    bench_table(repeat)
 
 
 if __name__ == "__main__":

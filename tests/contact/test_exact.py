@@ -11,9 +11,16 @@ import math
 import numpy as np
 import pytest
 from scipy import integrate
+from scipy.special import ellipe, ellipk
 
-from railadhesion.contact import kalker_coefficients
-from railadhesion.contact.exact import exact_rolling, solve_tangential, tangential_influence
+from railadhesion.contact import hertz_3d_from_curvatures, kalker_coefficients
+from railadhesion.contact.exact import (
+    exact_rolling,
+    hertz_curvatures,
+    solve_normal,
+    solve_tangential,
+    tangential_influence,
+)
 
 G = 82e9
 NU = 0.28
@@ -257,3 +264,184 @@ def test_warm_start_gives_the_same_solution():
     warm = exact_rolling(xi, 0.0005, 0.3, 6e4, 5e-3, 6e-3, 0.3, nx=12, ny=12, warm_start=True)
     np.testing.assert_allclose(warm.fx, cold.fx, rtol=1e-4, atol=1e-5 * 0.3 * 6e4)
     np.testing.assert_allclose(warm.fy, cold.fy, rtol=1e-4, atol=1e-5 * 0.3 * 6e4)
+
+
+# --------------------------------------------------------------------------- falling friction
+
+LN2 = math.log(2.0)
+
+
+def test_contact_veldep_fric_steady_case():
+    # CONTACT examples/veldep_fric.ref_out (revision 2707), case 1: steady rolling, 2D (one row
+    # of 92 elements, dx = 0.1 mm, first centre x = -4.6 mm, dy = 200 mm), wheel radius 460 mm
+    # on a plane, Fn = 622216 N, CKSI = -0.0009999, V = 45000 mm/s, G = 82000 N/mm^2, nu = 0.28,
+    # exponential falling friction L = 4: FKIN = 0.18, FEXP1 = 0.12, SABSH1 = 100 mm/s (the slip
+    # velocity at which the falling part is halved: mu = 0.18 + 0.12 * 2^(-w/SABSH1)), start
+    # from zero slip velocity (INISLP = 1). CONTACT: FX/FSTAT/FN = 0.5941 (FSTAT = 0.30),
+    # 45 adhesion and 36 slip elements of 81 in contact, approach 8.879e-2 mm, PMAX 495.3 N/mm^2,
+    # frictional power -4849 W, 6 outer iterations; the map (element 6 onwards):
+    # oSSSSSSSSSSSSSSSSSSSSSSSSSSSSSSSSSSS*********************************************So
+    fn, dx, dy = 622216.0, 0.1e-3, 0.2
+    x = -4.6e-3 + dx * np.arange(92)
+    normal = solve_normal((x**2 / (2 * 0.46))[None, :], dx, dy, fn)
+    assert normal.approach == pytest.approx(8.879e-5, rel=1e-3)
+    assert normal.pressure.max() == pytest.approx(495.3e6, rel=1e-3)
+    assert int((normal.pressure > 0).sum()) == 81
+    r = solve_tangential(
+        normal.pressure, dx, dy, -0.0009999, 0.0, 0.0, 0.30, x0=x[0], y0=0.0,
+        speed=45.0, friction_ratio=0.6, friction_decay=LN2 / 0.1,
+    )  # fmt: skip
+    assert float(r.fx) / (0.30 * fn) == pytest.approx(0.5941, abs=0.0005)
+    assert int((r.state == 1).sum()) == 45 and int((r.state == 2).sum()) == 36
+    cmap = "".join("o*S"[s] for s in r.state[0][5:88])
+    assert cmap == "o" + "S" * 35 + "*" * 45 + "So"
+    power = 45.0 * float((r.px * r.sx).sum()) * dx * dy
+    assert power == pytest.approx(-4849.0, rel=2e-3)
+    assert 2 <= int(r.friction_iterations) <= 20
+    # falling friction lowers the force of Coulomb friction at the static coefficient
+    coulomb = solve_tangential(normal.pressure, dx, dy, -0.0009999, 0.0, 0.0, 0.30, x0=x[0],
+                               y0=0.0)  # fmt: skip
+    assert float(coulomb.fx) > float(r.fx) * 1.03
+
+
+def test_falling_friction_law_holds_in_the_solution():
+    a, b, fz, mu = 5e-3, 6e-3, 8e4, 0.35
+    v, ratio, decay = 30.0, 0.4, 5.0
+    r = exact_rolling(0.0012, -0.0006, 0.4, fz, a, b, mu, nx=16, ny=16, speed=v,
+                      friction_ratio=ratio, friction_decay=decay, return_fields=True,
+                      tol=1e-9, tol_friction=1e-8)  # fmt: skip
+    slip = r.state == 2
+    stick = r.state == 1
+    assert slip.any() and stick.any()
+    w = v * np.hypot(r.sx, r.sy)
+    law = mu * ((1 - ratio) * np.exp(-decay * w) + ratio)
+    np.testing.assert_allclose(r.mu_local[slip], law[slip], rtol=1e-6)
+    np.testing.assert_allclose(r.mu_local[stick], mu)  # static coefficient where stuck
+    pt = np.hypot(r.px, r.py)
+    np.testing.assert_allclose(pt[slip], (law * r.pn)[slip], rtol=1e-5)
+    assert np.all(pt[stick] <= mu * r.pn[stick] * (1 + 1e-9))
+    # the traction opposes the slip
+    cos = -(r.px * r.sx + r.py * r.sy)[slip] / (pt[slip] * np.hypot(r.sx, r.sy)[slip])
+    assert np.all(cos > 1 - 1e-6)
+
+
+def test_falling_friction_limits():
+    args = (0.001, 0.0005, 0.2, 6e4, 5e-3, 6e-3, 0.3)
+    kw = dict(nx=12, ny=12)
+    coulomb = exact_rolling(*args, **kw)
+    assert int(coulomb.friction_iterations) == 0
+    # A = 1 or B = 0 is Coulomb friction, bit for bit
+    for law in (dict(friction_ratio=1.0, friction_decay=3.0), dict(friction_ratio=0.4)):
+        same = exact_rolling(*args, speed=20.0, **law, **kw)
+        assert float(same.fx) == float(coulomb.fx) and float(same.fy) == float(coulomb.fy)
+    # full sliding without spin: |F| = mu(V |creepage|) Fz, opposite to the creepage
+    xi, eta, fz, mu, v = 0.03, -0.04, 6e4, 0.3, 10.0
+    r = exact_rolling(xi, eta, 0.0, fz, 5e-3, 6e-3, mu, nx=12, ny=12, speed=v,
+                      friction_ratio=0.5, friction_decay=2.0)  # fmt: skip
+    mu_w = mu * (0.5 * math.exp(-2.0 * v * 0.05) + 0.5)
+    assert math.hypot(float(r.fx), float(r.fy)) == pytest.approx(mu_w * fz, rel=2e-3)
+    assert float(r.fx) < 0 < float(r.fy)
+    # point symmetry (xi, eta, phi) -> -(xi, eta, phi) holds with falling friction too
+    law = dict(speed=30.0, friction_ratio=0.4, friction_decay=5.0, nx=12, ny=12)
+    r1 = exact_rolling(0.0015, -0.0008, 0.5, 6e4, 5e-3, 6e-3, 0.3, **law)
+    r2 = exact_rolling(-0.0015, 0.0008, -0.5, 6e4, 5e-3, 6e-3, 0.3, **law)
+    assert float(r2.fx) == pytest.approx(-float(r1.fx), rel=1e-5)
+    assert float(r2.fy) == pytest.approx(-float(r1.fy), rel=1e-5)
+    assert float(r2.mz) == pytest.approx(-float(r1.mz), rel=1e-5)
+    # the law needs the rolling speed
+    with pytest.raises(ValueError, match="speed"):
+        exact_rolling(*args, friction_ratio=0.5, friction_decay=1.0, **kw)
+    with pytest.raises(ValueError, match="friction_ratio"):
+        exact_rolling(*args, speed=10.0, friction_ratio=1.5, friction_decay=1.0, **kw)
+
+
+def test_discrete_normal_problem_hertz_limit():
+    # fine 2D strip: the discrete pressure approaches Hertz's line contact (a = 1 mm here)
+    g, nu, r_cyl, p_len = 8.2e10, 0.28, 0.5, 35780 / 0.2
+    e_star = g / (1 - nu)
+    a = math.sqrt(4 * p_len * r_cyl / (math.pi * e_star))
+    dx = 0.02e-3
+    x = (np.arange(120) - 59.5) * dx
+    sol = solve_normal((x**2 / (2 * r_cyl))[None, :], dx, 0.2, 35780.0)
+    p0 = 2 * p_len / (math.pi * a)
+    assert sol.pressure.max() == pytest.approx(p0, rel=0.01)
+    assert sol.pressure.sum() * dx * 0.2 == pytest.approx(35780.0, rel=1e-12)
+    assert np.all(sol.pressure >= 0.0)
+    half = x[sol.pressure[0] > 0].max() + dx / 2
+    assert half == pytest.approx(a, abs=dx)
+
+
+# --------------------------------------------------------------------------- CONTACT, same grid
+# With the normal pressure of the discrete normal problem on the same grid (as CONTACT solves
+# it) the solver reproduces CONTACT's Hertzian steady-rolling results to the digits printed.
+
+
+def test_contact_fastsim_case_with_discrete_pressure():
+    # examples/fastsim.ref_out (revision 2707), case 1: a = 8, b = 4 mm, Fn = 82 kN,
+    # eta = -0.000625, phi = 0.000625 rad/mm, mu = 0.3, 44 x 44 over 1.1a x 1.1b.
+    # CONTACT: curvatures A1 = 0.8464e-3, B1 = 2.406e-3 1/mm, approach 9.266e-2 mm,
+    # FY/FSTAT/FN = -0.6074, MZ = -4.821e4 N mm, 1276 elements in contact, 356 adhesion, 920 slip
+    ca, cb = hertz_curvatures(8e-3, 4e-3, 82e3)
+    assert ca == pytest.approx(0.8464, rel=1e-3) and cb == pytest.approx(2.406, rel=1e-3)
+    r = exact_rolling(0.0, -0.000625, 0.625, 82e3, 8e-3, 4e-3, 0.3, nx=44, ny=44, scale=1.1,
+                      pressure="discrete", return_fields=True)  # fmt: skip
+    assert float(r.fy) / (0.3 * 82e3) == pytest.approx(-0.6074, abs=0.0001)
+    assert float(r.mz) == pytest.approx(-48.21, abs=0.01)
+    assert int((r.state > 0).sum()) == 1276
+    assert int((r.state == 1).sum()) == 356 and int((r.state == 2).sum()) == 920
+    assert float(r.pn.max()) == pytest.approx(1223e6, rel=1e-3)
+
+
+def test_contact_addon_case_with_spin():
+    # testbank/contact_addon.ref_out (revision 2322), result element 1: Hertzian, semi-axes
+    # prescribed a = 4.25 mm, b = 7.0 mm (A1 = 1.214e-3, B1 = 0.5730e-3 1/mm), approach
+    # 0.05 mm giving Fn = 42083.1 N, 21 x 33 elements over 1.2353a x 1.2353b (dx = 0.5 mm,
+    # dy = 0.5241 mm), CKSI = 1e-3, CPHI = 4e-4 rad/mm, mu = 0.3, G = 82000 N/mm^2, nu = 0.28.
+    # CONTACT: FX/FSTAT/FN = -0.3868, FY/FSTAT/FN = -0.3657, MZ = -2.367e4 N mm, PMAX 675.4,
+    # 363 in contact, 138 adhesion, 225 slip
+    fn = 42083.1
+    ca, cb = hertz_curvatures(4.25e-3, 7.0e-3, fn)
+    assert ca == pytest.approx(1.214, rel=2e-3) and cb == pytest.approx(0.5730, rel=2e-3)
+    r = exact_rolling(1e-3, 0.0, 0.4, fn, 4.25e-3, 7.0e-3, 0.3, nx=21, ny=33,
+                      scale=5.25 / 4.25, pressure="discrete", return_fields=True)  # fmt: skip
+    assert float(r.fx) / (0.3 * fn) == pytest.approx(-0.3868, abs=0.0002)
+    assert float(r.fy) / (0.3 * fn) == pytest.approx(-0.3657, abs=0.0002)
+    assert float(r.mz) == pytest.approx(-23.67, abs=0.02)
+    assert int((r.state > 0).sum()) == 363
+    assert int((r.state == 1).sum()) == 138 and int((r.state == 2).sum()) == 225
+
+
+def test_contact_testbank_circular_case():
+    # testbank/testbank.ref_out (revision 2447), case 7: steady rolling via the non-Hertzian
+    # module, quadratic gap 0.002963 (x^2 + y^2) 1/mm, 41 x 41 elements of 0.2 mm (centres
+    # -4.0 ... 4.0 mm), G = 1 N/mm^2, nu = 0.28, FN = 0.4705 N, CKSI = -0.00304,
+    # mu = 0.4013. CONTACT: FX/FSTAT/FN = 0.6466, approach 7.258e-2 mm, 973 elements in
+    # contact, 555 adhesion, 418 slip
+    g, dx = 1e6, 0.2e-3
+    x = -4.0e-3 + dx * np.arange(41)
+    gap = 2.963 * (x[None, :] ** 2 + x[:, None] ** 2)
+    normal = solve_normal(gap, dx, dx, 0.4705, shear_modulus=g)
+    assert normal.approach == pytest.approx(7.258e-5, rel=2e-4)
+    r = solve_tangential(normal.pressure, dx, dx, -0.00304, 0.0, 0.0, 0.4013, x0=x[0], y0=x[0],
+                         shear_modulus=g)  # fmt: skip
+    assert float(r.fx) / (0.4013 * 0.4705) == pytest.approx(0.6466, abs=0.0001)
+    assert int((r.state > 0).sum()) == 973
+    assert int((r.state == 1).sum()) == 555 and int((r.state == 2).sum()) == 418
+
+
+def test_contact_tractcurv_points_with_discrete_pressure():
+    # examples/tractcurv.ref_out (revision 2707), first series, three of its points (see
+    # test_contact_tractcurv_exact_coulomb_series): with the discrete pressure the deviation
+    # drops from up to 0.44 % (Hertz's pressure) to the printed digits. CONTACT's input is
+    # A1 = 0.0008 1/mm with a/b = 0.5 (IPOTCN = -2); the semi-axes follow from them (the
+    # printed 6.304 and 12.61 mm are rounded): B1 from Hertz's axis-ratio relation
+    k = 0.5
+    ratio = (ellipe(1 - k * k) / k**2 - ellipk(1 - k * k)) / (ellipk(1 - k * k) - ellipe(1 - k * k))
+    assert 0.8 / ratio == pytest.approx(0.2814, rel=2e-4)  # B1 = 0.2814e-3 1/mm, as printed
+    h = hertz_3d_from_curvatures(106.7e3, 0.8, 0.8 / ratio, young=2 * G * (1 + NU), poisson=NU)
+    assert float(h.a) == pytest.approx(6.304e-3, rel=1e-4)
+    xi = np.array([0.00001, 0.0008, 0.0016, 0.0032])
+    contact = np.array([-7.015e-3, -0.4742, -0.7831, -0.9976])
+    r = exact_rolling(xi, 0.0, 0.0, 106.7e3, float(h.a), float(h.b), 0.33, nx=48, ny=44,
+                      scale=1.1, pressure="discrete")  # fmt: skip
+    np.testing.assert_allclose(r.fx / (0.33 * 106.7e3), contact, rtol=0.002, atol=0.00005)

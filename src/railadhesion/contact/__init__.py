@@ -21,7 +21,11 @@ from railadhesion.contact.kalker import (
 # ``import railadhesion`` stays fast and does not import numba.
 _LAZY = {
     "ExactResult": "railadhesion.contact.exact",
+    "NormalSolution": "railadhesion.contact.exact",
     "exact_rolling": "railadhesion.contact.exact",
+    "hertz_curvatures": "railadhesion.contact.exact",
+    "normal_influence": "railadhesion.contact.exact",
+    "solve_normal": "railadhesion.contact.exact",
     "solve_tangential": "railadhesion.contact.exact",
     "tangential_influence": "railadhesion.contact.exact",
     "exact_table_forces": "railadhesion.contact.table",
@@ -38,6 +42,7 @@ def __getattr__(name):
 
 __all__ = [
     "ExactResult",
+    "NormalSolution",
     "NAMED_GEOMETRIES",
     "FastsimResult",
     "HertzContact",
@@ -51,10 +56,13 @@ __all__ = [
     "fastsim",
     "hertz_3d",
     "hertz_3d_from_curvatures",
+    "hertz_curvatures",
     "kalker_coefficients",
     "line_contact",
     "line_contact_from_pressure",
     "linear_creep_forces",
+    "normal_influence",
+    "solve_normal",
     "solve_tangential",
     "tangential_influence",
 ]

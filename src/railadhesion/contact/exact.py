@@ -20,6 +20,11 @@ the trailing edge, with the exact local solution of Coulomb's law per element (s
 else a scalar Newton iteration for the slip direction), in numba-compiled code. Many cases
 are solved in one compiled loop (:func:`exact_rolling` broadcasts).
 
+Extensions, as in CONTACT: slip-velocity dependent (falling) friction, solved by an outer
+fixed-point iteration on the slip-velocity field (:func:`exact_rolling`, Notes); and the
+discrete normal problem on the grid (:func:`solve_normal`, ``pressure="discrete"``), with
+which the solver reproduces CONTACT's published Hertzian results to the digits printed.
+
 Sign convention (``docs/CONVENTIONS.md``): forces exerted by the rail on the wheel, opposing
 the creepages; at small creepage ``Fx = -G c^2 C11 xi``, ``Fy = -G c^2 C22 eta - G c^3 C23 phi``,
 ``Mz = G c^3 C23 eta - G c^4 C33 phi`` (Kalker's linear theory).
@@ -29,6 +34,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numba
 import numpy as np
@@ -42,7 +48,11 @@ from railadhesion._validate import (
 
 __all__ = [
     "ExactResult",
+    "NormalSolution",
     "exact_rolling",
+    "hertz_curvatures",
+    "normal_influence",
+    "solve_normal",
     "solve_tangential",
     "tangential_influence",
 ]
@@ -147,6 +157,118 @@ def tangential_influence(x, y, dx, dy, poisson=0.28, shear_modulus=8.2e10):
     _influence_array(xf, yf, 0.5 * dx_, 0.5 * dy_, nuf, axx, axy, ayy)
     f = 1.0 / (math.pi * g)
     return tuple((f * v).reshape(shape) for v in (axx, axy, ayy))
+
+
+def normal_influence(x, y, dx, dy, poisson=0.28, shear_modulus=8.2e10):
+    """Normal influence coefficient of the half-space for a uniform pressure on a rectangle.
+
+    Normal displacement difference (approach of the surfaces) of two identical elastic
+    half-spaces at the surface point ``(x, y)``, caused by a uniform pressure of 1 Pa on the
+    rectangle ``[-dx/2, dx/2] x [-dy/2, dy/2]`` (Love 1929; Johnson 1985, eq. 3.25 for one
+    body): ``(1 - nu)/(pi G) * integral of 1/r over the rectangle`` [m/Pa]. Parameters as in
+    :func:`tangential_influence`.
+    """
+    x_, y_, nu = np.broadcast_arrays(
+        check_finite(x, "x"), check_finite(y, "y"), check_range(poisson, "poisson", 0.0, 0.5)
+    )
+    dx_ = float(check_positive(dx, "dx"))
+    dy_ = float(check_positive(dy, "dy"))
+    g = float(check_positive(shear_modulus, "shear_modulus"))
+    shape = x_.shape
+    xf, yf = (np.ascontiguousarray(v, dtype=float).ravel() for v in (x_, y_))
+    axx, axy, ayy = np.empty_like(xf), np.empty_like(xf), np.empty_like(xf)
+    # with nu = 0 the tangential xx-coefficient is the integral of 1/r over the rectangle
+    _influence_array(xf, yf, 0.5 * dx_, 0.5 * dy_, np.zeros_like(xf), axx, axy, ayy)
+    return ((1.0 - nu) / (math.pi * g)) * axx.reshape(shape)
+
+
+@dataclass(frozen=True)
+class NormalSolution:
+    """Result of :func:`solve_normal`."""
+
+    pressure: np.ndarray
+    """Normal pressure p_n at the element centres [Pa], shape (ny, nx)."""
+    approach: float
+    """Approach of the bodies (penetration) [m]."""
+    iterations: int
+    """Active-set iterations used."""
+
+
+def solve_normal(gap, dx, dy, normal_force, *, shear_modulus=8.2e10, poisson=0.28, max_iter=200):
+    """Discrete normal contact problem (frictionless, prescribed normal force).
+
+    Finds the pressure ``p_n >= 0`` and the approach ``delta`` of two identical elastic
+    half-spaces with ``h_I - delta + u_I = 0`` where ``p_n > 0`` and ``>= 0`` elsewhere,
+    ``sum(p_n) dx dy = Fz`` (Kalker 1990, section 5.2; CONTACT's normal problem with
+    prescribed force), on a grid of ``ny x nx`` equal rectangles with piecewise-constant
+    pressure (:func:`normal_influence`). Solved by an active-set iteration with a dense
+    direct solve per iteration (grids up to a few thousand elements).
+
+    Parameters
+    ----------
+    gap : array_like
+        Undeformed distance h [m] at the element centres, shape (ny, nx).
+    dx, dy : float
+        Element size [m].
+    normal_force : float
+        Fz [N], > 0.
+    shear_modulus, poisson : float, optional
+        Combined G [Pa] and nu [-] of the (identical) materials.
+    max_iter : int, optional
+        Largest number of active-set iterations.
+
+    Returns
+    -------
+    NormalSolution
+    """
+    h = check_finite(gap, "gap")
+    if h.ndim != 2:
+        raise ValueError(f"gap must be a 2-D array (ny, nx), got shape {h.shape}")
+    ny, nx = h.shape
+    dx_ = float(check_positive(dx, "dx"))
+    dy_ = float(check_positive(dy, "dy"))
+    fz = float(check_positive(normal_force, "normal_force"))
+    g = float(check_positive(shear_modulus, "shear_modulus"))
+    nu = float(check_range(poisson, "poisson", 0.0, 0.5))
+    ix = np.arange(nx)
+    iy = np.arange(ny)
+    # coefficients for every offset, then the dense matrix by lookup
+    ox = (np.arange(-(nx - 1), nx) * dx_)[None, :]
+    oy = (np.arange(-(ny - 1), ny) * dy_)[:, None]
+    coef = normal_influence(ox, oy, dx_, dy_, poisson=nu, shear_modulus=g)
+    jj, ii = np.meshgrid(iy, ix, indexing="ij")
+    jj, ii = jj.ravel(), ii.ravel()
+    mat = coef[jj[:, None] - jj[None, :] + ny - 1, ii[:, None] - ii[None, :] + nx - 1]
+    hf = h.ravel()
+    n = hf.size
+    active = hf <= np.min(hf) + 0.5 * (np.max(hf) - np.min(hf))  # initial guess
+    p = np.zeros(n)
+    delta = 0.0
+    total = fz / (dx_ * dy_)
+    iterations = 0
+    for _ in range(int(max_iter)):
+        iterations += 1
+        idx = np.flatnonzero(active)
+        m = idx.size
+        sys = np.empty((m + 1, m + 1))
+        sys[:m, :m] = mat[np.ix_(idx, idx)]
+        sys[:m, m] = -1.0
+        sys[m, :m] = 1.0
+        sys[m, m] = 0.0
+        rhs = np.concatenate([-hf[idx], [total]])
+        sol = np.linalg.solve(sys, rhs)
+        p[:] = 0.0
+        p[idx] = sol[:m]
+        delta = sol[m]
+        neg = p < 0.0
+        gap_def = hf - delta + mat @ p
+        pen = (~active) & (gap_def < -1e-12 * max(abs(delta), 1e-30))
+        if not neg.any() and not pen.any():
+            break
+        active = (active & ~neg) | pen
+    else:
+        raise RuntimeError(f"solve_normal: no convergence in {max_iter} iterations")
+    return NormalSolution(p.reshape(ny, nx), float(delta), iterations)
 
 
 @numba.njit(cache=True)
@@ -366,12 +488,91 @@ def _gauss_seidel(g, wx, wy, kxx, kxy, kyy, dgx, dgy, tol, max_iter, px, py, sx,
 
 
 @numba.njit(cache=True)
-def _solve_hertz_batch(
-    xi, eta, phi, fz, a, b, mu, gmod, nu, mx, my, scale, spin_offset, tol, max_iter,
-    out_f, out_iter, out_err, px_all, py_all, sx_all, sy_all, state_all, keep_fields, warm,
+def _friction_factor(slip_velocity, ratio, decay):
+    """mu(w)/mu0 = (1 - A) exp(-B w) + A (Polach 2005, eq. 11; CONTACT's exponential law)."""
+    return (1.0 - ratio) * math.exp(-decay * slip_velocity) + ratio
+
+
+@numba.njit(cache=True)
+def _solve_falling_friction(
+    g0, wx, wy, kxx, kxy, kyy, dgx, dgy, tol, max_iter, px, py, sx, sy, state, mu_fac,
+    speed, ratio, decay, tol_outer, max_outer,
 ):  # fmt: skip
-    """Loop over cases: Hertz pressure on the grid, kernel (reused when unchanged), solve."""
+    """Steady rolling with slip-velocity dependent friction: outer fixed-point iteration.
+
+    ``g0`` is the traction bound at zero slip (mu0 p_n / G). The local coefficient of
+    friction ``mu_fac * mu0`` of every element is frozen at the estimate ``v`` of its slip
+    velocity, the Coulomb problem with that bound is solved by :func:`_gauss_seidel` (warm
+    started from the previous tractions), and the estimate is updated from the new slip,
+    ``v <- v + omega (V |s| - v)``, starting from ``v = 0`` (static friction everywhere,
+    "slip from below"). The relaxation ``omega`` starts at 1 and is halved whenever the
+    update grows (down to 1/16). Stops when ``||V|s| - v||_2 <= tol_outer ||V|s|||_2``.
+    Returns (total sweeps, last inner residual, outer iterations, last outer change).
+    """
+    my, mx = g0.shape
+    vel = np.zeros((my, mx))  # slip-velocity estimate [m/s]
+    g = np.empty((my, mx))
+    sweeps = 0
+    err = 0.0
+    omega = 1.0
+    last = np.inf
+    change = 0.0
+    outer = 0
+    for _ in range(max_outer):
+        outer += 1
+        for j in range(my):
+            for i in range(mx):
+                mu_fac[j, i] = _friction_factor(vel[j, i], ratio, decay)
+                g[j, i] = g0[j, i] * mu_fac[j, i]
+        it, err = _gauss_seidel(g, wx, wy, kxx, kxy, kyy, dgx, dgy, tol, max_iter, px, py, sx, sy,
+                                state)  # fmt: skip
+        sweeps += it
+        dnorm = 0.0
+        snorm = 0.0
+        for j in range(my):
+            for i in range(mx):
+                if g0[j, i] <= 0.0:
+                    continue
+                v_new = speed * math.sqrt(sx[j, i] ** 2 + sy[j, i] ** 2)
+                d = v_new - vel[j, i]
+                dnorm += d * d
+                snorm += v_new * v_new
+        dnorm = math.sqrt(dnorm)
+        snorm = math.sqrt(snorm)
+        change = dnorm / snorm if snorm > 0.0 else 0.0
+        if dnorm <= tol_outer * snorm:
+            break
+        if dnorm > last and omega > 1.0 / 16.0:
+            omega *= 0.5
+        last = dnorm
+        for j in range(my):
+            for i in range(mx):
+                if g0[j, i] > 0.0:
+                    v_new = speed * math.sqrt(sx[j, i] ** 2 + sy[j, i] ** 2)
+                    vel[j, i] += omega * (v_new - vel[j, i])
+    # the friction coefficient consistent with the final slip
+    for j in range(my):
+        for i in range(mx):
+            if g0[j, i] > 0.0:
+                mu_fac[j, i] = _friction_factor(speed * math.hypot(sx[j, i], sy[j, i]), ratio,
+                                                decay)  # fmt: skip
+            else:
+                mu_fac[j, i] = 0.0
+    return sweeps, err, outer, change
+
+
+@numba.njit(cache=True)
+def _solve_hertz_batch(
+    xi, eta, phi, fz, a, b, mu, gmod, nu, speed, fratio, decay, mx, my, scale, spin_offset, tol,
+    max_iter, tol_outer, max_outer, out_f, out_iter, out_err, out_outer, px_all, py_all, sx_all,
+    sy_all, state_all, mu_all, keep_fields, warm, shape_in,
+):  # fmt: skip
+    """Loop over cases: Hertz pressure on the grid, kernel (reused when unchanged), solve.
+
+    ``shape_in`` (my, mx): the pressure distribution to use (any scale), or an empty array for
+    Hertz's at the element centres."""
     n = xi.size
+    mu_fac = np.ones((my, mx))
     px = np.zeros((my, mx))
     py = np.zeros((my, mx))
     sx = np.zeros((my, mx))
@@ -394,12 +595,15 @@ def _solve_hertz_batch(
         xh[i] = scale * (-1.0 + (2.0 * i + 1.0) / mx)
     for j in range(my):
         yh[j] = scale * (-1.0 + (2.0 * j + 1.0) / my)
-    # shape of the Hertz pressure at the element centres, and its sum
+    # shape of the pressure (Hertz's at the element centres unless given), and its sum
     ssum = 0.0
     for j in range(my):
         for i in range(mx):
-            q = 1.0 - xh[i] * xh[i] - yh[j] * yh[j]
-            shape[j, i] = math.sqrt(q) if q > 0.0 else 0.0
+            if shape_in.size > 0:
+                shape[j, i] = max(shape_in[j, i], 0.0)
+            else:
+                q = 1.0 - xh[i] * xh[i] - yh[j] * yh[j]
+                shape[j, i] = math.sqrt(q) if q > 0.0 else 0.0
             ssum += shape[j, i]
     for c in range(n):
         dx = 2.0 * scale * a[c] / mx
@@ -432,9 +636,19 @@ def _solve_hertz_batch(
                         f = g[j, i] / pt
                         px[j, i] *= f
                         py[j, i] *= f
-        it, err = _gauss_seidel(
-            g, wx, wy, kxx, kxy, kyy, dgx, dgy, tol, max_iter, px, py, sx, sy, st
-        )
+        if fratio[c] == 1.0 or decay[c] * speed[c] == 0.0:  # Coulomb
+            it, err = _gauss_seidel(
+                g, wx, wy, kxx, kxy, kyy, dgx, dgy, tol, max_iter, px, py, sx, sy, st
+            )
+            outer = 0
+            for j in range(my):
+                for i in range(mx):
+                    mu_fac[j, i] = 1.0 if g[j, i] > 0.0 else 0.0
+        else:
+            it, err, outer, _ = _solve_falling_friction(
+                g, wx, wy, kxx, kxy, kyy, dgx, dgy, tol, max_iter, px, py, sx, sy, st, mu_fac,
+                speed[c], fratio[c], decay[c], tol_outer, max_outer,
+            )  # fmt: skip
         fx = 0.0
         fy = 0.0
         mz = 0.0
@@ -459,6 +673,7 @@ def _solve_hertz_batch(
         out_f[c, 3] = area_slip / area_c if area_c > 0 else 0.0
         out_iter[c] = it
         out_err[c] = err
+        out_outer[c] = outer
         if keep_fields:
             for j in range(my):
                 for i in range(mx):
@@ -467,6 +682,7 @@ def _solve_hertz_batch(
                     sx_all[c, j, i] = sx[j, i]
                     sy_all[c, j, i] = sy[j, i]
                     state_all[c, j, i] = st[j, i]
+                    mu_all[c, j, i] = mu_fac[j, i] * mu[c]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -513,6 +729,11 @@ class ExactResult:
     """Slip along y per unit rolling distance [-]."""
     state: np.ndarray | None = None
     """Element state: 0 = outside the contact, 1 = stick (adhesion), 2 = slip."""
+    friction_iterations: np.ndarray | None = None
+    """Outer (friction-update) iterations with falling friction; 0 with Coulomb friction."""
+    mu_local: np.ndarray | None = None
+    """Local coefficient of friction at the final slip velocity, (*shape, ny, nx) (0 outside
+    the contact; the static value in stick)."""
 
 
 def _check_grid(value, name: str) -> int:
@@ -523,6 +744,59 @@ def _check_grid(value, name: str) -> int:
     if n != value or n < 1 or n > 2000:
         raise ValueError(f"{name} must be an integer in [1, 2000], got {value!r}")
     return n
+
+
+def _check_friction_law(speed, friction_ratio, friction_decay):
+    """Validated (A, B, V) of the falling friction law; V = 0 stands for 'not given'."""
+    ratio = check_range(friction_ratio, "friction_ratio", 0.0, 1.0)
+    decay = check_nonnegative(friction_decay, "friction_decay")
+    falling = np.any((ratio != 1.0) & (decay > 0.0))
+    if speed is None:
+        if falling:
+            raise ValueError("speed (rolling speed [m/s], >= 0) is needed with falling friction")
+        v = np.zeros(())
+    else:
+        v = check_nonnegative(speed, "speed")
+    return ratio, decay, v
+
+
+def hertz_curvatures(a, b, normal_force, shear_modulus=8.2e10, poisson=0.28):
+    """Gap coefficients (A, B) [1/m] of the Hertz contact with semi-axes a, b under Fz.
+
+    Inverse of :func:`railadhesion.contact.hertz.hertz_3d_from_curvatures` for two identical
+    bodies (``E* = G/(1 - nu)``): with ``k = min(a,b)/max(a,b)``, ``e^2 = 1 - k^2``,
+    ``max(A,B)/min(A,B) = (E/k^2 - K)/(K - E)`` (the smaller curvature along the longer
+    axis) and ``A + B = 2/rho``, ``rho = 4 pi E* sqrt(k) (ab)^(3/2) / (3 Fz E)`` (Johnson
+    1985, section 4.2; CONTACT ``hzcalc3d``). Scalars.
+    """
+    from scipy.special import ellipe, ellipk
+
+    a, b, fz = float(a), float(b), float(normal_force)
+    e_star = float(shear_modulus) / (1.0 - float(poisson))
+    k = min(a, b) / max(a, b)
+    m = 1.0 - k * k
+    big_k, big_e = float(ellipk(m)), float(ellipe(m))
+    ratio = (big_e / k**2 - big_k) / (big_k - big_e) if k < 1.0 else 1.0
+    rho = 4.0 * math.pi * e_star * math.sqrt(k) * (a * b) ** 1.5 / (3.0 * fz * big_e)
+    small = (2.0 / rho) / (1.0 + ratio)
+    return (small, ratio * small) if a >= b else (ratio * small, small)
+
+
+@lru_cache(maxsize=64)
+def _discrete_shape(aob: float, nu: float, nx: int, ny: int, scale: float) -> np.ndarray:
+    """Discrete normal pressure (relative) on the grid of :func:`exact_rolling` for a Hertz
+    contact of ratio a/b; the normalised solution does not depend on the size or the load."""
+    c, fz, g = 1e-2, 1e5, 8.2e10
+    a, b = c * math.sqrt(aob), c / math.sqrt(aob)
+    ca, cb = hertz_curvatures(a, b, fz, g, nu)
+    xh = scale * (-1.0 + (2.0 * np.arange(nx) + 1.0) / nx)
+    yh = scale * (-1.0 + (2.0 * np.arange(ny) + 1.0) / ny)
+    gap = ca * (a * xh[None, :]) ** 2 + cb * (b * yh[:, None]) ** 2
+    sol = solve_normal(gap, 2 * scale * a / nx, 2 * scale * b / ny, fz, shear_modulus=g,
+                       poisson=nu)  # fmt: skip
+    shp = sol.pressure / sol.pressure.max()
+    shp.flags.writeable = False
+    return shp
 
 
 def exact_rolling(
@@ -536,14 +810,20 @@ def exact_rolling(
     *,
     shear_modulus=8.2e10,
     poisson=0.28,
+    speed=None,
+    friction_ratio=1.0,
+    friction_decay=0.0,
     nx: int = 30,
     ny: int = 30,
     scale: float = 1.0,
     spin_offset: float = SPIN_OFFSET_CONTACT,
     tol: float = 1e-6,
     max_iter: int = 5000,
+    tol_friction: float = 1e-4,
+    max_friction_iter: int = 200,
     return_fields: bool = False,
     warm_start: bool = False,
+    pressure: str = "hertz",
 ) -> ExactResult:
     """Creep forces of steady rolling by Kalker's exact theory (half-space, Coulomb friction).
 
@@ -559,11 +839,22 @@ def exact_rolling(
         Hertzian contact semi-axes along x (rolling direction) and y [m], > 0
         (e.g. from :func:`railadhesion.contact.hertz.hertz_3d`).
     mu : array_like
-        Coefficient of friction [-], >= 0 (Coulomb: static = kinetic).
+        Coefficient of friction [-], >= 0: Coulomb's, or the static one mu0 of the falling
+        friction law below.
     shear_modulus : array_like, optional
         Combined shear modulus G [Pa], > 0. Default 82 GPa.
     poisson : array_like, optional
         Combined Poisson's ratio nu [-], in [0, 0.5]. Default 0.28.
+    speed : array_like, optional
+        Rolling speed V [m/s], >= 0: the local slip velocity is ``V |s|``. Needed only with
+        falling friction.
+    friction_ratio, friction_decay : array_like, optional
+        Falling friction: the local coefficient of friction falls with the local slip
+        velocity w as ``mu(w) = mu [(1 - A) exp(-B w) + A]`` with ``A = friction_ratio``
+        (mu_inf/mu0, in [0, 1]) and ``B = friction_decay`` [s/m], >= 0 (Polach 2005;
+        CONTACT's law L = 5, and its exponential law L = 4 with FKIN = A mu,
+        FEXP1 = (1 - A) mu and SABSH1 = ln(2)/B, SABSH1 being the slip velocity at which the
+        falling part is halved). Defaults A = 1, B = 0: Coulomb friction. See Notes.
     nx, ny : int, optional
         Elements along x and y covering ``[-scale a, scale a] x [-scale b, scale b]``
         (CONTACT's MX, MY). Default 30 x 30.
@@ -576,13 +867,26 @@ def exact_rolling(
     tol : float, optional
         Stop when no traction component changes by more than ``tol max|p|`` in a sweep.
     max_iter : int, optional
-        Largest number of Gauss-Seidel sweeps.
+        Largest number of Gauss-Seidel sweeps (per friction update with falling friction).
+    tol_friction, max_friction_iter : optional
+        Falling friction only: stop the outer iteration when the slip-velocity field changes
+        by less than ``tol_friction`` (relative, 2-norm), or after ``max_friction_iter``
+        updates (then ``friction_iterations == max_friction_iter`` flags non-convergence).
     return_fields : bool, optional
-        Also return the grid, tractions, pressure, slip and the stick/slip map.
+        Also return the grid, tractions, pressure, slip, the stick/slip map and the local
+        coefficient of friction.
     warm_start : bool, optional
         Start each case from the tractions of the previous case when the grid is the same
         (same a/b and nu): fewer sweeps along creep curves. The results then depend on the
         order of the cases within the tolerance ``tol``. Default False.
+    pressure : {"hertz", "discrete"}, optional
+        Normal pressure on the grid: Hertz's ellipse at the element centres (default), or the
+        solution of the discrete normal problem on the same grid for the quadratic gap of
+        that Hertz contact (:func:`solve_normal`, curvatures from a, b and Fz), which is what
+        CONTACT solves: with it the results agree with CONTACT's to the 4 digits it prints
+        (docs/validation/exact_solver.md). The discrete contact area is slightly larger than
+        the ellipse: use ``scale >= 1.1`` (CONTACT's examples do). Costs one dense normal
+        solve per distinct (a/b, nu), about 0.3-2 s on grids of 30 x 30 to 44 x 44.
 
     Returns
     -------
@@ -600,6 +904,17 @@ def exact_rolling(
     is ``w = (xi - phi y, eta + phi x)`` (Kalker 1990, eq. 1.1.11), the slip
     ``s_I = w_I + (u_I - u_{I+})/dx`` (steady state, step dq = dx). Coefficients:
     :func:`tangential_influence`.
+
+    Falling friction (slip-velocity dependent, as in CONTACT; Vollebregt & Schuttelaars,
+    J. Sound Vib. 331, 2012): in slip ``|p| = mu(V |s|) p_n``, in stick ``s = 0`` and
+    ``|p| <= mu(0) p_n``. Solved by an outer fixed-point iteration on the slip-velocity
+    field (as CONTACT does): the local coefficient of friction is frozen at the current
+    estimate of the slip velocity, the Coulomb problem with that traction bound is solved
+    (warm started), and the estimate is updated from the new slip (under-relaxed when the
+    update grows); it starts from zero slip velocity (static friction everywhere, CONTACT's
+    INISLP = 1, "slip from below"). Steep laws may have several solutions; this start
+    selects the one reached from below. The fixed point satisfies the law exactly; typical
+    cases converge in 5-15 updates (``friction_iterations``).
 
     Convergence: the discretisation error in the forces decreases about as 1/n; see
     ``docs/validation/exact_solver.md`` for a grid-convergence table and the comparison
@@ -624,6 +939,9 @@ def exact_rolling(
     mu_ = check_nonnegative(mu, "mu")
     g_mod = check_positive(shear_modulus, "shear_modulus")
     nu = check_range(poisson, "poisson", 0.0, 0.5)
+    ratio, decay, v = _check_friction_law(speed, friction_ratio, friction_decay)
+    tol_friction = float(check_range(tol_friction, "tol_friction", 1e-12, 1e-1))
+    max_friction_iter = _check_grid(max_friction_iter, "max_friction_iter")
     nx = _check_grid(nx, "nx")
     ny = _check_grid(ny, "ny")
     scale = float(check_range(scale, "scale", 1.0, 10.0))
@@ -631,23 +949,62 @@ def exact_rolling(
     tol = float(check_range(tol, "tol", 1e-14, 1e-2))
     max_iter = _check_grid(max_iter, "max_iter") if max_iter <= 2000 else int(max_iter)
 
-    args = np.broadcast_arrays(xi, eta, phi, fz, a_, b_, mu_, g_mod, nu)
+    args = np.broadcast_arrays(xi, eta, phi, fz, a_, b_, mu_, g_mod, nu, v, ratio, decay)
     shape = args[0].shape
     flat = [np.ascontiguousarray(np.ravel(v), dtype=float) for v in args]
     n = flat[0].size
     out_f = np.empty((n, 4))
     out_iter = np.empty(n, np.int64)
     out_err = np.empty(n)
+    out_outer = np.empty(n, np.int64)
     if return_fields:
         fields = [np.empty((n, ny, nx)) for _ in range(4)]
         state = np.empty((n, ny, nx), np.int8)
+        mu_all = np.empty((n, ny, nx))
     else:
         fields = [np.empty((1, 1, 1)) for _ in range(4)]
         state = np.empty((1, 1, 1), np.int8)
-    _solve_hertz_batch(
-        *flat, nx, ny, scale, spin_offset, tol, max_iter,
-        out_f, out_iter, out_err, *fields, state, return_fields, bool(warm_start),
-    )  # fmt: skip
+        mu_all = np.empty((1, 1, 1))
+    if pressure not in ("hertz", "discrete"):
+        raise ValueError(f"pressure must be 'hertz' or 'discrete', got {pressure!r}")
+    if pressure == "hertz":
+        shapes = None
+        _solve_hertz_batch(
+            *flat, nx, ny, scale, spin_offset, tol, max_iter, tol_friction, max_friction_iter,
+            out_f, out_iter, out_err, out_outer, *fields, state, mu_all, return_fields,
+            bool(warm_start), np.empty((0, 0)),
+        )  # fmt: skip
+    else:  # one discrete normal solution per (a/b, nu), the cases solved group by group
+        aob_all = flat[4] / flat[5]
+        keys = np.stack([aob_all, flat[8]], axis=1)
+        uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
+        inverse = inverse.ravel()
+        shapes = np.empty((n, ny, nx)) if return_fields else None
+        for k, (aob_k, nu_k) in enumerate(uniq):
+            idx = np.flatnonzero(inverse == k)
+            shp = _discrete_shape(float(aob_k), float(nu_k), nx, ny, scale)
+            sub = [np.ascontiguousarray(v[idx]) for v in flat]
+            m = idx.size
+            o_f, o_it, o_err, o_out = np.empty((m, 4)), np.empty(m, np.int64), np.empty(m), \
+                np.empty(m, np.int64)  # fmt: skip
+            if return_fields:
+                f_sub = [np.empty((m, ny, nx)) for _ in range(4)]
+                st_sub = np.empty((m, ny, nx), np.int8)
+                mu_sub = np.empty((m, ny, nx))
+            else:
+                f_sub, st_sub, mu_sub = fields, state, mu_all
+            _solve_hertz_batch(
+                *sub, nx, ny, scale, spin_offset, tol, max_iter, tol_friction,
+                max_friction_iter, o_f, o_it, o_err, o_out, *f_sub, st_sub, mu_sub,
+                return_fields, bool(warm_start), shp,
+            )  # fmt: skip
+            out_f[idx], out_iter[idx], out_err[idx], out_outer[idx] = o_f, o_it, o_err, o_out
+            if return_fields:
+                for full, part in zip(fields, f_sub, strict=True):
+                    full[idx] = part
+                state[idx] = st_sub
+                mu_all[idx] = mu_sub
+                shapes[idx] = shp
 
     def shaped(v):
         v = v.reshape(shape)
@@ -658,19 +1015,24 @@ def exact_rolling(
         xh = scale * (-1.0 + (2.0 * np.arange(nx) + 1.0) / nx)
         yh = scale * (-1.0 + (2.0 * np.arange(ny) + 1.0) / ny)
         a_f, b_f = flat[4], flat[5]
-        shp = np.clip(1.0 - xh[None, :] ** 2 - yh[:, None] ** 2, 0.0, None) ** 0.5
+        if shapes is None:
+            shapes = np.broadcast_to(
+                np.clip(1.0 - xh[None, :] ** 2 - yh[:, None] ** 2, 0.0, None) ** 0.5,
+                (n, ny, nx),
+            )
         dxa = 2.0 * scale * a_f / nx
         dya = 2.0 * scale * b_f / ny
-        pfac = flat[3] / (shp.sum() * dxa * dya)
+        pfac = flat[3] / (shapes.sum(axis=(1, 2)) * dxa * dya)
         extra = {
             "x": (a_f[:, None] * xh[None, :]).reshape(*shape, nx),
             "y": (b_f[:, None] * yh[None, :]).reshape(*shape, ny),
             "px": fields[0].reshape(*shape, ny, nx),
             "py": fields[1].reshape(*shape, ny, nx),
-            "pn": (pfac[:, None, None] * shp[None]).reshape(*shape, ny, nx),
+            "pn": (pfac[:, None, None] * shapes).reshape(*shape, ny, nx),
             "sx": fields[2].reshape(*shape, ny, nx),
             "sy": fields[3].reshape(*shape, ny, nx),
             "state": state.reshape(*shape, ny, nx),
+            "mu_local": mu_all.reshape(*shape, ny, nx),
         }
     return ExactResult(
         shaped(out_f[:, 0]),
@@ -679,6 +1041,7 @@ def exact_rolling(
         shaped(out_f[:, 3]),
         shaped(out_iter),
         shaped(out_err),
+        friction_iterations=shaped(out_outer),
         **extra,
     )
 
@@ -696,9 +1059,14 @@ def solve_tangential(
     y0=None,
     shear_modulus=8.2e10,
     poisson=0.28,
+    speed=None,
+    friction_ratio=1.0,
+    friction_decay=0.0,
     spin_offset: float = SPIN_OFFSET_CONTACT,
     tol: float = 1e-6,
     max_iter: int = 5000,
+    tol_friction: float = 1e-4,
+    max_friction_iter: int = 200,
 ) -> ExactResult:
     """Steady-rolling tangential problem on a given grid and normal pressure (one case).
 
@@ -717,8 +1085,9 @@ def solve_tangential(
     x0, y0 : float, optional
         Centre of the first element (column 0, row 0) [m]; default: the grid is centred at
         the origin. Spin and the moment refer to the origin.
-    shear_modulus, poisson, spin_offset, tol, max_iter
-        As in :func:`exact_rolling`.
+    shear_modulus, poisson, speed, friction_ratio, friction_decay, spin_offset, tol, max_iter,
+    tol_friction, max_friction_iter
+        As in :func:`exact_rolling` (scalars here).
 
     Returns
     -------
@@ -737,6 +1106,9 @@ def solve_tangential(
     mu_ = float(check_nonnegative(mu, "mu"))
     g = float(check_positive(shear_modulus, "shear_modulus"))
     nu = float(check_range(poisson, "poisson", 0.0, 0.5))
+    ratio, decay, v = (float(q) for q in _check_friction_law(speed, friction_ratio, friction_decay))
+    tol_friction = float(check_range(tol_friction, "tol_friction", 1e-12, 1e-1))
+    max_friction_iter = _check_grid(max_friction_iter, "max_friction_iter")
     x0 = -0.5 * (nx - 1) * dx_ if x0 is None else float(check_finite(x0, "x0"))
     y0 = -0.5 * (ny - 1) * dy_ if y0 is None else float(check_finite(y0, "y0"))
     x = x0 + dx_ * np.arange(nx)
@@ -755,10 +1127,19 @@ def solve_tangential(
     st = np.zeros((ny, nx), np.int8)
     contact = pn > 0.0
     gb[~contact] = 0.0
-    it, err = _gauss_seidel(
-        gb, wx, wy, kxx, kxy, kyy, dgx, dgy, float(tol), int(max_iter), px, py, sx, sy, st
-    )
+    mu_fac = np.ones((ny, nx))
+    if ratio == 1.0 or decay * v == 0.0:
+        it, err = _gauss_seidel(
+            gb, wx, wy, kxx, kxy, kyy, dgx, dgy, float(tol), int(max_iter), px, py, sx, sy, st
+        )
+        outer = 0
+    else:
+        it, err, outer, _ = _solve_falling_friction(
+            gb, wx, wy, kxx, kxy, kyy, dgx, dgy, float(tol), int(max_iter), px, py, sx, sy, st,
+            mu_fac, v, ratio, decay, tol_friction, max_friction_iter,
+        )  # fmt: skip
     st[~contact] = _EXTERIOR
+    mu_fac[~contact] = 0.0
     da = dx_ * dy_
     px *= g
     py *= g
@@ -770,4 +1151,5 @@ def solve_tangential(
         np.float64(fx), np.float64(fy), np.float64(mz),
         np.float64((st == _SLIP).sum() / nc), np.int64(it), np.float64(err),
         x=x, y=y, px=px, py=py, pn=np.array(pn, dtype=float), sx=sx, sy=sy, state=st,
+        friction_iterations=np.int64(outer), mu_local=mu_fac * mu_,
     )  # fmt: skip
