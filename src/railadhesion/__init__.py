@@ -5,6 +5,8 @@ xi = (V - omega R)/V (braking positive); forces are exerted by the rail on the w
 oppose the creepage (Kalker's convention, as in CONTACT).
 """
 
+import math as _math
+
 import numpy as _np
 
 from railadhesion._labelled import labelled as _labelled
@@ -28,6 +30,10 @@ def adhesion(fx, fy, normal_force):
     >>> float(adhesion(3.0, 4.0, 20.0))
     0.25
     """
+    if isinstance(fx, float) and isinstance(fy, float) and isinstance(normal_force, float):
+        # scalar fast path (FMU steps, ODE right-hand sides): same result and error
+        if 0.0 < normal_force < _math.inf:
+            return _np.float64(_math.hypot(fx, fy) / normal_force)
     from railadhesion._validate import check_positive
 
     q = check_positive(normal_force, "normal_force")

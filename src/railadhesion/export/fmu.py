@@ -119,16 +119,22 @@ class FmuVariable:
 @contextlib.contextmanager
 def _isolated_import_state():
     """pythonfmu's builder inserts the script folder into sys.path and imports the slave
-    module; undo both so that building twice (or building then testing) starts clean."""
+    module; undo both so that building twice (or building then testing) starts clean.
+
+    Only modules loaded from the folders the build put on sys.path (the slave script) are
+    forgotten: libraries first imported during the build (numba, llvmlite, ...) stay, since
+    other modules already hold references to them (a second copy of numba in one process
+    corrupts its compiler state)."""
     path = list(sys.path)
     modules = set(sys.modules)
     try:
         yield
     finally:
+        added = [str(Path(p).resolve()) for p in sys.path if p and p not in path]
         sys.path[:] = path
         for name in set(sys.modules) - modules:
-            package = name.split(".")[0]
-            if package not in ("pythonfmu", "railadhesion"):  # the slave module goes
+            file = getattr(sys.modules[name], "__file__", None)
+            if file and any(str(Path(file).resolve()).startswith(a) for a in added):
                 del sys.modules[name]
 
 
