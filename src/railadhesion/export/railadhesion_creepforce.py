@@ -23,6 +23,16 @@ from pathlib import Path
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
 from pythonfmu.enums import Fmi2Status
 
+
+def _release_at_exit(resources) -> None:
+    """Avoid pythonfmu's use-after-free at exit in a Python host (railadhesion.export._host)."""
+    try:
+        from railadhesion.export._host import release_pythonfmu_state_at_exit
+    except ImportError:  # the package is missing or older: said where it is needed
+        return
+    release_pythonfmu_state_at_exit(resources)
+
+
 CONFIG_FILE = "railadhesion_fmu.json"
 
 
@@ -46,6 +56,8 @@ class RailadhesionCreepForce(Fmi2Slave):
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         resources = Path(self.resources)
+        # a Python host would otherwise risk an abort at exit in pythonfmu's binary
+        _release_at_exit(self.resources)
         config = json.loads((resources / CONFIG_FILE).read_text(encoding="utf-8"))
         self.description = config["description"]
         self.version = config["fmu_version"]
