@@ -131,7 +131,8 @@ def _load():
     # outputs last, as rows of _NOUT (Fx, Fy, Mz): the 4 spin nodes of a (t, theta) pair
     # that a lookup needs are then 12 contiguous doubles, loaded as one SIMD vector; ghost
     # nodes on every axis
-    values = _with_ghosts(np.moveaxis(data["values"], 0, -1), (0, 1, 2, 3))
+    # (in double precision: the file holds single)
+    values = _with_ghosts(np.moveaxis(data["values"], 0, -1).astype(float), (0, 1, 2, 3))
     padded = np.zeros(values.shape[:-1] + (_NOUT,))
     padded[..., :3] = values
     data["padded"] = _read_only(padded)
