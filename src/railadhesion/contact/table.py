@@ -587,7 +587,8 @@ def exact_table_forces(
     load average 1.1): with one a/b for all contacts, about 0.05 us per contact at 2e5
     and 1e6 contacts with spin, 2.2-2.6 times the package's vectorised
     :func:`~railadhesion.models.polach.polach_forces` on the same contacts, with Coulomb or
-    falling friction and at nu = 0.25 alike; with a/b varying per contact about 0.6 us.
+    falling friction and at nu = 0.25 alike (1.7-3.3 times over five runs, with the load);
+    with a/b varying per contact about 0.6 us.
     Parallel from 1e5 contacts (``numba.get_num_threads()`` threads).
 
     **Falling friction.** The exact solution with a slip-velocity dependent coefficient has
