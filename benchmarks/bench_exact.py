@@ -1,6 +1,7 @@
 """Benchmark of the exact steady-rolling solver and of its table model.
 
-Run with ``PYTHONPATH=src python3 benchmarks/bench_exact.py`` (``--quick``: fewer repeats).
+Run with ``PYTHONPATH=src python3 benchmarks/bench_exact.py`` (``--quick``: fewer repeats;
+``--table``: the table model only).
 Prints:
 
 * the exact solver's wall-clock time per case (median of the repeats, after compilation) at
@@ -9,9 +10,10 @@ Prints:
   Coulomb friction and with falling friction (Polach's dry law at 30 m/s), plus the number
   of Gauss-Seidel sweeps (and friction updates). CONTACT (Fortran) needs about 26 ms and
   0.6 s per case at these sizes (issue 12);
-* the table model's cost per contact, vectorised over 200 000 contacts with spin, beside
-  the package's vectorised Polach on the same contacts in the same run (issue 12 target:
-  at most 10x Polach), with Coulomb friction, with falling friction, and at nu = 0.25.
+* the table model's cost per contact, vectorised over 200 000 and 1 000 000 contacts with
+  spin (one a/b for all: the 3-D lookup), beside the package's vectorised Polach on the same
+  contacts in the same run (issue 12 target: at most 10x Polach), with Coulomb friction,
+  with falling friction, and at nu = 0.25. Both run in parallel at these sizes.
 
 Timings vary with the load of the machine: quote medians and ratios, with ``uptime``.
 """
@@ -58,21 +60,29 @@ def bench_solver(repeat: int) -> None:
 
 
 def bench_table(repeat: int) -> None:
-    n = 200_000
+    for n in (200_000, 1_000_000):
+        _bench_table(n, repeat)
+
+
+def _bench_table(n: int, repeat: int) -> None:
     rng = np.random.default_rng(0)
     xs = rng.uniform(-3e-3, 3e-3, n)
     ys = rng.uniform(-3e-3, 3e-3, n)
     ps = rng.uniform(-1, 1, n)
     fz, mu, v, a, b = 1e5, 0.3, 30.0, 5e-3, 6e-3
 
-    def best(f):
-        f()
-        out = []
+    def best(ft, fp):
+        """Best times of the table and of Polach, run alternately (a change of the machine's
+        load then hits both)."""
+        ft()
+        fp()
+        times = ([], [])
         for _ in range(repeat):
-            t0 = time.perf_counter()
-            f()
-            out.append(time.perf_counter() - t0)
-        return min(out)
+            for f, out in zip((ft, fp), times, strict=True):
+                t0 = time.perf_counter()
+                f()
+                out.append(time.perf_counter() - t0)
+        return min(times[0]), min(times[1])
 
     rows = [
         ("Coulomb",
@@ -85,21 +95,25 @@ def bench_table(repeat: int) -> None:
          lambda: exact_table_forces(xs, ys, ps, fz, a, b, mu, poisson=0.25),
          lambda: polach_forces(xs, ys, ps, fz, v, a, b, mu0=mu, poisson=0.25)),
     ]  # fmt: skip
-    print(f"\ntable model vs Polach, {n:,} contacts with spin (best of {repeat}):")
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    print(f"\ntable model vs Polach, {n:,} contacts with spin (best of {repeat}; load average "
+          f"{load:.2f}):")  # fmt: skip
     print(f"{'friction':<24} {'table [us]':>11} {'Polach [us]':>12} {'ratio':>7}")
     for name, ft, fp in rows:
-        tt, tp = best(ft), best(fp)
+        tt, tp = best(ft, fp)
         print(f"{name:<24} {tt / n * 1e6:>11.3f} {tp / n * 1e6:>12.3f} {tt / tp:>7.1f}")
 
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="one repeat (smoke run)")
+    parser.add_argument("--table", action="store_true", help="the table model only")
     args = parser.parse_args(argv)
     repeat = 1 if args.quick else 5
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"python {platform.python_version()}, {platform.machine()}, load average {load:.2f}")
-    bench_solver(repeat)
+    if not args.table:
+        bench_solver(repeat)
     bench_table(repeat)
 
 

@@ -17,6 +17,7 @@ falling friction (four laws) and the table at Poisson's ratios 0.25 and 0.30. Ru
 from __future__ import annotations
 
 import itertools
+import os
 import sys
 import time
 from pathlib import Path
@@ -165,8 +166,9 @@ def main(out: Path = DEFAULT_OUT) -> None:
         "",
         "## Cost",
         "",
-        f"Vectorised, {n:,} contacts with spin (best of 3, shared 2-core machine): table "
-        f"model {tt / n * 1e6:.2f} µs per contact, Polach {tp / n * 1e6:.2f} µs per contact "
+        f"Vectorised, {n:,} contacts with spin (best of 3, shared 2-core machine, load average "
+        f"{os.getloadavg()[0]:.2f}): table model {tt / n * 1e6:.3f} µs per contact, Polach "
+        f"{tp / n * 1e6:.3f} µs per contact "
         f"(ratio {tt / tp:.1f}). Exact solver on {GRID} × {GRID}: {t_exact / len(cs):.2f} s "
         "per case (mean over the cases above).",
         "",

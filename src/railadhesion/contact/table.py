@@ -17,7 +17,8 @@ grid: log(a/b), the magnitude ``r = sqrt(X^2 + Y^2)`` through ``t = (2/pi) atan(
 direction ``theta = atan2(Y, X)`` in [0, pi/2] and the spin through ``u = (2/pi) atan(S)``;
 other quadrants follow from the symmetries (xi, eta, phi) -> -(xi, eta, phi) (all outputs
 change sign) and (eta, phi) -> -(eta, phi) (Fy and Mz change sign). Interpolation in compiled
-code, cubic (Catmull-Rom) along every axis. The nodes are solved with the build grid's own
+code, cubic (Catmull-Rom) along every axis, with a ghost node beyond each end extrapolated
+quadratically (stored in the table as loaded). The nodes are solved with the build grid's own
 linear coefficients and looked up with Kalker's
 (:func:`railadhesion.contact.kalker.kalker_coefficients`), which removes most of the grid's
 discretisation error (its excess stiffness).
@@ -37,6 +38,9 @@ from importlib import resources
 
 import numba
 import numpy as np
+from llvmlite import ir
+from numba import njit, types
+from numba.extending import intrinsic
 
 from railadhesion._validate import (
     as_float_array,
@@ -46,6 +50,14 @@ from railadhesion._validate import (
 )
 from railadhesion.contact.exact import _check_friction_law
 from railadhesion.contact.kalker import kalker_coefficients
+from railadhesion.models.kernels import (
+    _TASKS_PER_THREAD,
+    _atan_nonneg,
+    _chunk,
+    _exp_into,
+    _fill,
+    _thread_pool,
+)
 
 __all__ = ["exact_table_forces", "table_axes"]
 
@@ -89,368 +101,423 @@ def node_creepages(tmag, theta, uspin):
     return r * np.cos(theta), r * np.sin(theta), ph
 
 
+def _with_ghosts(values, axes):
+    """``values`` with one ghost node added before the first and after the last node of each
+    of ``axes``, extrapolated quadratically: f[-1] = 3 f[0] - 3 f[1] + f[2] and
+    f[n] = 3 f[n-1] - 3 f[n-2] + f[n-3]. The Catmull-Rom cubic then needs no special case at
+    the ends, and its slope at an end node is second-order accurate (linear theory at
+    vanishing creepage)."""
+    for ax in axes:
+        v = np.moveaxis(values, ax, 0)
+        lo = 3.0 * v[0] - 3.0 * v[1] + v[2]
+        hi = 3.0 * v[-1] - 3.0 * v[-2] + v[-3]
+        values = np.moveaxis(np.concatenate([lo[None], v, hi[None]]), 0, ax)
+    return values
+
+
 @lru_cache(maxsize=1)
 def _load():
     with resources.files("railadhesion").joinpath("data/exact_table.npz").open("rb") as fh:
         z = np.load(fh)
         data = {k: np.array(z[k]) for k in z.files}
-    # outputs last and contiguous, as rows of 3: one memory access per node
-    last = np.ascontiguousarray(np.moveaxis(data["values"], 0, -1), dtype=float)
-    data["flat"] = last.reshape(-1, 3)
     axes = (np.log(data["aob"]), data["tmag"], data["theta"], data["uspin"])
+    for ax in axes:  # the interpolation assumes uniform axes of at least 4 nodes
+        if ax.size < 4 or not np.allclose(np.diff(ax), (ax[-1] - ax[0]) / (ax.size - 1),
+                                          rtol=1e-9, atol=1e-12):  # fmt: skip
+            raise RuntimeError("exact_table.npz: table axes are not uniform")
     data["dims"] = np.array([ax.size for ax in axes], dtype=np.int64)
     data["origin"] = np.array([ax[0] for ax in axes])
     data["inv_step"] = np.array([(ax.size - 1) / (ax[-1] - ax[0]) for ax in axes])
-    for ax in axes:  # the interpolation assumes uniform axes
-        if not np.allclose(np.diff(ax), (ax[-1] - ax[0]) / (ax.size - 1), rtol=1e-9, atol=1e-12):
-            raise RuntimeError("exact_table.npz: table axes are not uniform")
+    # outputs last, as rows of _NOUT (Fx, Fy, Mz): the 4 spin nodes of a (t, theta) pair
+    # that a lookup needs are then 12 contiguous doubles, loaded as one SIMD vector; ghost
+    # nodes on every axis
+    # (in double precision: the file holds single)
+    values = _with_ghosts(np.moveaxis(data["values"], 0, -1).astype(float), (0, 1, 2, 3))
+    padded = np.zeros(values.shape[:-1] + (_NOUT,))
+    padded[..., :3] = values
+    data["padded"] = _read_only(padded)
+    # distance in memory (doubles) between consecutive nodes along log(a/b), t, theta, u
+    data["strides"] = np.array([padded.strides[j] // padded.itemsize for j in range(4)],
+                               dtype=np.int64)  # fmt: skip
+    for v in ("dims", "strides", "origin", "inv_step"):
+        data[v] = _read_only(data[v])
     return data
 
 
-@numba.njit(cache=True)
-def _locate(v, nodes):
-    """Index i and weight w with v between nodes[i] and nodes[i+1] (clipped)."""
-    n = nodes.size
-    if v <= nodes[0]:
-        return 0, 0.0
-    if v >= nodes[n - 1]:
-        return n - 2, 1.0
-    lo, hi = 0, n - 1
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if nodes[mid] <= v:
-            lo = mid
-        else:
-            hi = mid
-    return lo, (v - nodes[lo]) / (nodes[lo + 1] - nodes[lo])
+def _read_only(x):
+    """A read-only view of x (the kernel is compiled for read-only arrays only)."""
+    x = x.view()
+    x.flags.writeable = False
+    return x
 
 
-@numba.njit(cache=True, inline="always")
-def _cubic(i, w, n, ids, wts):
-    """Catmull-Rom weights on nodes i-1 .. i+2 for the fraction w in [i, i+1]; beyond the
-    ends, ghost nodes extrapolated quadratically (folded into the end weights), so that the
-    slope at an end node is second-order accurate (linear theory at vanishing creepage)."""
+def _catmull_rom(w):
+    """Catmull-Rom weights of the nodes i-1 .. i+2 at the fraction w of [i, i+1]."""
     w2 = w * w
     w3 = w2 * w
-    wts[0] = 0.5 * (-w3 + 2.0 * w2 - w)
-    wts[1] = 0.5 * (3.0 * w3 - 5.0 * w2 + 2.0)
-    wts[2] = 0.5 * (-3.0 * w3 + 4.0 * w2 + w)
-    wts[3] = 0.5 * (w3 - w2)
-    ids[0] = i - 1
-    ids[1] = i
-    ids[2] = i + 1
-    ids[3] = i + 2
-    if i - 1 < 0:  # ghost f[-1] = 3 f[0] - 3 f[1] + f[2]
-        wg = wts[0]
-        wts[0] = 0.0
-        ids[0] = 0
-        wts[1] += 3.0 * wg
-        wts[2] -= 3.0 * wg
-        if n > 2:
-            wts[3] += wg  # ids[3] = 2 here (i = 0) unless n == 2
-        else:
-            wts[1] -= wg
-            wts[2] += wg
-    if i + 2 > n - 1:  # ghost f[n] = 3 f[n-1] - 3 f[n-2] + f[n-3]
-        wg = wts[3]
-        wts[3] = 0.0
-        ids[3] = n - 1
-        wts[2] += 3.0 * wg
-        wts[1] -= 3.0 * wg
-        if n > 2 and ids[0] == n - 3:
-            wts[0] += wg
-        elif n > 2:  # i - 1 was folded (n == 3): node n-3 is node 0 = ids[1]
-            wts[1] += wg
-        else:
-            wts[2] -= wg
-            wts[1] += wg
+    return (0.5 * (-w3 + 2.0 * w2 - w), 0.5 * (3.0 * w3 - 5.0 * w2 + 2.0),
+            0.5 * (-3.0 * w3 + 4.0 * w2 + w), 0.5 * (w3 - w2))  # fmt: skip
 
 
-#: Contacts per task of the parallel interpolation, and the number of contacts from which
-#: the parallel kernel is used (below, thread start-up costs more than it saves; as the
-#: package's Polach kernels).
-_CHUNK = 4096
-_PARALLEL_MIN = 100_000
-
-
-_TAN_PI_8 = math.sqrt(2.0) - 1.0
-
-
-@numba.njit(cache=True, inline="always")
-def _at(arr, k):
-    """arr[k], or arr[0] for a value shared by all contacts (length-1 array)."""
-    return arr[k] if arr.size > 1 else arr[0]
-
-
-@numba.njit(cache=True, inline="always")
-def _atan_pos(x):
-    """atan(x) for x >= 0 to about 1e-9 (faster than libm): reduced to |z| <= tan(pi/8)
-    by atan(x) = pi/2 - atan(1/x) and atan(x) = pi/4 + atan((x - 1)/(x + 1)), then the odd
-    Taylor series to z^17 (remainder below 0.4143^19/19 < 3e-9)."""
-    inverted = x > 1.0
-    if inverted:
-        x = 1.0 / x
-    off = 0.0
-    if x > _TAN_PI_8:
-        x = (x - 1.0) / (x + 1.0)
-        off = 0.25 * math.pi
-    z2 = x * x
-    p = 1.0 / 17.0
-    p = 1.0 / 15.0 - z2 * p
-    p = 1.0 / 13.0 - z2 * p
-    p = 1.0 / 11.0 - z2 * p
-    p = 1.0 / 9.0 - z2 * p
-    p = 1.0 / 7.0 - z2 * p
-    p = 1.0 / 5.0 - z2 * p
-    p = 1.0 / 3.0 - z2 * p
-    p = 1.0 - z2 * p
-    at = off + x * p
-    return 0.5 * math.pi - at if inverted else at
-
-
-@numba.njit(cache=True, inline="always")
 def _locate_uniform(v, v0, inv_h, n):
-    """Index i and weight w with v between the uniform nodes i and i+1 (clipped)."""
+    """Index i and fraction w of v between the uniform nodes i and i+1 (clipped to the
+    nodes; NaN goes to the first node): float i, w (vectorisable)."""
     q = (v - v0) * inv_h
-    if q <= 0.0:
-        return 0, 0.0
-    if q >= n - 1:
-        return n - 2, 1.0
-    i = int(q)
-    if i > n - 2:
-        i = n - 2
+    q = q if q > 0.0 else 0.0
+    q = q if q < n - 1.0 else n - 1.0
+    i = min(np.floor(q), n - 2.0)
     return i, q - i
 
 
-def _interp_py(flat, dims, origin, inv_step, laob, xi, eta, phi, kx, ky, ks, kf, km, lv, la, lb,
-               out):  # fmt: skip
-    """Cubic (Catmull-Rom) interpolation, per axis, of the 3 outputs at Kalker-scaled
-    creepages (X, Y, S). ``flat`` holds the table as rows of 3 outputs, node (ia, it, id, iu)
-    at row ``((ia n_t + it) n_theta + id) n_u + iu``; the four axes (log a/b, t, theta, u)
-    are uniform with first node ``origin`` and inverse spacing ``inv_step``. The spin axis
-    (innermost in memory) is summed first, then scaled by the product of the other weights.
-
-    Inputs per contact (arrays of length n, or 1 for a value shared by all): the creepages
-    xi, eta, phi and their factors to Kalker-scaled creepages kx, ky, ks
-    (``X = xi kx`` ...); the force and moment scales kf = mu Fz, km = mu Fz c. The
-    interpolated |(Fx, Fy)| is capped at mu Fz (the cubic may overshoot it by a few 0.1 %
-    near full sliding, the exact solution never does). Falling friction: speed lv, ratio la
-    and decay lb; the coefficient is mu ((1 - A) exp(-B V |(xi, eta)|) + A), which divides
-    the scaled creepages and multiplies the forces. ``out`` (3, n) receives Fx, Fy, Mz."""
-    n = out.shape[1]
-    na, nt, nd, nu = dims[0], dims[1], dims[2], dims[3]
-    nchunk = (n + _CHUNK - 1) // _CHUNK
-    for ch in numba.prange(nchunk):
-        ia_ = np.empty(4, np.int64)
-        wa_ = np.empty(4)
-        it_ = np.empty(4, np.int64)
-        wt_ = np.empty(4)
-        id_ = np.empty(4, np.int64)
-        wd_ = np.empty(4)
-        iu_ = np.empty(4, np.int64)
-        wu_ = np.empty(4)
-        for k in range(ch * _CHUNK, min((ch + 1) * _CHUNK, n)):
-            cx = _at(xi, k)
-            cy = _at(eta, k)
-            fac = 1.0
-            ra = _at(la, k)
-            bv = _at(lb, k) * _at(lv, k)
-            if ra != 1.0 and bv > 0.0:  # Polach's global slip velocity V |(xi, eta)|
-                fac = (1.0 - ra) * math.exp(-bv * math.sqrt(cx * cx + cy * cy)) + ra
-            inv = 1.0 / fac if fac > 0.0 else 0.0
-            x = cx * _at(kx, k) * inv
-            y = cy * _at(ky, k) * inv
-            p = _at(phi, k) * _at(ks, k) * inv
-            sgn = 1.0
-            if x < 0.0:  # point symmetry: all outputs change sign
-                x, y, p, sgn = -x, -y, -p, -1.0
-            sy = 1.0
-            if y < 0.0:  # mirror in y: Fy and Mz change sign
-                y, p, sy = -y, -p, -1.0
-            r = math.sqrt(x * x + y * y)
-            t = _TWO_PI * _atan_pos(r / R0)
-            # direction in [0, pi/2] (x, y >= 0 here)
-            if y <= x:
-                th = _atan_pos(y / x) if x > 0.0 else 0.0
-            else:
-                th = 0.5 * math.pi - _atan_pos(x / y)
-            u = _TWO_PI * (_atan_pos(p / S0) if p >= 0.0 else -_atan_pos(-p / S0))
-            ia, wa = _locate_uniform(laob[k], origin[0], inv_step[0], na)
-            it, wt = _locate_uniform(t, origin[1], inv_step[1], nt)
-            idd, wd = _locate_uniform(th, origin[2], inv_step[2], nd)
-            iu, wu = _locate_uniform(u, origin[3], inv_step[3], nu)
-            _cubic(ia, wa, na, ia_, wa_)
-            _cubic(it, wt, nt, it_, wt_)
-            _cubic(idd, wd, nd, id_, wd_)
-            _cubic(iu, wu, nu, iu_, wu_)
-            a0 = 0.0
-            a1 = 0.0
-            a2 = 0.0
-            for qa in range(4):
-                fa = wa_[qa]
-                if fa == 0.0:
-                    continue
-                ba = ia_[qa] * nt
-                for qt in range(4):
-                    ft = fa * wt_[qt]
-                    if ft == 0.0:
-                        continue
-                    bt = (ba + it_[qt]) * nd
-                    for qd in range(4):
-                        fd = ft * wd_[qd]
-                        if fd == 0.0:
-                            continue
-                        bd = (bt + id_[qd]) * nu
-                        s0 = 0.0
-                        s1 = 0.0
-                        s2 = 0.0
-                        for qu in range(4):
-                            w = wu_[qu]
-                            row = bd + iu_[qu]
-                            s0 += w * flat[row, 0]
-                            s1 += w * flat[row, 1]
-                            s2 += w * flat[row, 2]
-                        a0 += fd * s0
-                        a1 += fd * s1
-                        a2 += fd * s2
-            ft = math.sqrt(a0 * a0 + a1 * a1)
-            if ft > 1.0:  # Coulomb's bound
-                a0 /= ft
-                a1 /= ft
-            f = sgn * fac * _at(kf, k)
-            out[0, k] = f * a0
-            out[1, k] = f * sy * a1
-            out[2, k] = sgn * sy * fac * _at(km, k) * a2
-
-
-def _interp3_py(flat, dims, origin, inv_step, xi, eta, phi, kx, ky, ks, kf, km, lv, la, lb,
-                out):  # fmt: skip
-    """As :func:`_interp_py` on a table already interpolated to one a/b (axes t, theta, u)."""
-    n = out.shape[1]
-    nt, nd, nu = dims[1], dims[2], dims[3]
-    nchunk = (n + _CHUNK - 1) // _CHUNK
-    for ch in numba.prange(nchunk):
-        it_ = np.empty(4, np.int64)
-        wt_ = np.empty(4)
-        id_ = np.empty(4, np.int64)
-        wd_ = np.empty(4)
-        iu_ = np.empty(4, np.int64)
-        wu_ = np.empty(4)
-        for k in range(ch * _CHUNK, min((ch + 1) * _CHUNK, n)):
-            cx = _at(xi, k)
-            cy = _at(eta, k)
-            fac = 1.0
-            ra = _at(la, k)
-            bv = _at(lb, k) * _at(lv, k)
-            if ra != 1.0 and bv > 0.0:  # Polach's global slip velocity V |(xi, eta)|
-                fac = (1.0 - ra) * math.exp(-bv * math.sqrt(cx * cx + cy * cy)) + ra
-            inv = 1.0 / fac if fac > 0.0 else 0.0
-            x = cx * _at(kx, k) * inv
-            y = cy * _at(ky, k) * inv
-            p = _at(phi, k) * _at(ks, k) * inv
-            sgn = 1.0
-            if x < 0.0:  # point symmetry: all outputs change sign
-                x, y, p, sgn = -x, -y, -p, -1.0
-            sy = 1.0
-            if y < 0.0:  # mirror in y: Fy and Mz change sign
-                y, p, sy = -y, -p, -1.0
-            r = math.sqrt(x * x + y * y)
-            t = _TWO_PI * _atan_pos(r / R0)
-            # direction in [0, pi/2] (x, y >= 0 here)
-            if y <= x:
-                th = _atan_pos(y / x) if x > 0.0 else 0.0
-            else:
-                th = 0.5 * math.pi - _atan_pos(x / y)
-            u = _TWO_PI * (_atan_pos(p / S0) if p >= 0.0 else -_atan_pos(-p / S0))
-            it, wt = _locate_uniform(t, origin[1], inv_step[1], nt)
-            idd, wd = _locate_uniform(th, origin[2], inv_step[2], nd)
-            iu, wu = _locate_uniform(u, origin[3], inv_step[3], nu)
-            _cubic(it, wt, nt, it_, wt_)
-            _cubic(idd, wd, nd, id_, wd_)
-            _cubic(iu, wu, nu, iu_, wu_)
-            a0 = 0.0
-            a1 = 0.0
-            a2 = 0.0
-            for qt in range(4):
-                ft = wt_[qt]
-                if ft == 0.0:
-                    continue
-                bt = it_[qt] * nd
-                for qd in range(4):
-                    fd = ft * wd_[qd]
-                    if fd == 0.0:
-                        continue
-                    bd = (bt + id_[qd]) * nu
-                    s0 = 0.0
-                    s1 = 0.0
-                    s2 = 0.0
-                    for qu in range(4):
-                        w = wu_[qu]
-                        row = bd + iu_[qu]
-                        s0 += w * flat[row, 0]
-                        s1 += w * flat[row, 1]
-                        s2 += w * flat[row, 2]
-                    a0 += fd * s0
-                    a1 += fd * s1
-                    a2 += fd * s2
-            ft = math.sqrt(a0 * a0 + a1 * a1)
-            if ft > 1.0:  # Coulomb's bound
-                a0 /= ft
-                a1 /= ft
-            f = sgn * fac * _at(kf, k)
-            out[0, k] = f * a0
-            out[1, k] = f * sy * a1
-            out[2, k] = sgn * sy * fac * _at(km, k) * a2
-
-
-_interp_ser = numba.njit(cache=True, fastmath=True)(_interp_py)
-_interp_par = numba.njit(cache=True, fastmath=True, parallel=True)(_interp_py)
-_interp3_ser = numba.njit(cache=True, fastmath=True)(_interp3_py)
-_interp3_par = numba.njit(cache=True, fastmath=True, parallel=True)(_interp3_py)
+_catmull_rom_jit = njit(cache=True, error_model="numpy", inline="always")(_catmull_rom)
+_locate_jit = njit(cache=True, error_model="numpy", inline="always")(_locate_uniform)
 
 
 @lru_cache(maxsize=32)
 def _slice_at(laob: float) -> np.ndarray:
-    """The table interpolated (cubic, as in the kernel) to one log(a/b): rows of 3 outputs."""
+    """The table (with ghost nodes) interpolated cubically, as in the kernel, to one
+    log(a/b): a flat read-only array, layout of :func:`_load`'s ``padded`` without the a/b
+    axis."""
     d = _load()
     na = int(d["dims"][0])
-    ia, wa = _locate_uniform.py_func(laob, d["origin"][0], d["inv_step"][0], na)
-    ids = np.empty(4, np.int64)
-    wts = np.empty(4)
-    _cubic.py_func(ia, wa, na, ids, wts)
-    planes = d["flat"].reshape(na, -1, 3)
-    out = np.zeros_like(planes[0])
-    for i, w in zip(ids, wts, strict=True):
-        if w != 0.0:
-            out += w * planes[i]
-    out.flags.writeable = False
-    return out
+    ia, wa = _locate_uniform(laob, d["origin"][0], d["inv_step"][0], na)
+    planes = d["padded"]  # the a/b nodes ia - 1 .. ia + 2 are planes ia .. ia + 3
+    out = np.zeros(planes.shape[1:])
+    for q, w in enumerate(_catmull_rom(wa)):
+        out += w * planes[int(ia) + q]
+    return _read_only(out.reshape(-1))
+
+
+#: Values per table node in memory: Fx, Fy, Mz (rows padded to 4 were measured slower: the
+#: table is larger, and the lookup is bound by its memory accesses as much as by arithmetic).
+_NOUT = 3
+#: Contacts per chunk of the kernel (its scratch rows stay in the level-2 cache).
+_CHUNK = 512
+#: Contacts from which the lookup runs in parallel (as the package's Polach kernels).
+_PARALLEL_MIN = 100_000
+
+# Rows of the kernel's scratch array (shape (_ROWS, _CHUNK)): the Kalker-scaled creepages
+# (X, Y, S), turned in place into the table coordinates (t, theta, u); the signs of the
+# symmetries; the friction coefficient's factor and its inverse; the first table row of the
+# contact's 4^3 (or 4^4) nodes; the cubic weights along t, theta, u and log(a/b); the
+# interpolated outputs; scratch.
+_R_X, _R_Y, _R_S, _R_SGN, _R_SY, _R_FAC, _R_INV, _R_BASE = range(8)
+_R_WT, _R_WD, _R_WU, _R_WA = 8, 12, 16, 20
+_R_F0, _R_F1, _R_F2, _R_ARG, _R_TMP = range(24, 29)
+_ROWS = 29
+
+
+@intrinsic
+def _contract(typingctx, tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd2, wd3, wu0, wu1,
+              wu2, wu3):  # fmt: skip
+    """The cubic interpolation of one contact in a table of rows of _NOUT values:
+    sum over qt, qd, qu = 0..3 of wt[qt] wd[qd] wu[qu] tab[base + qt st + qd sd + _NOUT qu + j],
+    j = 0, 1, 2 (Fx, Fy, Mz). Written in LLVM vector operations: the 4 spin nodes of a
+    (t, theta) pair are 4 _NOUT contiguous doubles, loaded and accumulated as one vector
+    (numba does not vectorise such short fixed loops itself: they are unrolled before its
+    loop vectoriser runs, and its SLP vectoriser is off). The products are summed along
+    theta, then t, then u."""
+    f64 = types.float64
+    if not (isinstance(tab, types.Array) and tab.dtype == f64 and tab.ndim == 1
+            and tab.layout == "C" and all(isinstance(v, types.Integer) for v in (base, st, sd))
+            and all(w == f64 for w in (wt0, wt1, wt2, wt3, wd0, wd1, wd2, wd3, wu0, wu1, wu2,
+                                       wu3))):  # fmt: skip
+        return None
+    sig = types.UniTuple(f64, 3)(tab, base, st, sd, *([f64] * 12))
+
+    def codegen(context, builder, signature, args):
+        data = context.make_array(signature.args[0])(context, builder, args[0]).data
+        i64 = ir.IntType(64)
+        i32 = ir.IntType(32)
+        base_, st_, sd_ = (
+            context.cast(builder, v, t, types.int64)
+            for v, t in zip(args[1:4], signature.args[1:4], strict=True)
+        )
+        wt, wd, wu = args[4:8], args[8:12], args[12:16]
+        n = 4 * _NOUT
+        vrun = ir.VectorType(ir.DoubleType(), n)  # the 4 spin nodes of a (t, theta) pair
+        vnode = ir.VectorType(ir.DoubleType(), _NOUT)
+        flags = ("contract",)
+
+        def splat(x, vty, width):
+            v = builder.insert_element(ir.Constant(vty, ir.Undefined), x, ir.Constant(i32, 0))
+            mask = ir.Constant(ir.VectorType(i32, width), [0] * width)
+            return builder.shuffle_vector(v, ir.Constant(vty, ir.Undefined), mask)
+
+        acc = None
+        for qt in range(4):
+            row_t = builder.add(base_, builder.mul(st_, ir.Constant(i64, qt)))
+            part = None
+            for qd in range(4):
+                row = builder.add(row_t, builder.mul(sd_, ir.Constant(i64, qd)))
+                ptr = builder.bitcast(builder.gep(data, [row], inbounds=True), vrun.as_pointer())
+                term = builder.fmul(builder.load(ptr, align=8), splat(wd[qd], vrun, n),
+                                    flags=flags)  # fmt: skip
+                part = term if part is None else builder.fadd(part, term, flags=flags)
+            term = builder.fmul(part, splat(wt[qt], vrun, n), flags=flags)
+            acc = term if acc is None else builder.fadd(acc, term, flags=flags)
+        res = None
+        for qu in range(4):
+            mask = ir.Constant(ir.VectorType(i32, _NOUT), [_NOUT * qu + j for j in range(_NOUT)])
+            node = builder.shuffle_vector(acc, ir.Constant(vrun, ir.Undefined), mask)
+            term = builder.fmul(node, splat(wu[qu], vnode, _NOUT), flags=flags)
+            res = term if res is None else builder.fadd(res, term, flags=flags)
+        vals = [builder.extract_element(res, ir.Constant(i32, j)) for j in range(3)]
+        return context.make_tuple(builder, signature.return_type, vals)
+
+    return sig, codegen
+
+
+# Each stage below is one short loop over a chunk, with few arrays (few run-time aliasing
+# checks) and no float -> int conversion, so that it compiles to SIMD code (as the package's
+# Polach kernels, railadhesion.models.kernels).
+
+
+@njit(cache=True, error_model="numpy")
+def _friction_factor(xs, ys, lvs, las, lbs, rows, m):
+    """Falling friction: the coefficient's factor (1 - A) exp(-B V |(xi, eta)|) + A (Polach's
+    global slip velocity) and its inverse, into rows; 1 where A = 1 or B V = 0."""
+    fac, inv, arg, tmp = rows[_R_FAC], rows[_R_INV], rows[_R_ARG], rows[_R_TMP]
+    for k in range(m):
+        arg[k] = -(lbs[k] * lvs[k]) * math.sqrt(xs[k] * xs[k] + ys[k] * ys[k])
+    _exp_into(arg, fac, tmp, m)
+    for k in range(m):  # beyond _exp_into's range (exp(x) < 1e-304): libm's exp
+        if not arg[k] >= -700.0:
+            fac[k] = math.exp(arg[k])
+    for k in range(m):
+        ra = las[k]
+        falling = (ra != 1.0) & (lbs[k] * lvs[k] > 0.0)
+        fac[k] = (1.0 - ra) * fac[k] + ra if falling else 1.0
+    for k in range(m):
+        f = fac[k]
+        inv[k] = 1.0 / (f if f > 0.0 else 1.0) if f > 0.0 else 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _scaled(cs, factor, inv, out, m):
+    """out = cs factor inv (Kalker-scaled creepage of the looked-up coefficient)."""
+    for k in range(m):
+        out[k] = cs[k] * factor[k] * inv[k]
+
+
+@njit(cache=True, error_model="numpy")
+def _coordinates(rows, m):
+    """Kalker-scaled (X, Y, S) -> table coordinates (t, theta, u) in place, reflected into
+    X >= 0, Y >= 0 (point symmetry: all outputs change sign; mirror in y: Fy and Mz change
+    sign); the signs into their rows."""
+    xr, yr, pr, sgr, syr = rows[_R_X], rows[_R_Y], rows[_R_S], rows[_R_SGN], rows[_R_SY]
+    for k in range(m):
+        x = xr[k]
+        y = yr[k]
+        p = pr[k]
+        sgn = -1.0 if x < 0.0 else 1.0
+        x = sgn * x
+        y = sgn * y
+        p = sgn * p
+        sy = -1.0 if y < 0.0 else 1.0
+        y = sy * y
+        p = sy * p
+        r = math.sqrt(x * x + y * y)
+        xr[k] = _TWO_PI * _atan_nonneg(r / R0)
+        # direction in [0, pi/2] from the smaller over the larger of x, y (both >= 0 here)
+        hi = max(x, y)
+        lo = min(x, y)
+        a = _atan_nonneg(lo / (hi if hi > 0.0 else 1.0))
+        yr[k] = 0.5 * math.pi - a if y > x else a
+        u = _TWO_PI * _atan_nonneg(abs(p) / S0)
+        pr[k] = -u if p < 0.0 else u
+        sgr[k] = sgn
+        syr[k] = sy
+
+
+@njit(cache=True, error_model="numpy")
+def _weights(v, v0, inv_h, n, stride, base, w, m):
+    """Cubic weights along one axis into w[0..3]; the axis' part of the contact's first
+    table row (node index times ``stride``) added to base."""
+    w0, w1, w2, w3 = w[0], w[1], w[2], w[3]
+    for k in range(m):
+        i, f = _locate_jit(v[k], v0, inv_h, n)
+        c0, c1, c2, c3 = _catmull_rom_jit(f)
+        w0[k] = c0
+        w1[k] = c1
+        w2[k] = c2
+        w3[k] = c3
+        base[k] = base[k] + i * stride
+
+
+@njit(cache=True, error_model="numpy")
+def _gather(tab, rows, m, st, sd, sa):
+    """The interpolated outputs of each contact (sa > 0: also along log(a/b), the planes sa
+    apart)."""
+    base, f0, f1, f2 = rows[_R_BASE], rows[_R_F0], rows[_R_F1], rows[_R_F2]
+    wt, wd, wu, wa = rows[_R_WT:_R_WT + 4], rows[_R_WD:_R_WD + 4], rows[_R_WU:_R_WU + 4], \
+        rows[_R_WA:_R_WA + 4]  # fmt: skip
+    for k in range(m):
+        b = int(base[k])
+        if sa == 0:
+            a0, a1, a2 = _contract(tab, b, st, sd, wt[0, k], wt[1, k], wt[2, k], wt[3, k],
+                                   wd[0, k], wd[1, k], wd[2, k], wd[3, k], wu[0, k], wu[1, k],
+                                   wu[2, k], wu[3, k])  # fmt: skip
+        else:
+            a0 = 0.0
+            a1 = 0.0
+            a2 = 0.0
+            for qa in range(4):
+                s0, s1, s2 = _contract(tab, b + qa * sa, st, sd, wt[0, k], wt[1, k], wt[2, k],
+                                       wt[3, k], wd[0, k], wd[1, k], wd[2, k], wd[3, k],
+                                       wu[0, k], wu[1, k], wu[2, k], wu[3, k])  # fmt: skip
+                w = wa[qa, k]
+                a0 += w * s0
+                a1 += w * s1
+                a2 += w * s2
+        f0[k] = a0
+        f1[k] = a1
+        f2[k] = a2
+
+
+@njit(cache=True, error_model="numpy")
+def _cap(f0, f1, m):
+    """|(Fx, Fy)| / (mu Fz) capped at 1 (Coulomb's bound)."""
+    for k in range(m):
+        a0 = f0[k]
+        a1 = f1[k]
+        ft = math.sqrt(a0 * a0 + a1 * a1)
+        c = ft if ft > 1.0 else 1.0
+        f0[k] = a0 / c
+        f1[k] = a1 / c
+
+
+@njit(cache=True, error_model="numpy")
+def _forces(rows, kfs, kms, ox, oy, oz, m):
+    """Forces and moment from the normalised outputs: signs, mu Fz and mu Fz c scales."""
+    sgr, syr, fac = rows[_R_SGN], rows[_R_SY], rows[_R_FAC]
+    f0, f1, f2 = rows[_R_F0], rows[_R_F1], rows[_R_F2]
+    for k in range(m):
+        sgn = sgr[k]
+        sy = syr[k]
+        f = sgn * fac[k] * kfs[k]
+        ox[k] = f * f0[k]
+        oy[k] = f * sy * f1[k]
+        oz[k] = sgn * sy * fac[k] * kms[k] * f2[k]
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def _lookup_chunks(tab, dims, strides, origin, inv_step, laob, xi, eta, phi, kx, ky, ks, kf,
+                   km, lv, la, lb, out, first, last):  # fmt: skip
+    """Cubic (Catmull-Rom) interpolation, per axis, of the 3 outputs at Kalker-scaled
+    creepages, for the chunks ``first`` to ``last - 1`` (of _CHUNK contacts) of ``out``.
+
+    ``tab`` is the table with ghost nodes (:func:`_load`'s ``padded``, flat: rows of _NOUT
+    values, node (ia, it, id, iu), counting the ghosts, at row ``ia strides[0] + it
+    strides[1] + id strides[2] + iu strides[3]``, strides[3] = _NOUT), or its slice at one
+    a/b (:func:`_slice_at`; then ``laob`` is empty). The four axes (log a/b, t, theta, u)
+    have ``dims`` nodes (ghosts not counted), uniform, the first at ``origin`` and spaced
+    1/``inv_step``.
+
+    Inputs per contact (arrays of length n, or 1 for a value shared by all): log(a/b) (or
+    empty), the creepages xi, eta, phi and their factors to Kalker-scaled creepages kx, ky, ks
+    (``X = xi kx`` ...); the force and moment scales kf = mu Fz, km = mu Fz c. The
+    interpolated |(Fx, Fy)| is capped at mu Fz (the cubic may overshoot it by a few 0.1 %
+    near full sliding, the exact solution never does). Falling friction: speed lv, ratio la
+    and decay lb; the coefficient is mu ((1 - A) exp(-B V |(xi, eta)|) + A), which divides
+    the scaled creepages and multiplies the forces. ``out`` (3, n) receives Fx, Fy, Mz.
+
+    Stages per chunk (each a short loop, SIMD code): the friction factor, the scaled
+    creepages, the table coordinates, the weights and first row, the interpolation (LLVM
+    vector code, :func:`_contract`), the cap, the forces.
+    """
+    n = out.shape[1]
+    na, nt, nd, nu = dims[0], dims[1], dims[2], dims[3]
+    sa = strides[0] if laob.size > 0 else 0
+    st, sd, su = strides[1], strides[2], strides[3]
+    m0 = max(min(_CHUNK, n), 1)
+    single = np.empty((12, m0))  # values shared by all contacts, repeated over a chunk
+    for j, x in enumerate((laob, xi, eta, phi, kx, ky, ks, kf, km, lv, la, lb)):
+        _fill(single[j], x[0] if x.size > 0 else 0.0, m0)
+    rows = np.empty((_ROWS, m0))
+    # Coulomb friction for every contact (one test for the whole call)
+    coulomb = (
+        la.size == 1
+        and lb.size == 1
+        and lv.size == 1
+        and not (la[0] != 1.0 and lb[0] * lv[0] > 0.0)
+    )
+    if coulomb:
+        _fill(rows[_R_FAC], 1.0, m0)
+        _fill(rows[_R_INV], 1.0, m0)
+    for c in range(first, last):
+        lo = c * _CHUNK
+        hi = min(lo + _CHUNK, n)
+        m = hi - lo
+        xs = _chunk(xi, single[1], lo, hi)
+        ys = _chunk(eta, single[2], lo, hi)
+        if not coulomb:
+            _friction_factor(xs, ys, _chunk(lv, single[9], lo, hi),
+                             _chunk(la, single[10], lo, hi), _chunk(lb, single[11], lo, hi),
+                             rows, m)  # fmt: skip
+        inv = rows[_R_INV]
+        _scaled(xs, _chunk(kx, single[4], lo, hi), inv, rows[_R_X], m)
+        _scaled(ys, _chunk(ky, single[5], lo, hi), inv, rows[_R_Y], m)
+        _scaled(_chunk(phi, single[3], lo, hi), _chunk(ks, single[6], lo, hi), inv, rows[_R_S],
+                m)  # fmt: skip
+        _coordinates(rows, m)
+        base = rows[_R_BASE]
+        _fill(base, 0.0, m)
+        _weights(rows[_R_X], origin[1], inv_step[1], nt, st, base, rows[_R_WT : _R_WT + 4], m)
+        _weights(rows[_R_Y], origin[2], inv_step[2], nd, sd, base, rows[_R_WD : _R_WD + 4], m)
+        _weights(rows[_R_S], origin[3], inv_step[3], nu, su, base, rows[_R_WU : _R_WU + 4], m)
+        if sa > 0:
+            laobs = _chunk(laob, single[0], lo, hi)
+            _weights(laobs, origin[0], inv_step[0], na, sa, base, rows[_R_WA : _R_WA + 4], m)
+        _gather(tab, rows, m, st, sd, sa)
+        _cap(rows[_R_F0], rows[_R_F1], m)
+        _forces(rows, _chunk(kf, single[7], lo, hi), _chunk(km, single[8], lo, hi),
+                out[0, lo:hi], out[1, lo:hi], out[2, lo:hi], m)  # fmt: skip
 
 
 def _interp(d, laob, shape, xi, eta, phi, kx, ky, ks, kf, km, lv, la, lb):
     """Fx, Fy, Mz of the contacts (``shape``); every input broadcasts to ``shape``. One a/b
-    for all contacts (the usual case) is looked up in a 3-D slice of the table."""
+    for all contacts (the usual case) is looked up in a 3-D slice of the table.
+
+    From _PARALLEL_MIN contacts on, the chunks are split into tasks run by
+    ``numba.get_num_threads()`` Python threads (the kernel releases the GIL; the package's
+    pool, as Polach's kernels: handed out one by one, so that a thread held up on a busy
+    machine is balanced by the others)."""
     n = math.prod(shape)
 
-    def flat(v):  # length 1 (shared) or n; anything else is broadcast out
+    def flat(v):  # length 1 (shared) or n; anything else is broadcast out; read-only
         v = np.asarray(v, dtype=float)
         if v.size == 1:
-            return v.reshape(1)
-        if v.shape != shape:
-            v = np.broadcast_to(v, shape)
-        return np.ascontiguousarray(v).reshape(-1)
+            v = v.reshape(1)
+        else:
+            if v.shape != shape:
+                v = np.broadcast_to(v, shape)
+            v = np.ascontiguousarray(v).reshape(-1)
+        return _read_only(v)
 
     args = tuple(flat(v) for v in (xi, eta, phi, kx, ky, ks, kf, km, lv, la, lb))
     out = np.empty((3, n))
-    par = n >= _PARALLEL_MIN
     if laob.size == 1 or np.all(laob == laob.flat[0]):
-        table = _slice_at(float(laob.flat[0]))
-        kernel = _interp3_par if par else _interp3_ser
-        kernel(table, d["dims"], d["origin"], d["inv_step"], *args, out)
+        table, laobs = _slice_at(float(laob.flat[0])), _NO_AOB
     else:
-        kernel = _interp_par if par else _interp_ser
-        kernel(d["flat"], d["dims"], d["origin"], d["inv_step"], flat(laob), *args, out)
+        table, laobs = d["padded"].reshape(-1), flat(laob)
+    head = (table, d["dims"], d["strides"], d["origin"], d["inv_step"], laobs, *args, out)
+    nchunk = (n + _CHUNK - 1) // _CHUNK
+    nthreads = numba.get_num_threads() if n >= _PARALLEL_MIN else 1
+    if nthreads <= 1 or nchunk < 2:
+        _lookup_chunks(*head, 0, nchunk)
+    else:
+        ntask = min(nchunk, _TASKS_PER_THREAD * nthreads)
+        bounds = [nchunk * t // ntask for t in range(ntask + 1)]
+        pool = _thread_pool(nthreads)
+        tasks = [pool.submit(_lookup_chunks, *head, bounds[t], bounds[t + 1])
+                 for t in range(ntask)]  # fmt: skip
+        for task in tasks:
+            task.result()
     return out.reshape(3, *shape)
+
+
+_NO_AOB = _read_only(np.empty(0))
 
 
 def exact_table_forces(
@@ -515,6 +582,14 @@ def exact_table_forces(
     module docstring. |F| is capped at mu Fz (the cubic interpolation may overshoot it by
     up to about 0.4 % near full sliding). Accuracy against the exact solver:
     ``docs/validation/exact_models.md``.
+
+    **Cost** (``benchmarks/bench_exact.py --table``, 2-core machine shared with other jobs,
+    load average 1.1): with one a/b for all contacts, about 0.05 us per contact at 2e5
+    and 1e6 contacts with spin, 2.2-2.6 times the package's vectorised
+    :func:`~railadhesion.models.polach.polach_forces` on the same contacts, with Coulomb or
+    falling friction and at nu = 0.25 alike (1.7-3.3 times over five runs, with the load);
+    with a/b varying per contact about 0.6 us.
+    Parallel from 1e5 contacts (``numba.get_num_threads()`` threads).
 
     **Falling friction.** The exact solution with a slip-velocity dependent coefficient has
     a coefficient that varies over the contact with the local slip velocity; the table

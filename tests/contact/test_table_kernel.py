@@ -1,0 +1,101 @@
+"""The table model's compiled lookup against a plain NumPy evaluation of the same scheme, and its
+parallel path against its serial one (railadhesion.contact.table)."""
+
+import numpy as np
+import pytest
+
+from railadhesion.contact import kalker_coefficients
+from railadhesion.contact import table as tm
+
+G, MU, FZ = 8.2e10, 0.3, 1e5
+
+
+def _cubic_weights(v, nodes):
+    """Catmull-Rom weights (n, 4) and node indices (n, 4) along one uniform axis, the ghost
+    nodes beyond the ends folded into the end weights (f[-1] = 3 f0 - 3 f1 + f2, likewise at
+    the other end): the table's scheme (module docstring), written out independently."""
+    n = nodes.size
+    q = np.clip((v - nodes[0]) / (nodes[1] - nodes[0]), 0.0, n - 1.0)
+    i = np.minimum(np.floor(q), n - 2).astype(int)
+    w = q - i
+    wts = 0.5 * np.stack([-(w**3) + 2 * w**2 - w, 3 * w**3 - 5 * w**2 + 2,
+                          -3 * w**3 + 4 * w**2 + w, w**3 - w**2], axis=1)  # fmt: skip
+    ids = i[:, None] + np.arange(-1, 3)
+    full = np.zeros((v.size, n))  # weight of every node
+    rows = np.arange(v.size)[:, None]
+    inside = (ids >= 0) & (ids < n)
+    np.add.at(full, (np.broadcast_to(rows, ids.shape)[inside], ids[inside]), wts[inside])
+    lo = np.where(ids[:, 0] < 0, wts[:, 0], 0.0)
+    hi = np.where(ids[:, 3] > n - 1, wts[:, 3], 0.0)
+    full[:, :3] += lo[:, None] * np.array([3.0, -3.0, 1.0])
+    full[:, -3:] += hi[:, None] * np.array([1.0, -3.0, 3.0])
+    return full
+
+
+def _reference(xi, eta, phi, a, b, nu=0.28):
+    """Fx, Fy, Mz of the table model with Coulomb friction, in NumPy (np.arctan2 etc.)."""
+    d = tm._load()
+    aob = a / b
+    c = np.sqrt(a * b)
+    tau = MU * 1.5 / np.pi * FZ / (a * b * G)
+    k = kalker_coefficients(aob, nu)
+    f = 1.5 / np.pi / tau
+    x, y, s = xi * f * k.c11, eta * f * k.c22, phi * c * f * k.c23
+    sgn = np.where(x < 0, -1.0, 1.0)
+    x, y, s = sgn * x, sgn * y, sgn * s
+    sy = np.where(y < 0, -1.0, 1.0)
+    y, s = sy * y, sy * s
+    t = 2 / np.pi * np.arctan(np.hypot(x, y) / tm.R0)
+    th = np.arctan2(y, x)
+    u = 2 / np.pi * np.arctan(s / tm.S0)
+    wa = _cubic_weights(np.log(np.broadcast_to(aob, xi.shape)), np.log(d["aob"]))
+    wt = _cubic_weights(t, d["tmag"])
+    wd = _cubic_weights(th, d["theta"])
+    wu = _cubic_weights(u, d["uspin"])
+    out = np.einsum("na,nt,nd,nu,katdu->kn", wa, wt, wd, wu, d["values"], optimize=True)
+    ft = np.maximum(np.hypot(out[0], out[1]), 1.0)
+    return (sgn * MU * FZ * out[0] / ft, sgn * sy * MU * FZ * out[1] / ft,
+            sgn * sy * MU * FZ * c * out[2])  # fmt: skip
+
+
+@pytest.mark.parametrize("shared_aob", [True, False])
+def test_lookup_matches_a_numpy_evaluation_of_the_scheme(shared_aob):
+    rng = np.random.default_rng(3)
+    n = 3000
+    aob = 1.3 if shared_aob else np.exp(rng.uniform(np.log(0.2), np.log(5.0), n))
+    a, b = 6e-3 * np.sqrt(aob), 6e-3 / np.sqrt(aob)
+    tau = MU * 1.5 / np.pi * FZ / (a * b * G)
+    c = np.sqrt(a * b)
+    # normalised creepage and spin over the whole table (to the infinite last nodes)
+    r = 10 ** rng.uniform(-4, 4, n)
+    th = rng.uniform(-np.pi, np.pi, n)
+    ph = np.sign(rng.uniform(-1, 1, n)) * 10 ** rng.uniform(-4, 4, n) * (rng.random(n) < 0.9)
+    xi, eta, phi = r * np.cos(th) * tau, r * np.sin(th) * tau, ph * tau / c
+    fx, fy, mz = tm.exact_table_forces(xi, eta, phi, FZ, a, b, MU)
+    rx, ry, rz = _reference(xi, eta, phi, a, b)
+    # the arctan of the kernel is libm's to an ulp: differences are rounding
+    assert np.abs(fx - rx).max() < 1e-9 * MU * FZ
+    assert np.abs(fy - ry).max() < 1e-9 * MU * FZ
+    assert (np.abs(mz - rz) / (MU * FZ * c)).max() < 1e-9
+
+
+@pytest.mark.parametrize("shared_aob", [True, False])
+def test_parallel_lookup_equals_serial(monkeypatch, shared_aob):
+    rng = np.random.default_rng(5)
+    n = 5000  # ten chunks: several tasks per thread
+    xi = rng.uniform(-3e-3, 3e-3, n)
+    eta = rng.uniform(-3e-3, 3e-3, n)
+    phi = rng.uniform(-1, 1, n)
+    b = 6e-3 if shared_aob else rng.uniform(3e-3, 9e-3, n)
+    speed = rng.uniform(0.0, 40.0, n)
+    law = dict(speed=speed, friction_ratio=0.4, friction_decay=0.6)
+    serial = tm.exact_table_forces(xi, eta, phi, FZ, 5e-3, b, MU, **law)
+    monkeypatch.setattr(tm, "_PARALLEL_MIN", 1)
+    monkeypatch.setattr(tm.numba, "get_num_threads", lambda: 2)
+    parallel = tm.exact_table_forces(xi, eta, phi, FZ, 5e-3, b, MU, **law)
+    for s, p in zip(serial, parallel, strict=True):
+        np.testing.assert_array_equal(s, p)
+    # a single contact (a/b then shared: the 3-D lookup) agrees to rounding
+    one = tm.exact_table_forces(xi[0], eta[0], phi[0], FZ, 5e-3, np.atleast_1d(b)[0], MU,
+                                speed=speed[0], friction_ratio=0.4, friction_decay=0.6)  # fmt: skip
+    assert one == pytest.approx([v[0] for v in serial], rel=1e-12, abs=1e-9)
