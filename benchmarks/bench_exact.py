@@ -21,6 +21,7 @@ Timings vary with the load of the machine: quote medians and ratios, with ``upti
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import platform
 import statistics
@@ -62,6 +63,32 @@ def bench_solver(repeat: int) -> None:
 def bench_table(repeat: int) -> None:
     for n in (200_000, 1_000_000):
         _bench_table(n, repeat)
+    bench_table_scalar(repeat)
+
+
+def bench_table_scalar(repeat: int, calls: int = 20_000) -> None:
+    """One contact per call with Python floats (the fast scalar path), beside Polach's."""
+    args = (1e-3, 2e-4, 0.3, 1e5)
+    table = [exact_table_forces(*args, 5e-3, 6e-3, 0.3),
+             exact_table_forces(*args, 5e-3, 6e-3, 0.3, **FALLING)]  # fmt: skip
+    assert all(math.isfinite(x) for r in table for x in r)
+
+    def per_call(fn):
+        fn()
+        out = []
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            for _ in range(calls):
+                fn()
+            out.append((time.perf_counter() - t0) / calls)
+        return statistics.median(out)
+
+    tt = per_call(lambda: exact_table_forces(*args, 5e-3, 6e-3, 0.3))
+    tf = per_call(lambda: exact_table_forces(*args, 5e-3, 6e-3, 0.3, **FALLING))
+    tp = per_call(lambda: polach_forces(*args, 30.0, 5e-3, 6e-3, mu0=0.3))
+    print(f"\none contact per call, Python floats (median of {repeat} x {calls:,} calls): "
+          f"table {tt * 1e6:.1f} us (falling friction {tf * 1e6:.1f} us), "
+          f"polach_forces {tp * 1e6:.1f} us")
 
 
 def _bench_table(n: int, repeat: int) -> None:

@@ -179,3 +179,43 @@ def test_poisson_outside_the_range_is_refused(nu):
     a, b, _ = _contact(1.0)
     with pytest.raises(ValueError, match=r"poisson must be in \[0.25, 0.3\]"):
         exact_table_forces(0.001, 0.0, 0.0, FZ, a, b, MU, poisson=nu)
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    xi=st.floats(-0.02, 0.02), eta=st.floats(-0.02, 0.02), phi=st.floats(-5.0, 5.0),
+    log_aob=st.floats(math.log(0.2), math.log(5.0)), nu=st.floats(0.25, 0.30),
+    falling=st.booleans(),
+)  # fmt: skip
+def test_scalar_path_equals_the_array_path(xi, eta, phi, log_aob, nu, falling):
+    """Python floats take a fast path (checks in plain Python, one compiled call on the 4-D
+    table); arrays take the vectorised path (3-D slice at the shared a/b). Same numbers."""
+    b = 5e-3
+    a = b * math.exp(log_aob)
+    kw = {"poisson": nu}
+    if falling:
+        kw |= {"speed": 30.0, "friction_ratio": 0.4, "friction_decay": 0.6}
+    scalar = exact_table_forces(xi, eta, phi, 1e5, a, b, 0.3, **kw)
+    assert all(type(v) is float for v in scalar)
+    vector = exact_table_forces(np.array([xi, 0.0]), eta, phi, 1e5, a, b, 0.3, **kw)
+    scale = (0.3e5, 0.3e5, 0.3e5 * math.sqrt(a * b))
+    for s, v, q in zip(scalar, vector, scale, strict=True):
+        assert abs(s - v[0]) <= 1e-12 * q
+
+
+@pytest.mark.parametrize(
+    ("args", "kw", "name"),
+    [
+        ((math.nan, 0.0, 0.0, 1e5, 6e-3, 5e-3, 0.3), {}, "creep_long"),
+        ((1e-3, 0.0, 0.0, -1.0, 6e-3, 5e-3, 0.3), {}, "normal_force"),
+        ((1e-3, 0.0, 0.0, 1e5, 6e-3, 0.0, 0.3), {}, "b"),
+        ((1e-3, 0.0, 0.0, 1e5, 6e-3, 5e-3, 0.3), {"poisson": 0.35}, "poisson"),
+        ((1e-3, 0.0, 0.0, 1e5, 6e-2, 5e-3, 0.3), {}, "a/b"),
+        ((1e-3, 0.0, 0.0, 1e5, 6e-3, 5e-3, 0.3), {"friction_ratio": 0.4, "friction_decay": 0.6},
+         "speed"),
+        ((1e-3, 0.0, 0.0, 1e5, 6e-3, 5e-3, 0.3), {"speed": -1.0}, "speed"),
+    ],
+)  # fmt: skip
+def test_scalar_inputs_are_checked_as_arrays_are(args, kw, name):
+    with pytest.raises(ValueError, match=name):
+        exact_table_forces(*args, **kw)
