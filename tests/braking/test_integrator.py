@@ -214,10 +214,15 @@ def test_numba_adhesion_function_runs_compiled_with_the_python_path_numbers():
 def test_stale_layout_cache_is_purged(tmp_path):
     """The kernels freeze _layout's constants at compile time while numba keys its cache on
     _kernels.py alone: cached code built against another layout must be dropped."""
+    from railadhesion._jit import source_checksum
     from railadhesion.braking import _kernels as kern
     from railadhesion.braking import _layout
+    from railadhesion.models import kernels as models_kernels
 
-    assert kern._compiled_layout_fingerprint() == _layout.fingerprint()
+    # the cached code was built with the current layout and models.kernels source
+    current = _layout.fingerprint() ^ source_checksum(models_kernels)
+    assert kern._LAYOUT_FINGERPRINT == current
+    assert kern._compiled_layout_fingerprint() == current
     names = ["_kernels.step-1072.py311.nbi", "_kernels.step-1072.py311.1.nbc",
              "_kernels._advance-918.py311.nbi", "simulator.cpython-311.pyc",
              "kernels.polach-10.py311.nbi"]

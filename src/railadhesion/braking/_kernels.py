@@ -37,12 +37,14 @@ the lane loop vectorises.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 from llvmlite import ir
 from numba import njit, types
 from numba.core.extending import intrinsic
 
+from railadhesion._jit import guard_cache, purge_module_cache, source_checksum
 from railadhesion.braking._layout import (  # noqa: F401 (numba reads them as constants)
     AVAIL_ON_,
     BAD_COMMAND,
@@ -197,6 +199,7 @@ from railadhesion.braking._layout import (  # noqa: F401 (numba reads them as co
     X_,
 )
 from railadhesion.braking._layout import fingerprint as _layout_checksum
+from railadhesion.models import kernels as _models_kernels
 from railadhesion.models.kernels import _factors as _wilac_factors
 from railadhesion.models.kernels import _weights as _wilac_weights
 
@@ -1217,11 +1220,12 @@ def available(buf, work):
 
 # --------------------------------------------------------------------------------------------
 # Stale-cache guard: numba keys its cache on this file alone, but the kernels freeze the
-# constants of ``_layout.py`` at compile time. The layout's checksum is compiled in too; if
-# the cached value differs from the current one, every cache entry of this module is dropped
-# (before any other kernel is loaded) so that the kernels compile afresh.
+# constants of ``_layout.py`` at compile time and inline njit helpers of
+# ``railadhesion.models.kernels``. A checksum of both is compiled in too; if the cached value
+# differs from the current one, every cache entry of this module is dropped (before any other
+# kernel is loaded) so that the kernels compile afresh (railadhesion._jit.guard_cache).
 
-_LAYOUT_FINGERPRINT = _layout_checksum()
+_LAYOUT_FINGERPRINT = _layout_checksum() ^ source_checksum(_models_kernels)
 
 
 @njit(cache=True)
@@ -1232,17 +1236,7 @@ def _compiled_layout_fingerprint():
 def purge_stale_cache(cache_dir, compiled: int, current: int) -> list:
     """Delete this module's numba cache files in ``cache_dir`` if ``compiled`` (the checksum
     the cached code was built with) differs from ``current``; return the deleted paths."""
-    from pathlib import Path
-
-    if compiled == current:
-        return []
-    gone = []
-    for path in Path(cache_dir).glob(f"{Path(__file__).stem}.*.nb[ic]"):
-        path.unlink(missing_ok=True)
-        gone.append(path)
-    return gone
+    return purge_module_cache(cache_dir, Path(__file__).stem, compiled, current)
 
 
-if purge_stale_cache(_compiled_layout_fingerprint._cache._cache_path,
-                     _compiled_layout_fingerprint(), _LAYOUT_FINGERPRINT):
-    _compiled_layout_fingerprint.recompile()
+guard_cache(_compiled_layout_fingerprint, __file__, _LAYOUT_FINGERPRINT)

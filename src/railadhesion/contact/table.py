@@ -33,6 +33,7 @@ table is first interpolated to that a/b and the lookup is 3-D.
 from __future__ import annotations
 
 import math
+import sys
 from functools import lru_cache
 from importlib import resources
 
@@ -42,6 +43,7 @@ from llvmlite import ir
 from numba import njit, types
 from numba.extending import intrinsic
 
+from railadhesion import _jit
 from railadhesion._validate import (
     as_float_array,
     check_finite,
@@ -61,6 +63,19 @@ from railadhesion.models.kernels import (
 from railadhesion.models.kernels import kalker_scalar as _kalker_scalar
 
 __all__ = ["exact_table_forces", "table_axes"]
+
+# The kernels below inline njit helpers of railadhesion.models.kernels, which numba's cache of
+# this file does not track: a checksum of that module is compiled in, and a mismatch drops
+# this module's cached code (railadhesion._jit.guard_cache).
+_DEPENDENCY_FINGERPRINT = _jit.source_checksum(sys.modules["railadhesion.models.kernels"])
+
+
+@njit(cache=True)
+def _compiled_dependency_fingerprint():
+    return _DEPENDENCY_FINGERPRINT
+
+
+_jit.guard_cache(_compiled_dependency_fingerprint, __file__, _DEPENDENCY_FINGERPRINT)
 
 #: Poisson's ratio of the table.
 TABLE_POISSON = 0.28
