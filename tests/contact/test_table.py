@@ -20,17 +20,22 @@ def _contact(aob, c=6e-3):
     return a, b, tau
 
 
-def test_table_reproduces_solver_on_its_grid_between_nodes():
-    # interpolation error only: the solver on the table's own 20 x 20 grid, random cases over
-    # a/b, creep direction and magnitude, spin (issue 12 target: 0.01 muQ median, 0.03 max)
-    rng = np.random.default_rng(7)
-    n = 24
+def _random_cases(seed, n=24):
+    """Random contacts over the table's range: a/b 0.2-5 (log-uniform), creepage magnitude
+    0-3 mu p0/G in any direction, spin +-4 mu p0/(G c) on 70 % of them."""
+    rng = np.random.default_rng(seed)
     aob = np.exp(rng.uniform(np.log(0.2), np.log(5.0), n))
     a, b, tau = _contact(aob)
     r = rng.uniform(0, 3, n)
     th = rng.uniform(-np.pi, np.pi, n)
     ph = rng.uniform(-4, 4, n) * (rng.random(n) < 0.7)
-    xi, eta, phi = r * np.cos(th) * tau, r * np.sin(th) * tau, ph * tau / np.sqrt(a * b)
+    return a, b, r * np.cos(th) * tau, r * np.sin(th) * tau, ph * tau / np.sqrt(a * b)
+
+
+def test_table_reproduces_solver_on_its_grid_between_nodes():
+    # interpolation error only: the solver on the table's own 20 x 20 grid, random cases over
+    # a/b, creep direction and magnitude, spin (issue 12 target: 0.01 muQ median, 0.03 max)
+    a, b, xi, eta, phi = _random_cases(seed=7)
     fx, fy, _ = exact_table_forces(xi, eta, phi, FZ, a, b, MU, kalker_correction=False)
     ex = exact_rolling(xi, eta, phi, FZ, a, b, MU, nx=20, ny=20)
     err = np.hypot(fx - ex.fx, fy - ex.fy) / (MU * FZ)
@@ -153,14 +158,7 @@ def test_poisson_range_against_the_solver(nu):
     # solver at nu on the table's grid (random cases with spin). Over 135 cases at 40 x 40:
     # median <= 0.004 muQ, max 0.026 (nu = 0.25) and 0.032 (nu = 0.30), as at 0.28
     # (docs/validation/exact_models.md)
-    rng = np.random.default_rng(11)
-    n = 24
-    aob = np.exp(rng.uniform(np.log(0.2), np.log(5.0), n))
-    a, b, tau = _contact(aob)
-    r = rng.uniform(0, 3, n)
-    th = rng.uniform(-np.pi, np.pi, n)
-    ph = rng.uniform(-4, 4, n) * (rng.random(n) < 0.7)
-    xi, eta, phi = r * np.cos(th) * tau, r * np.sin(th) * tau, ph * tau / np.sqrt(a * b)
+    a, b, xi, eta, phi = _random_cases(seed=11)
     fx, fy, _ = exact_table_forces(xi, eta, phi, FZ, a, b, MU, poisson=nu,
                                    kalker_correction=False)  # fmt: skip
     ex = exact_rolling(xi, eta, phi, FZ, a, b, MU, nx=20, ny=20, poisson=nu)

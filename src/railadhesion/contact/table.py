@@ -33,7 +33,6 @@ table is first interpolated to that a/b and the lookup is 3-D.
 from __future__ import annotations
 
 import math
-import sys
 from functools import lru_cache
 from importlib import resources
 
@@ -52,6 +51,7 @@ from railadhesion._validate import (
 )
 from railadhesion.contact.exact import _check_friction_law
 from railadhesion.contact.kalker import kalker_coefficients
+from railadhesion.models import kernels as _models_kernels
 from railadhesion.models.kernels import (
     _TASKS_PER_THREAD,
     _atan_nonneg,
@@ -67,7 +67,7 @@ __all__ = ["exact_table_forces", "table_axes"]
 # The kernels below inline njit helpers of railadhesion.models.kernels, which numba's cache of
 # this file does not track: a checksum of that module is compiled in, and a mismatch drops
 # this module's cached code (railadhesion._jit.guard_cache).
-_DEPENDENCY_FINGERPRINT = _jit.source_checksum(sys.modules["railadhesion.models.kernels"])
+_DEPENDENCY_FINGERPRINT = _jit.source_checksum(_models_kernels)
 
 
 @njit(cache=True)
