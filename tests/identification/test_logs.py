@@ -180,3 +180,19 @@ def test_parquet_without_pyarrow_is_a_clear_error(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "pyarrow.parquet", None)  # import fails
     with pytest.raises(ValueError, match="needs pyarrow"):
         read_braking_log(tmp_path / "a.parquet")
+
+
+def test_columns_that_collide_after_stripping_spaces_are_an_error(tmp_path):
+    """' wheel_speed_1' and 'wheel_speed_1' name the same channel: which one is meant would be
+    a guess, so the reader refuses (CSV, Parquet and frames alike) rather than keep one."""
+    df = clean_frame()
+    df.insert(len(df.columns), " wheel_speed_1", df["wheel_speed_1"] + 1.0)
+    with pytest.raises(ValueError, match=r"columns \d+ and \d+ are both named 'wheel_speed_1'"):
+        braking_log_from_frame(df)
+    df.to_csv(tmp_path / "dup.csv", index=False)
+    with pytest.raises(ValueError, match="both named 'wheel_speed_1'"):
+        read_braking_log(tmp_path / "dup.csv")
+    pytest.importorskip("pyarrow")
+    df.to_parquet(tmp_path / "dup.parquet")
+    with pytest.raises(ValueError, match="both named 'wheel_speed_1'"):
+        read_braking_log(tmp_path / "dup.parquet")

@@ -226,14 +226,26 @@ def braking_log_from_frame(
         No ``time`` or ``train_speed`` column, no axle channel, fewer than 3 usable rows.
     """
     names = [str(c).strip() for c in frame.columns]
-    columns = {}
-    for name, col in zip(names, frame.columns, strict=True):
-        columns.setdefault(name, col)
+    _check_unique(names, source)
+    columns = dict(zip(names, frame.columns, strict=True))
     return _log_from_columns(
         names, lambda name: frame[columns[name]], len(frame), source=source,
         max_fill=max_fill, gap_factor=gap_factor, stuck_time=stuck_time,
         stuck_pressure_time=stuck_pressure_time, warn=warn, stacklevel=4,
     )
+
+
+def _check_unique(names, source) -> None:
+    """ValueError if two columns have the same name once surrounding spaces are stripped (which
+    one is the channel would be a guess)."""
+    seen: dict[str, int] = {}
+    for k, name in enumerate(names):
+        if name in seen:
+            raise ValueError(
+                f"{source}: columns {seen[name] + 1} and {k + 1} are both named {name!r} "
+                "(after stripping spaces): keep one"
+            )
+        seen[name] = k
 
 
 def _as_float(col, name, rows, issues):
@@ -456,9 +468,8 @@ def _read_parquet(path: Path):
         ) from None
     table = pq.read_table(path)
     names = [str(c).strip() for c in table.column_names]
-    index = {}
-    for k, name in enumerate(names):
-        index.setdefault(name, k)
+    _check_unique(names, path)
+    index = {name: k for k, name in enumerate(names)}
 
     def get(name):
         col = table.column(index[name])
