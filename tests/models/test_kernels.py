@@ -413,3 +413,20 @@ def test_read_only_and_writeable_inputs_share_one_compiled_kernel():
     for sig in kernels._batch_chunks.signatures:
         inputs = [t for i, t in enumerate(sig) if i not in (16, 17) and hasattr(t, "mutable")]
         assert not any(t.mutable for t in inputs), sig
+
+
+def test_polach_contact_recomputes_everything_when_an_input_changes():
+    """Setting an input (here a, then poisson) gives the forces of a new contact with those
+    inputs (Kalker's coefficients recomputed), bad values are refused as by the constructor,
+    and derived values cannot be set."""
+    from railadhesion.models.polach import PolachContact, polach_forces
+
+    c = PolachContact(1e5, 20.0, 6e-3, 5e-3, mu0=0.3)
+    c.a = 12e-3
+    c.poisson = 0.25
+    expected = polach_forces(0.002, 0.003, 0.1, 1e5, 20.0, 12e-3, 5e-3, mu0=0.3, poisson=0.25)
+    np.testing.assert_allclose(c.forces(0.002, 0.003, 0.1), expected, rtol=1e-12)
+    with pytest.raises(ValueError, match="mu0"):
+        c.mu0 = -1.0
+    with pytest.raises(AttributeError, match="c11"):
+        c.c11 = 1.0

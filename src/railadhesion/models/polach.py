@@ -587,10 +587,24 @@ class PolachContact:
             self.k_A, self.k_S, self.mu0, self.A, self.B,
         ]))  # fmt: skip
 
+    _INPUTS = ("normal_force", "speed", "a", "b", "mu0", "k_A", "k_S", "A", "B",
+               "shear_modulus", "poisson")  # fmt: skip
+
     def __setattr__(self, name, value) -> None:
-        object.__setattr__(self, name, value)
-        if hasattr(self, "_data"):  # a changed public value
-            self._refresh()
+        if not hasattr(self, "_data"):  # being built by __init__
+            object.__setattr__(self, name, value)
+            return
+        if name not in self._INPUTS:
+            raise AttributeError(f"PolachContact.{name} is derived from the contact's inputs "
+                                 f"({', '.join(self._INPUTS)}): set those")  # fmt: skip
+        # a changed input: validated and everything derived from it (Kalker's coefficients,
+        # the kernel's data) recomputed, as by the constructor
+        values = {k: getattr(self, k) for k in self._INPUTS}
+        values[name] = value
+        q, v, a, b = (values.pop(k) for k in ("normal_force", "speed", "a", "b"))
+        fresh = PolachContact(q, v, a, b, **values)
+        for k in self.__slots__:
+            object.__setattr__(self, k, getattr(fresh, k))
 
     def __repr__(self) -> str:
         return (f"PolachContact(normal_force={self.normal_force!r}, speed={self.speed!r}, "
