@@ -239,6 +239,8 @@ def _eval_lanes(work, n, nl, v):
         work[LA_S, j] = abs(work[R_XI, int(work[LA_AX, j])])
     for j in range(nl):  # exp(-B s V): polynomial part and the shifter
         x = max(-work[LA_B, j] * work[LA_S, j] * v, -700.0)
+        x = x if x <= 700.0 else math.nan  # exp overflows (negative trial speed): NaN, as
+        # math.exp's inf gives in the reference, never wrapped exponent bits
         k = x * _LOG2E + _SHIFTER
         kk = k - _SHIFTER
         r = (x - kk * _LN2_HI) - kk * _LN2_LO
