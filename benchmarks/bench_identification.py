@@ -42,7 +42,7 @@ from railadhesion.identification import (
     identify_adhesion,
     read_braking_log,
 )
-from railadhesion.identification.braking import _worker_count
+from railadhesion.identification.brake_tests import _worker_count
 from railadhesion.identification.pipeline import run_identification
 
 PERIOD = 2.4e-3

@@ -489,7 +489,7 @@ def fit_adhesion_curves(ident, *, slip: str = "absolute", speed_bands=None, phas
     Parameters
     ----------
     ident : BrakingIdentification
-        From :func:`~railadhesion.identification.braking.identify_adhesion` (its ``speed``,
+        From :func:`~railadhesion.identification.brake_tests.identify_adhesion` (its ``speed``,
         ``slip`` or ``relative_slip``, ``mu``, ``use`` and ``phase`` arrays).
     slip : {"absolute", "relative"}
         Fit against the absolute slip [m/s] or the relative slip [-].

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from railadhesion.identification.braking import _worker_count, identify_adhesion
+from railadhesion.identification.brake_tests import _worker_count, identify_adhesion
 from railadhesion.identification.curves import band_statistics, fit_adhesion_curves
 from railadhesion.identification.logs import BrakingLog, read_braking_log
 from railadhesion.identification.signals import VEHICLE_CUTOFF, WHEEL_CUTOFF

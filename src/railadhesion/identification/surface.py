@@ -102,7 +102,7 @@ def adhesion_surface(ident, *, speed_edges=None, slip_edges=None, slip: str = "a
     Parameters
     ----------
     ident : BrakingIdentification
-        From :func:`~railadhesion.identification.braking.identify_adhesion`.
+        From :func:`~railadhesion.identification.brake_tests.identify_adhesion`.
     speed_edges : array_like, optional
         Cell edges in speed [m/s]; default 0, 1, ..., 40 (the paper's 40 cells).
     slip_edges : array_like, optional

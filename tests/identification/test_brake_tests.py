@@ -6,7 +6,7 @@ import pandas as pd
 import pytest
 
 from railadhesion.braking import Vehicle
-from railadhesion.identification.braking import identify_adhesion
+from railadhesion.identification.brake_tests import identify_adhesion
 from railadhesion.identification.curves import fit_adhesion_curves
 from railadhesion.identification.logs import braking_log_from_frame
 
