@@ -51,8 +51,8 @@ from railadhesion.identification.signals import (
     VEHICLE_CUTOFF,
     WHEEL_CUTOFF,
     FirstOrderFilter,
-    _gradient_weighted,
     gradient_coefficients,
+    gradient_weighted,
 )
 
 __all__ = [
@@ -539,19 +539,17 @@ def _axle_adhesion(i, wd, p, slip, v, d, wheel, train, valid, substituted, edge,
         rel[k, i] = slip[k, i] / v[k] if fast else np.nan
         use[k, i] = (valid[k, i] and not substituted and fast and wheel[k, i] * r > 0.05 * vr
                      and np.isfinite(x) and not edge[k])
+    finite = np.empty(n)  # the relative slip with NaN read as 0 (numpy.nan_to_num)
+    for k in range(n):
+        finite[k] = _finite(rel[k, i])
     for q in range(seg_a.size):
         a = seg_a[q]
         b = seg_b[q]
         if b - a < 2:
             for k in range(a, b):
                 rel_rate[k, i] = 0.0
-            continue
-        rel_rate[a, i] = (_finite(rel[a + 1, i]) - _finite(rel[a, i])) / (t[a + 1] - t[a])
-        rel_rate[b - 1, i] = (_finite(rel[b - 1, i]) - _finite(rel[b - 2, i])) / (
-            t[b - 1] - t[b - 2])
-        for k in range(a + 1, b - 1):
-            rel_rate[k, i] = (gc[0, k] * _finite(rel[k - 1, i]) + gc[1, k] * _finite(rel[k, i])
-                              + gc[2, k] * _finite(rel[k + 1, i]))
+        else:
+            gradient_weighted(finite, t, gc, a, b, rel_rate[a:b, i], 1.0)
     for k in range(n):
         if not v[k] >= min_speed:
             rel_rate[k, i] = np.nan
@@ -741,7 +739,7 @@ def _identify(log, vehicle, pool, step, filter_mode, vehicle_cutoff, wheel_cutof
 
         def vehicle_job(a=a, b=b, slow=slow, fast=fast):
             buf = scratch(0, b - a)
-            _gradient_weighted(train, t, gc, a, b, buf, -1.0)  # d = -dv/dt
+            gradient_weighted(train, t, gc, a, b, buf, -1.0)  # d = -dv/dt
             slow.apply(buf, d_f[a:b])
             fast.apply(train[a:b], v_f[a:b])
 
@@ -749,19 +747,19 @@ def _identify(log, vehicle, pool, step, filter_mode, vehicle_cutoff, wheel_cutof
             ws, ps = scratch(0, b - a), scratch(1, b - a)
             _column_sums(wheel, press, a, b, ws, ps)
             slow.apply(ps, psum[a:b])
-            _gradient_weighted(ws, t[a:b], gc[:, a:b], 0, b - a, ps, 1.0)
+            gradient_weighted(ws, t[a:b], gc[:, a:b], 0, b - a, ps, 1.0)
             slow.apply(ps, jsum[a:b])
 
         def axle_job(i, a=a, b=b, fast=fast):
             w = wheel[:, i]
             buf = scratch(0, b - a)
-            _gradient_weighted(w, t, gc, a, b, buf, 1.0)
+            gradient_weighted(w, t, gc, a, b, buf, 1.0)
             fast.apply(buf, wd2[a:b, i])
             fast.apply(press[a:b, i], p2[a:b, i])
             np.multiply(w[a:b], r, out=buf)
             np.subtract(train[a:b], buf, out=buf)
             fast.apply(buf, slip[a:b, i])
-            _gradient_weighted(slip[:, i], t, gc, a, b, slip_rate[a:b, i], 1.0)
+            gradient_weighted(slip[:, i], t, gc, a, b, slip_rate[a:b, i], 1.0)
 
         jobs += [vehicle_job, eq14_job] + [partial(axle_job, i) for i in range(n_ax)]
     _run_jobs(pool, jobs)
