@@ -59,6 +59,7 @@ __all__ = [
     "BrakeCoefficient",
     "BrakingIdentification",
     "brake_coefficient",
+    "brake_coefficient_per_sample",
     "identify_adhesion",
     "identification_windows",
 ]
@@ -285,10 +286,11 @@ def brake_coefficient(
 
     Notes
     -----
-    Eq. 14 (seed 002), from the vehicle's translation (eq. 8) and each wheelset's rotation
-    (eq. 6): ``c = (M_tot d - sum_i J w_dot_i / R) / (sum_i p_i / R)``. The running resistance
-    ``F_res(v)`` of the vehicle, when given, is subtracted from ``M_tot d`` (the paper neglects
-    it). Valid while every wheel turns (a locked wheel's brake torque is not ``c p``).
+    Eq. 14 (seed 002) at every sample is :func:`brake_coefficient_per_sample`, with the sums
+    over the axles of the angular accelerations and pressures. The running resistance
+    ``F_res(v)`` of the vehicle, when given with ``speed``, is subtracted from ``M_tot d`` (the
+    paper neglects it). Valid while every wheel turns (a locked wheel's brake torque is not
+    ``c p``).
 
     Examples
     --------
@@ -308,26 +310,76 @@ def brake_coefficient(
     1.0
     """
     t = np.asarray(time, dtype=float)
-    d = np.asarray(deceleration, dtype=float)
     wd = np.asarray(angular_acceleration, dtype=float)
     p = np.asarray(pressure, dtype=float)
-    r = float(vehicle.wheel_radius)
-    j = float(vehicle.wheelset_inertia)
-    force = float(vehicle.total_mass) * d - j * wd.sum(axis=1) / r
+    resistance = None
     if speed is not None and hasattr(vehicle, "running_resistance"):
-        force = force - np.asarray(vehicle.running_resistance(np.asarray(speed, float)))
+        resistance = vehicle.running_resistance(np.asarray(speed, float))
     ok = np.ones(t.size, bool) if mask is None else np.asarray(mask, bool).copy()
-    return _brake_from_force(t, force, p.sum(axis=1) / r, p.mean(axis=1), ok, min_pressure)
+    return _brake_window(t, deceleration, wd.sum(axis=1), p.sum(axis=1), p.mean(axis=1),
+                         vehicle, resistance, ok, min_pressure)
 
 
-def _brake_from_force(t, force, psum, pmean, ok, min_pressure):
-    """Eq. 14 from its numerator (``M_tot d - F_res - sum J w_dot / R``) and denominator
-    (``sum p / R``) per sample, the mean pressure and the allowed samples."""
-    applied = pmean >= max(float(min_pressure), 1e-9)
-    c = np.full(t.size, np.nan)
-    c[applied] = force[applied] / psum[applied]
-    top = np.max(pmean[ok & applied]) if np.any(ok & applied) else np.inf
-    window = ok & applied & (pmean >= 0.5 * top) & np.isfinite(c)
+def brake_coefficient_per_sample(deceleration, wheel_acceleration_sum, pressure_sum, vehicle, *,
+                                 resistance=None, where=None):
+    """Eq. 14 of seed 002: the brake coefficient c at every sample [N m/Pa].
+
+    ``c = (M_tot d - F_res - sum_i J w_dot_i / R) / (sum_i p_i / R)``, from the vehicle's
+    translation (eq. 8) and each wheelset's rotation (eq. 6). The one implementation of
+    eq. 14: :func:`brake_coefficient` and :func:`identify_adhesion` call it.
+
+    Parameters
+    ----------
+    deceleration : array_like (n,)
+        d = -dv/dt [m/s^2].
+    wheel_acceleration_sum : array_like (n,)
+        Sum over the axles of the angular accelerations w_dot_i [rad/s^2].
+    pressure_sum : array_like (n,)
+        Sum over the axles of the brake-cylinder pressures p_i [Pa].
+    vehicle : Vehicle
+        ``total_mass`` M_tot [kg], ``wheelset_inertia`` J [kg m^2] (each axle),
+        ``wheel_radius`` R [m].
+    resistance : array_like (n,), optional
+        Running resistance F_res [N] (the paper neglects it, eq. 7).
+    where : array_like of bool (n,), optional
+        Samples to compute (the brake applied); NaN elsewhere. Default: every sample.
+
+    Examples
+    --------
+    >>> from railadhesion.braking import Vehicle
+    >>> veh = Vehicle()
+    >>> torque = veh.total_mass * 1.0 * veh.wheel_radius  # 1 m/s^2 with massless wheels
+    >>> c = brake_coefficient_per_sample([1.0], [0.0], [torque / veh.brake_coefficient],
+    ...                                  veh)
+    >>> round(float(c[0] / veh.brake_coefficient), 9)
+    1.0
+    """
+    r = float(vehicle.wheel_radius)
+    force = np.multiply(np.asarray(deceleration, dtype=float), float(vehicle.total_mass))
+    inertia = np.multiply(np.asarray(wheel_acceleration_sum, dtype=float),
+                          float(vehicle.wheelset_inertia))
+    np.divide(inertia, r, out=inertia)
+    np.subtract(force, inertia, out=force)
+    if resistance is not None:
+        np.subtract(force, np.asarray(resistance, dtype=float), out=force)
+    np.divide(np.asarray(pressure_sum, dtype=float), r, out=inertia)  # sum p / R
+    if where is None:
+        return np.divide(force, inertia, out=force)
+    c = np.full(force.shape, np.nan)
+    np.divide(force, inertia, out=c, where=np.asarray(where, dtype=bool))
+    return c
+
+
+def _brake_window(t, deceleration, wheel_acceleration_sum, pressure_sum, pressure_mean,
+                  vehicle, resistance, ok, min_pressure):
+    """:class:`BrakeCoefficient`: eq. 14 where the mean pressure is at least ``min_pressure``,
+    its statistics over the window of steady braking (at least half the largest mean
+    pressure among the allowed samples ``ok``)."""
+    applied = pressure_mean >= max(float(min_pressure), 1e-9)
+    c = brake_coefficient_per_sample(deceleration, wheel_acceleration_sum, pressure_sum,
+                                     vehicle, resistance=resistance, where=applied)
+    top = np.max(pressure_mean[ok & applied]) if np.any(ok & applied) else np.inf
+    window = ok & applied & (pressure_mean >= 0.5 * top) & np.isfinite(c)
     if not window.any():
         raise ValueError(
             "no sample with the brake applied (mean pressure >= "
@@ -769,16 +821,11 @@ def _identify(log, vehicle, pool, step, filter_mode, vehicle_cutoff, wheel_cutof
     valid = np.asarray(log.valid, dtype=np.bool_)
     c_ok = np.empty(n, np.bool_)
     _brake_mask(wheel, train, valid, sub, edge, v_f, float(min_speed), r, c_ok)
-    # M_tot d - sum J w_dot / R (- F_res), the same arithmetic in place
-    force = np.multiply(d_f, float(vehicle.total_mass))
-    inertia = np.multiply(jsum, j)
-    np.divide(inertia, r, out=inertia)
-    np.subtract(force, inertia, out=force)
+    resistance = None
     if hasattr(vehicle, "running_resistance"):
-        np.subtract(force, np.asarray(vehicle.running_resistance(v_f), dtype=float), out=force)
-    np.divide(psum, r, out=inertia)  # sum p / R
-    brake = _brake_from_force(t, force, inertia, psum / n_ax, c_ok, min_pressure)
-    del force, inertia
+        resistance = vehicle.running_resistance(v_f)
+    brake = _brake_window(t, d_f, jsum, psum, psum / n_ax, vehicle, resistance, c_ok,
+                          min_pressure)
     c = brake.mean if brake_coefficient_value is None else float(
         check_positive(brake_coefficient_value, "brake_coefficient_value"))
     step("normal loads and adhesion (eqs. 10-13)")
