@@ -204,6 +204,24 @@ def test_threads_do_not_change_the_results(mini_run, mini_vehicle):
         identify_adhesion(log, mini_vehicle, threads=0)
 
 
+def test_default_threads_follow_numba():
+    # the identification uses as many threads as the compiled kernels: numba's setting, not
+    # the cores the process may run on
+    import numba
+
+    from railadhesion.identification.brake_tests import worker_count
+
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        assert worker_count() == 1
+        numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+        assert worker_count() == numba.config.NUMBA_NUM_THREADS
+    finally:
+        numba.set_num_threads(before)
+    assert worker_count(3) == 3
+
+
 def test_loads_of_a_vehicle_that_is_not_affine_in_d(mini_run, mini_vehicle):
     # a vehicle whose loads are not affine in the deceleration is evaluated sample by sample
     class Curved:

@@ -34,7 +34,6 @@ resistance (0 unless given): the paper neglects it (eq. 7).
 
 from __future__ import annotations
 
-import os
 import threading
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
@@ -62,6 +61,7 @@ __all__ = [
     "brake_coefficient_per_sample",
     "identify_adhesion",
     "identification_windows",
+    "worker_count",
 ]
 
 #: Samples this close to a segment's ends are not used for the brake coefficient [s].
@@ -607,15 +607,18 @@ def _axle_adhesion(i, wd, p, slip, v, d, wheel, train, valid, substituted, edge,
             rel_rate[k, i] = np.nan
 
 
-def _worker_count(threads) -> int:
+def worker_count(threads=None) -> int:
+    """Threads the identification runs in: ``threads`` (>= 1), or by default
+    ``numba.get_num_threads()``, the number the package's compiled kernels use (every core
+    available unless ``NUMBA_NUM_THREADS`` or :func:`numba.set_num_threads` says otherwise)."""
     if threads is None:
-        try:
-            return max(1, len(os.sched_getaffinity(0)))
-        except AttributeError:  # pragma: no cover - not Linux
-            return max(1, os.cpu_count() or 1)
+        import numba
+
+        return max(1, int(numba.get_num_threads()))
     threads = int(threads)
     if threads < 1:
-        raise ValueError(f"threads must be >= 1 (or None for every core), got {threads}")
+        raise ValueError(
+            f"threads must be >= 1 (or None for numba.get_num_threads()), got {threads}")
     return threads
 
 
@@ -688,8 +691,9 @@ def identify_adhesion(
     progress : callable, optional
         Called with the name of each stage (for progress bars).
     threads : int, optional
-        Threads for the channels and axles (compiled kernels that release the GIL); default:
-        every core available. The results do not depend on it.
+        Threads for the channels and axles (compiled kernels and scipy's filters release the
+        GIL); default: :func:`worker_count`, ``numba.get_num_threads()``. The results do not
+        depend on it.
 
     Returns
     -------
@@ -706,7 +710,7 @@ def identify_adhesion(
     check_nonnegative(min_speed, "min_speed")
     check_nonnegative(min_pressure, "min_pressure")
     check_positive(speed_tolerance, "speed_tolerance")
-    workers = _worker_count(threads)
+    workers = worker_count(threads)
     step = progress or (lambda _stage: None)
     n_ax = log.n_axles
     if int(getattr(vehicle, "n_axles", n_ax)) != n_ax:

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from railadhesion.identification.brake_tests import _worker_count, identify_adhesion
+from railadhesion.identification.brake_tests import identify_adhesion, worker_count
 from railadhesion.identification.curves import band_statistics, fit_adhesion_curves
 from railadhesion.identification.logs import BrakingLog, read_braking_log
 from railadhesion.identification.signals import VEHICLE_CUTOFF, WHEEL_CUTOFF
@@ -134,7 +134,7 @@ def run_identification(
     figures : bool, default False
         Also draw the figures (``out/figures``; needs ``out``).
     threads : int, optional
-        Threads for the compiled stages (default: every core available).
+        Threads for the compiled stages (default: ``numba.get_num_threads()``).
     progress : callable, optional
         Called with the name of each stage of :data:`STAGES` after the first as it starts.
 
@@ -148,7 +148,7 @@ def run_identification(
         Unreadable log or vehicle, bad options, no braking in the log.
     """
     step = progress or (lambda _stage: None)
-    workers = _worker_count(threads)
+    workers = worker_count(threads)
     timings: dict[str, float] = {}
     clock = [time.perf_counter()]
 
