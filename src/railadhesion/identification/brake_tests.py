@@ -855,16 +855,20 @@ def _identify(log, vehicle, pool, step, filter_mode, vehicle_cutoff, wheel_cutof
                        edge_fast, t, gc, seg_a, seg_b, j, c, r, float(min_speed),
                        float(load0[i]), float(load1[i]), affine is not None, loads, mu, rel,
                        rel_rate, use)
-        s0, s1, sign = _windows(t, v_f, slip_rate[:, i], use[:, i], segment_index,
-                                float(speed_tolerance), float(min_window),
-                                float(slip_rate_deadband), phase[:, i])
-        found[i] = (s0, s1, sign, _window_sums(s0, s1, v_f, mu[:, i]))
 
     _run_jobs(pool, [partial(adhesion_job, i) for i in range(n_ax)])
     pitch = None
     if getattr(vehicle, "secondary_stiffness", None) is not None:
         pitch = np.asarray(vehicle.pitch_angle(d_f), dtype=float)
     step("identification windows")
+
+    def windows_job(i):
+        s0, s1, sign = _windows(t, v_f, slip_rate[:, i], use[:, i], segment_index,
+                                float(speed_tolerance), float(min_window),
+                                float(slip_rate_deadband), phase[:, i])
+        found[i] = (s0, s1, sign, _window_sums(s0, s1, v_f, mu[:, i]))
+
+    _run_jobs(pool, [partial(windows_job, i) for i in range(n_ax)])
     parts = []
     for i, (s0, s1, sign, sums) in enumerate(found):
         if s0.size == 0:

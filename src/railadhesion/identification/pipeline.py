@@ -189,6 +189,7 @@ def run_identification(
         if out is not None:
             paths["windows"] = write_frame_csv(ident.windows, out / "windows.csv")
         stats_abs.result()
+        step("fitted curves")
         law = fit_adhesion_curves(ident, speed_bands=bands)
         phase_curves = {}
         for phase in ("loss", "recovery"):
@@ -206,7 +207,6 @@ def run_identification(
         if pool is not None:
             pool.shutdown()
     lap("surfaces (waiting for them)")
-    step("fitted curves")
     if out is not None:
         save_surface(surface, out / "surface.nc")
         save_surface(surface_relative, out / "surface_relative.nc")
