@@ -45,8 +45,18 @@ def test_each_progress_label_fires_when_its_stage_starts(mini_run, mini_vehicle,
     assert first("surface") < first("fitted curves") < first("fit_adhesion_curves")
     assert last("fit_adhesion_curves") < first("figures")
     assert last("save_surface") < first("figures") < first("summary")
-    # windows.csv is a plain CSV that pandas reads back as written
+    # windows.csv is a CSV that pandas reads back as written
     back = pd.read_csv(run.paths["windows"])
     assert list(back.columns) == list(run.ident.windows.columns)
     assert len(back) == len(run.ident.windows) > 0
     assert set(back["phase"]) <= {"loss", "recovery"}
+
+
+def test_write_frame_csv_round_trips_awkward_values(tmp_path):
+    frame = pd.DataFrame({"phase": ["loss", 'a "quoted", value', "x\ny"],
+                          "t": [0.1, 1e-300, 1149.0], "n": [1, 2, 3]})
+    back = pd.read_csv(pipeline.write_frame_csv(frame, tmp_path / "a.csv"))
+    pd.testing.assert_frame_equal(back, frame, check_dtype=False)
+    empty = pd.DataFrame(columns=["axle", "phase", "start_time"])
+    back = pd.read_csv(pipeline.write_frame_csv(empty, tmp_path / "b.csv"))
+    assert list(back.columns) == list(empty.columns) and len(back) == 0

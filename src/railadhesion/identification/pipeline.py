@@ -78,28 +78,13 @@ class IdentificationRun:
 
 
 def write_frame_csv(frame, path) -> Path:
-    """Write a DataFrame as CSV without its index, numbers in their shortest round-trip form
-    (pyarrow's writer; pandas' if pyarrow is missing)."""
+    """Write a DataFrame as CSV without its index (:func:`pyarrow.csv.write_csv`: numbers in
+    their shortest round-trip form, column names and strings quoted)."""
+    import pyarrow as pa
+    import pyarrow.csv as pcsv
+
     path = Path(path)
-    try:
-        import pyarrow as pa
-        import pyarrow.csv as pcsv
-    except ImportError:  # pragma: no cover - pyarrow is a dependency
-        frame.to_csv(path, index=False)
-        return path
-    table = pa.Table.from_pandas(frame, preserve_index=False)
-    body = pa.BufferOutputStream()
-    if len(frame):
-        try:  # plain values, as pandas writes them
-            pcsv.write_csv(table, body, write_options=pcsv.WriteOptions(
-                include_header=False, quoting_style="none"))
-        except pa.ArrowInvalid:  # a value holds a comma, quote or newline: quote strings
-            body = pa.BufferOutputStream()
-            pcsv.write_csv(table, body, write_options=pcsv.WriteOptions(
-                include_header=False, quoting_style="needed"))
-    with path.open("wb") as fh:
-        fh.write((",".join(str(c) for c in frame.columns) + "\n").encode())
-        fh.write(body.getvalue().to_pybytes())
+    pcsv.write_csv(pa.Table.from_pandas(frame, preserve_index=False), str(path))
     return path
 
 
