@@ -26,10 +26,10 @@ accelerations and pressures: those sums are filtered, which the filter's lineari
 same as summing the filtered channels, to rounding.)
 
 The channels (per segment: speed and deceleration, the eq. 14 sums, each axle's filters and
-derivatives) and then the axles (loads, eq. 10, windows) run in compiled kernels that release
-the GIL, in threads (``threads=``); each is computed alone, so the results do not depend on
-the number of threads. The running resistance ``F_res`` is the vehicle's Davis
-resistance (0 unless given): the paper neglects it (eq. 7).
+derivatives) and then the axles (loads, eq. 10, windows) run in compiled kernels and scipy's
+filters, which release the GIL, in threads (``threads=``); each is computed alone, so the
+results do not depend on the number of threads. The running resistance ``F_res`` is the
+vehicle's Davis resistance (0 unless given): the paper neglects it (eq. 7).
 """
 
 from __future__ import annotations
