@@ -49,7 +49,7 @@ from numba import njit
 from scipy import optimize
 
 from railadhesion._validate import check_choice
-from railadhesion.identification.surface import _cell
+from railadhesion.identification.surface import cell_index
 
 __all__ = [
     "LAW_FORMAT",
@@ -139,7 +139,7 @@ def _band_stats(speed, x, mu, use, phase, edges):  # pragma: no cover - compiled
     band = np.empty(n, np.int64)
     for k in range(n):
         v = speed[k]
-        b = _cell(v, edges) if v < edges[nb] else -1  # bands are [low, high)
+        b = cell_index(v, edges) if v < edges[nb] else -1  # bands are [low, high)
         band[k] = b
         h0 = False
         h1 = False
