@@ -27,8 +27,8 @@ against ``sqrt(2 pi**3 dt fc'**3)`` with zero phase (fc' = 1.554 fc): 0.25 again
 0.04 rad/s**2 for 0.02 rad/s of wheel-speed noise at 2 Hz and 2.4 ms. On the closed-loop
 test logs it also gives the smaller bias of mu at small slip (``docs/identification.md``).
 
-``scipy.signal`` is imported when a filter is first built, not with this module (it adds
-about half a second to the start of a command that does not filter).
+``scipy.signal`` is imported when a filter is first built, not with this module (it is slow
+to import, and a command that does not filter need not wait for it).
 """
 
 from __future__ import annotations
