@@ -6,8 +6,9 @@ Allotta, Malvezzi and Toni identify the adhesion coefficient from the channels a
 records (train speed, wheelset angular speeds, brake-cylinder pressures, every 2.4 ms). Here
 the log comes from the package's own braking simulator on a low-adhesion rail (a Polach set
 with μ0 = 0.13 and falling friction), written with sensor noise; the identification recovers
-the brake coefficient, μ of every axle at every sample, and a fitted law μ(slip). Since the
-true law is known, the fit can be checked against it.
+the brake coefficient, μ of every axle at every sample, and a fitted law μ(slip). The test
+suite closes the same loop and checks the identified law against the simulated one (RMS
+difference 0.0033 in μ, :doc:`/validation`).
 """
 
 import tempfile
@@ -34,8 +35,10 @@ write_braking_log(result, log_path, period=2.4e-3, seed=11,
 # Identify: read the log (every defect would be reported), then c, μ per axle and sample.
 log = read_braking_log(log_path)
 ident = identify_adhesion(log, vehicle)
-print(f"brake coefficient: identified {ident.brake.mean:.5f}, "
-      f"true {vehicle.brake_coefficient:.5f} N m/Pa")
+error = ident.brake.mean / vehicle.brake_coefficient - 1
+print(f"brake coefficient: identified {ident.brake.mean:.6f} N m/Pa, "
+      f"true {vehicle.brake_coefficient:.6f} ({100 * error:+.3f} %)")
+print(f"{ident.use.sum()} usable samples on {ident.use.shape[1]} axles")
 law = fit_adhesion_curves(ident)  # mu(slip) per speed band and over all speeds
 
 # %%
