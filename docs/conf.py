@@ -36,9 +36,7 @@ extensions = [
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "_ext", "**/README.md", "auto_examples/*.ipynb",
-                    "auto_examples/*.py", "auto_examples/*.zip", "auto_examples/*.md5",
-                    "auto_examples/*.json", "auto_examples/*.codeobj.json"]
+exclude_patterns = ["_build", "_ext", "_templates"]
 templates_path = ["_templates"]
 
 # --- cross-references: every internal reference must resolve (-n). References to outside
@@ -48,15 +46,11 @@ nitpick_ignore_regex = [
     (r"py:.*", r"(numpy|np|pandas|pd|xarray|xr|scipy|dask|distributed|matplotlib|mpl|numba|"
                r"typer|click|rich|pathlib|os|io|collections|typing|datetime|fmpy|pythonfmu|"
                r"pyarrow|zarr|concurrent|types)(\..*)?"),
-    (r"py:class", r"(array_like|array|ndarray|Path|DataFrame|Dataset|DataArray|Series|Figure|"
-                  r"Axes|callable|optional|default|iterable|sequence|mapping|path-like|"
-                  r"str|int|float|bool|dict|list|tuple|None|object|complex|bytes|type)"),
 ]
 
 # --- MyST: Markdown pages; "#" links between pages are checked (myst.xref_missing warns).
 myst_enable_extensions = ["dollarmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3
-suppress_warnings = []
 
 # --- API reference
 autosummary_generate = True
