@@ -16,6 +16,7 @@ from __future__ import annotations
 import ctypes
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -307,6 +308,20 @@ def test_undefined_symbols_agrees_with_nm(unzipped):
                          text=True, check=True)  # fmt: skip
     listed = {line.split()[-1].split("@")[0] for line in out.stdout.splitlines() if line.strip()}
     assert listed == set(undefined_symbols(binary.read_bytes()))
+
+
+@pytest.mark.parametrize("model", ["polach", "wilac"])
+def test_binary_loads_on_glibc_2_14(unzipped, model):
+    """libm's functions are bound to their first x86-64 versions (exp@GLIBC_2.29 and
+    hypot@GLIBC_2.35 would keep the binary off older systems); memcpy needs 2.14."""
+    nm = shutil.which("nm")
+    if nm is None:
+        pytest.skip("nm is not installed")
+    out = subprocess.run([nm, "-D", "--undefined-only", str(unzipped[model].binary)],
+                         capture_output=True, text=True, check=True).stdout  # fmt: skip
+    versions = [tuple(int(x) for x in v.split(".")) for v in
+                re.findall(r"@GLIBC_([0-9.]+)", out)]  # fmt: skip
+    assert versions and max(versions) <= (2, 14), out
 
 
 def test_no_allocation_in_set_step_get(unzipped):

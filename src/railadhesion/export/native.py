@@ -107,6 +107,12 @@ _PORTABLE_INTRINSICS = (
     "llvm.memcpy.", "llvm.memmove.", "llvm.memset.", "llvm.assume", "llvm.expect.",
     "llvm.is.fpclass.", "llvm.vector.reduce.", "llvm.experimental.noalias.scope.decl",
 )  # fmt: skip
+# glibc gave these libm functions new symbol versions (exp, log, pow, exp2, log2 in 2.29,
+# without the old SVID error wrapper; hypot in 2.35): a binary linked on this machine would
+# not load on older systems. The first x86-64 versions compute the same numbers (the wrapper
+# calls the same implementation and only adds errno handling), so the linux64 object is bound
+# to them: with memcpy@GLIBC_2.14 of the C layer, the binary needs glibc >= 2.14.
+_GLIBC_BASELINE = {n: "GLIBC_2.2.5" for n in ("exp", "exp2", "hypot", "log", "log2", "pow")}
 _C_KEYWORDS = frozenset(
     "auto break case char const continue default do double else enum extern float for goto if "
     "inline int long register restrict return short signed sizeof static struct switch "
@@ -208,6 +214,7 @@ def _llvm():
 
     llvm.initialize_all_targets()
     llvm.initialize_all_asmprinters()
+    llvm.initialize_native_asmparser()  # the linux64 object's .symver directives
     return llvm
 
 
@@ -229,7 +236,9 @@ def compile_functions(
     -------
     CompiledCode
         The optimised IR (only the given symbols external, hidden visibility), the object, and
-        its undefined symbols (ELF targets; else those of the IR's declarations).
+        its undefined symbols (ELF targets; else those of the IR's declarations). For linux64
+        the object binds libm's functions to their first glibc versions (the IR does not:
+        it stays free of platform directives).
 
     Raises
     ------
@@ -279,9 +288,16 @@ def compile_functions(
     declared = sorted(fn.name for fn in module.functions if fn.is_declaration)
     foreign = [n for n in declared if n.startswith("llvm.") and not n.startswith(
         _PORTABLE_INTRINSICS)]  # fmt: skip
+    ir = str(module)
     obj = machine.emit_object(module)
     if obj[:4] == b"\x7fELF":
         undefined = undefined_symbols(obj)
+        pinned = sorted(set(undefined) & set(_GLIBC_BASELINE)) if triple == _TRIPLE else []
+        if pinned:  # bind libm to its first x86-64 version: the binary loads on old glibc
+            text = ir + "".join(
+                f'\nmodule asm ".symver {n},{n}@{_GLIBC_BASELINE[n]}"' for n in pinned)
+            module = llvm.parse_assembly(text + "\n")
+            obj = machine.emit_object(module)
     else:
         undefined = [n for n in declared if not n.startswith("llvm.")]
     forbidden = sorted(set(undefined) - ALLOWED_SYMBOLS) + foreign
@@ -291,7 +307,7 @@ def compile_functions(
             "libm may remain (numba runtime symbols come from an allocation or an exception "
             "path, Py* from Python objects; target intrinsics tie the IR to one processor)"
         )
-    return CompiledCode(str(module), obj, triple, cpu, tuple(functions), tuple(undefined))
+    return CompiledCode(ir, obj, triple, cpu, tuple(functions), tuple(undefined))
 
 
 # --------------------------------------------------------------------------------------------
