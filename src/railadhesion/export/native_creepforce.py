@@ -44,12 +44,30 @@ _KALKER_RANGE = "a/b outside the range of Kalker's coefficients [1e-150, 1e150]"
 _OPEN_BELOW = ("a", "b", "shear_modulus")
 
 
-def _polach_step(settings_t, inputs_t):
-    from numba import carray
+def _creep_force_step(model, settings_t, inputs_t):
+    """The step function of the creep-force FMU of ``model`` for the record dtypes of one
+    export: the law of the package's validating scalar kernel, lift-off, the adhesion."""
+    from numba import carray, njit
 
-    from railadhesion.models.kernels import polach_checked
+    from railadhesion.models.kernels import polach_checked, wilac_checked
 
     state_t = _STATE
+    if model == "wilac":
+
+        def law(p, x):  # (fx, fy, error code)
+            fx, fy, ok = wilac_checked(x.creep_long, x.creep_lat, x.spin, x.normal_force,
+                                       x.speed, x.a, x.b, x.water_flow, p.shear_modulus,
+                                       p.poisson, 0.0, 0.0, 0.0, p.packed)  # fmt: skip
+            return fx, fy, 0 if ok else 1
+    else:
+
+        def law(p, x):
+            fx, fy, bad = polach_checked(x.creep_long, x.creep_lat, x.spin, x.normal_force,
+                                         x.speed, x.a, x.b, p.shear_modulus, p.poisson, 0.0,
+                                         0.0, 0.0, p.k_A, p.k_S, p.mu0, p.A, p.B)  # fmt: skip
+            return fx, fy, 0 if bad < 0 else 1 + bad
+
+    forces = njit(error_model="numpy")(law)
 
     def step(state, settings, inputs, dt):
         out = carray(state, 1, state_t)
@@ -57,55 +75,14 @@ def _polach_step(settings_t, inputs_t):
         x = carray(inputs, 1, inputs_t)[0]
         q = x.normal_force
         if q <= 0.0:  # wheel lift-off: no contact, no force
-            out[0].Fx = 0.0
-            out[0].Fy = 0.0
-            out[0].adhesion = 0.0
-            return 0
-        fx, fy, bad = polach_checked(x.creep_long, x.creep_lat, x.spin, q, x.speed, x.a, x.b,
-                                     p.shear_modulus, p.poisson, 0.0, 0.0, 0.0, p.k_A, p.k_S,
-                                     p.mu0, p.A, p.B)  # fmt: skip
-        if bad >= 0:
-            out[0].Fx = math.nan
-            out[0].Fy = math.nan
-            out[0].adhesion = math.nan
-            return 1 + bad
+            fx, fy, code, adhesion = 0.0, 0.0, 0, 0.0
+        else:  # after an error the forces are NaN, and so is the adhesion
+            fx, fy, code = forces(p, x)
+            adhesion = math.hypot(fx, fy) / q  # railadhesion.adhesion
         out[0].Fx = fx
         out[0].Fy = fy
-        out[0].adhesion = math.hypot(fx, fy) / q  # railadhesion.adhesion
-        return 0
-
-    return step
-
-
-def _wilac_step(settings_t, inputs_t):
-    from numba import carray
-
-    from railadhesion.models.kernels import wilac_checked
-
-    state_t = _STATE
-
-    def step(state, settings, inputs, dt):
-        out = carray(state, 1, state_t)
-        p = carray(settings, 1, settings_t)[0]
-        x = carray(inputs, 1, inputs_t)[0]
-        q = x.normal_force
-        if q <= 0.0:  # wheel lift-off: no contact, no force
-            out[0].Fx = 0.0
-            out[0].Fy = 0.0
-            out[0].adhesion = 0.0
-            return 0
-        fx, fy, ok = wilac_checked(x.creep_long, x.creep_lat, x.spin, q, x.speed, x.a, x.b,
-                                   x.water_flow, p.shear_modulus, p.poisson, 0.0, 0.0, 0.0,
-                                   p.packed)  # fmt: skip
-        if not ok:
-            out[0].Fx = math.nan
-            out[0].Fy = math.nan
-            out[0].adhesion = math.nan
-            return 1
-        out[0].Fx = fx
-        out[0].Fy = fy
-        out[0].adhesion = math.hypot(fx, fy) / q  # railadhesion.adhesion
-        return 0
+        out[0].adhesion = adhesion
+        return code
 
     return step
 
@@ -135,12 +112,12 @@ def creep_force_step_model(model: str, params, *, shear_modulus: float = 8.2e10,
         packed = pack_wilac(params)
         settings_t = np.dtype([("shear_modulus", "f8"), ("poisson", "f8"),
                                ("packed", "f8", (packed.size,))], align=True)  # fmt: skip
-        step = _wilac_step(settings_t, inputs_t)
+        step = _creep_force_step(model, settings_t, inputs_t)
         errors = {1: f"the WILAC law refused its inputs: {_KALKER_RANGE}"}
     else:
         settings_t = np.dtype([(n, "f8") for n in ("shear_modulus", "poisson", *_POLACH)],
                               align=True)  # fmt: skip
-        step = _polach_step(settings_t, inputs_t)
+        step = _creep_force_step(model, settings_t, inputs_t)
         errors = {1 + k: f"the Polach law refused {name} (outside its range)"
                   for k, name in enumerate(_POLACH_ARGS)}  # fmt: skip
         errors[18] = f"the Polach law refused its inputs: {_KALKER_RANGE}"
