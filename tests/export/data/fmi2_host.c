@@ -23,7 +23,9 @@
  *                                 -> N lines "S V..."
  *   bench I NIN VR.. NOUT VR.. N REPEAT  then N lines of inputs: REPEAT passes of set + doStep +
  *                                 get over the rows, then REPEAT passes of doStep alone
- *                                 -> bench NS_PER_STEP NS_PER_DOSTEP ALLOCS_DURING
+ *                                 -> bench NS_PER_STEP NS_PER_DOSTEP ALLOCS_DURING STATUS
+ *                                    CPU_NS_PER_STEP CPU_NS_PER_DOSTEP (wall clock, then this
+ *                                    thread's CPU time: on a busy machine, the time it ran)
  */
 #define _POSIX_C_SOURCE 200809L
 #include <dlfcn.h>
@@ -169,6 +171,12 @@ static double seconds(void) {
     return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
+static double cpu_seconds(void) { /* this thread's CPU time: not the time it waited */
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
 static int script(const Api *api, const char *resources, const char *guid) {
     Component slot[SLOTS] = {0};
     void *state[SLOTS] = {0};
@@ -252,7 +260,7 @@ static int script(const Api *api, const char *resources, const char *guid) {
             int sweep = cmd[1] == 'w'; /* before read_rows overwrites the line */
             int n_in = read_refs(in), n_out = read_refs(out), rows = atoi(token());
             int repeat = sweep ? 1 : atoi(token());
-            double *table = read_rows(rows, n_in), t0, t_full, t_step;
+            double *table = read_rows(rows, n_in), t0, c0, t_full, t_step, c_full, c_step;
             long allocs_before = n_allocs;
             if (sweep) {
                 for (int r = 0; r < rows; r++) {
@@ -266,6 +274,7 @@ static int script(const Api *api, const char *resources, const char *guid) {
                 }
             } else {
                 t0 = seconds();
+                c0 = cpu_seconds();
                 for (int p = 0; p < repeat; p++)
                     for (int r = 0; r < rows; r++) {
                         s |= api->set_real(slot[i], in, (size_t)n_in, table + r * n_in);
@@ -274,15 +283,18 @@ static int script(const Api *api, const char *resources, const char *guid) {
                         s |= api->get_real(slot[i], out, (size_t)n_out, values);
                     }
                 t_full = (seconds() - t0) / ((double)repeat * rows);
+                c_full = (cpu_seconds() - c0) / ((double)repeat * rows);
                 t0 = seconds();
+                c0 = cpu_seconds();
                 for (int p = 0; p < repeat; p++)
                     for (int r = 0; r < rows; r++) {
                         s |= api->do_step(slot[i], time[i], 1e-3, 1);
                         time[i] += 1e-3;
                     }
                 t_step = (seconds() - t0) / ((double)repeat * rows);
-                printf("bench %.3f %.3f %ld %d\n", t_full * 1e9, t_step * 1e9,
-                       n_allocs - allocs_before, s);
+                c_step = (cpu_seconds() - c0) / ((double)repeat * rows);
+                printf("bench %.3f %.3f %ld %d %.3f %.3f\n", t_full * 1e9, t_step * 1e9,
+                       n_allocs - allocs_before, s, c_full * 1e9, c_step * 1e9);
             }
             free(table);
         } else {
