@@ -460,6 +460,10 @@ def test_fmpy_low_level_states(fmus, tmp_path):
     slave = FMU2Slave(guid=md.guid, unzipDirectory=str(tmp_path), instanceName="s",
                       modelIdentifier=md.coSimulation.modelIdentifier)  # fmt: skip
     slave.instantiate()
+    slave.setDebugLogging(True, ["logStatusError", "logAll"])
+    with pytest.raises(Exception, match="fmi2SetDebugLogging"):  # FMPy's FMICallException
+        slave.setDebugLogging(True, ["logNothing"])
+    slave.reset()
     slave.setupExperiment(startTime=0.0)
     slave.enterInitializationMode()
     slave.exitInitializationMode()
