@@ -632,9 +632,9 @@ def test_c_struct_refuses_what_c_would_not_reproduce(dtype, message):
 # The generic step model: a stand-in for the braking vehicle
 
 
-BOGIE_STATE = np.dtype([("speed", "f8"), ("omega", "f8", (2,)), ("distance", "f8"),
-                        ("force", "f8", (2,)), ("stopped", "u1"), ("steps", "i8")],
-                       align=True)  # fmt: skip
+BOGIE_WHEELS = np.dtype([("omega", "f8", (2,)), ("force", "f8", (2,))], align=True)
+BOGIE_STATE = np.dtype([("speed", "f8"), ("wheels", BOGIE_WHEELS), ("distance", "f8"),
+                        ("stopped", "u1"), ("steps", "i8")], align=True)  # fmt: skip
 BOGIE_SETTINGS = np.dtype([("mass", "f8"), ("inertia", "f8"), ("radius", "f8"), ("load", "f8"),
                            ("initial_speed", "f8"), ("polach", "f8", (5,))],
                           align=True)  # fmt: skip
@@ -652,14 +652,15 @@ def bogie_step(state, settings, inputs, dt):
     v = s[0].speed
     total = 0.0
     for k in range(2):
-        creep = (v - s[0].omega[k] * p.radius) / v
+        w = s[0].wheels
+        creep = (v - w.omega[k] * p.radius) / v
         fx, _ = polach_scalar(creep, 0.0, 0.0, p.load, v, 6e-3, 9e-3, 8.2e10, 0.28, 0.0, 0.0,
                               0.0, p.polach[0], p.polach[1], p.polach[2], p.polach[3],
                               p.polach[4])  # fmt: skip
         torque = u.torque[k] if u.valve[k] == 0 else (0.5 * u.torque[k] if u.valve[k] == 1
                                                       else 0.0)  # fmt: skip
-        s[0].omega[k] = max(s[0].omega[k] + dt * (-torque - fx * p.radius) / p.inertia, 0.0)
-        s[0].force[k] = fx
+        w.omega[k] = max(w.omega[k] + dt * (-torque - fx * p.radius) / p.inertia, 0.0)
+        w.force[k] = fx
         total += fx
     s[0].speed = v + dt * total / p.mass
     s[0].distance += dt * v
@@ -677,7 +678,7 @@ def bogie_init(state, settings, inputs):
     p = carray(settings, 1, BOGIE_SETTINGS)[0]
     s[0].speed = p.initial_speed
     for k in range(2):
-        s[0].omega[k] = p.initial_speed / p.radius
+        s[0].wheels.omega[k] = p.initial_speed / p.radius
     return 0
 
 
@@ -699,9 +700,9 @@ def _bogie_model():
                                                 "speed at the start", 15.0, min=1.0),
                                     "initial_speed"))  # fmt: skip
     variables += [RecordVariable(FmuVariable(n, "output", u, n), f, i) for n, u, f, i in [
-        ("speed", "m/s", "speed", ()), ("omega_1", "rad/s", "omega", (0,)),
-        ("omega_2", "rad/s", "omega", (1,)), ("force_1", "N", "force", (0,)),
-        ("force_2", "N", "force", (1,)), ("distance", "m", "distance", ()),
+        ("speed", "m/s", "speed", ()), ("omega_1", "rad/s", "wheels.omega", (0,)),
+        ("omega_2", "rad/s", "wheels.omega", (1,)), ("force_1", "N", "wheels.force", (0,)),
+        ("force_2", "N", "wheels.force", (1,)), ("distance", "m", "distance", ()),
         ("stopped", "1", "stopped", ()), ("steps", "1", "steps", ())]]  # fmt: skip
     return StepModel("standin_bogie", bogie_step, np.zeros(1, BOGIE_STATE), settings,
                      np.zeros(1, BOGIE_INPUTS), variables,
@@ -742,7 +743,8 @@ def _bogie_reference(model, rows, initial_speed=15.0):
         records["inputs"]["valve"] = [[round(row[1]), round(row[3])]]
         assert step(ptr["state"], ptr["settings"], ptr["inputs"], 1e-3) == 0
         s = records["state"][0]
-        out.append([float(s["speed"]), *map(float, s["omega"]), *map(float, s["force"]),
+        out.append([float(s["speed"]), *map(float, s["wheels"]["omega"]),
+                    *map(float, s["wheels"]["force"]),
                     float(s["distance"]), float(s["stopped"]), float(s["steps"])])  # fmt: skip
     return np.array(out)
 

@@ -445,9 +445,11 @@ class RecordVariable:
     """An FMU variable and the record field holding it.
 
     The record follows from the causality: inputs live in ``inputs``, parameters in
-    ``settings``, outputs in ``state``. ``index`` selects one element of a sub-array field
-    (e.g. ``("wheel_speed", (2,))`` is ``wheel_speed_3`` of a four-axle vehicle).
-    ``min_open``: the value must be strictly above ``variable.min`` (e.g. a semi-axis > 0).
+    ``settings``, outputs in ``state``. ``field`` names a field of that record, or, with
+    dots, a field of a nested record (``"vehicle.speed"``); ``index`` selects one element of
+    a sub-array field (e.g. ``("wheel_speed", (2,))`` is ``wheel_speed_3`` of a four-axle
+    vehicle). ``min_open``: the value must be strictly above ``variable.min`` (e.g. a
+    semi-axis > 0).
     """
 
     variable: FmuVariable
@@ -458,6 +460,22 @@ class RecordVariable:
     @property
     def record(self) -> str:
         return _RECORDS[self.variable.causality]
+
+    def dtype(self, record: np.dtype) -> np.dtype | None:
+        """The dtype of the field in ``record`` (None if there is no such field)."""
+        dtype = record
+        for part in self.field.split("."):
+            if dtype.names is None or part not in dtype.names:
+                return None
+            dtype = dtype.fields[part][0]
+        return dtype
+
+    def view(self, record: np.ndarray) -> np.ndarray:
+        """The field of a one-element record array, shape (1, *sub-array shape)."""
+        out = record
+        for part in self.field.split("."):
+            out = out[part]
+        return out
 
 
 @dataclass(frozen=True)
@@ -503,7 +521,7 @@ class StepModel:
                "inputs": self.inputs.copy()}  # fmt: skip
         for rv in self.variables:
             if rv.variable.causality != "output":
-                out[rv.record][rv.field][(0, *rv.index)] = rv.variable.start
+                rv.view(out[rv.record])[(0, *rv.index)] = rv.variable.start
         return out
 
     def check(self) -> None:
@@ -521,10 +539,11 @@ class StepModel:
                 raise ValueError(f"variables: {v.name!r} appears twice")
             seen.add(v.name)
             rec = getattr(self, rv.record)
-            if rv.field not in rec.dtype.names:
+            fdtype = rv.dtype(rec.dtype)
+            if fdtype is None:
                 raise ValueError(f"variables: {v.name} maps to {rv.record}.{rv.field}, which "
                                  f"is not a field of {rec.dtype}")  # fmt: skip
-            base, shape = _base(rec.dtype.fields[rv.field][0])
+            base, shape = _base(fdtype)
             if base.names is not None or len(rv.index) != len(shape) or any(
                 not 0 <= i < n for i, n in zip(rv.index, shape, strict=True)
             ):
@@ -585,11 +604,9 @@ def model_header(model: StepModel, guid: str, records: Mapping[str, np.ndarray])
     for vr, rv in enumerate(model.variables):
         v = rv.variable
         rec = records[rv.record]
-        base, shape = _base(rec.dtype.fields[rv.field][0])
-        offset = f"offsetof(ra_{rv.record}, {rv.field})"
-        if rv.index:
-            flat = int(np.ravel_multi_index(rv.index, shape))
-            offset += f" + {flat} * sizeof({_c_scalar(base, rv.field)})"
+        base, _ = _base(rv.dtype(rec.dtype))
+        index = "".join(f"[{i}]" for i in rv.index)
+        offset = f"offsetof(ra_{rv.record}, {rv.field}{index})"  # C99: a member designator
         ctype = _C_TYPES[f"{base.kind}{base.itemsize}"][1]
         lo = _c_number(-np.inf if v.min is None else v.min)
         hi = _c_number(np.inf if v.max is None else v.max)
