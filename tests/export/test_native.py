@@ -795,3 +795,14 @@ def test_step_model_integer_inputs_are_rounded_and_checked(bogie):
     assert np.array_equal(got, want)
     _error(bogie, f"new 0\ninit 0\nset 0 {bogie.vr['valve_1']} 2.5\n", "set 0 3",
            "fmi2SetReal: valve_1 = 2.5 is out of range [0, 2]")  # fmt: skip
+
+
+@pytest.mark.parametrize(("kwargs", "message"), [
+    ({"poisson": 0.7}, r"poisson must be in \[0, 0.5\], got 0.7"),
+    ({"shear_modulus": math.inf}, r"shear_modulus must be in \(0, inf\), got inf"),
+    ({"shear_modulus": 0.0}, r"shear_modulus must be in \(0, inf\)"),
+])  # fmt: skip
+def test_build_refuses_bad_elastic_constants(tmp_path, kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        build_native_creep_force_fmu(tmp_path / "x.fmu", "polach", **kwargs)
+    assert not (tmp_path / "x.fmu").exists()

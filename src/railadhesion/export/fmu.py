@@ -21,6 +21,7 @@ import contextlib
 import hashlib
 import html
 import json
+import math
 import shutil
 import sys
 import tempfile
@@ -296,13 +297,20 @@ def _add_initial_unknowns(root: ET.Element) -> None:
 # Creep-force FMU
 
 
-def creep_force_variables(model: str) -> list[FmuVariable]:
+def creep_force_variables(model: str, *, shear_modulus: float = 8.2e10,
+                          poisson: float = 0.28) -> list[FmuVariable]:  # fmt: skip
     """The variables of the creep-force FMU of ``model`` (``"wilac"`` or ``"polach"``).
 
     Inputs: creepages, spin, normal force, speed, semi-axes and (WILAC) water flow; fixed
-    parameters: elastic constants; outputs: Fx, Fy, adhesion. Signs: ``docs/CONVENTIONS.md``.
+    parameters: elastic constants, with start values ``shear_modulus`` [Pa] in (0, inf) and
+    ``poisson`` [-] in [0, 0.5]; outputs: Fx, Fy, adhesion. Signs: ``docs/CONVENTIONS.md``.
     """
     _check_model(model)
+    g, nu = float(shear_modulus), float(poisson)
+    if not (0.0 < g < math.inf):
+        raise ValueError(f"shear_modulus must be in (0, inf), got {shear_modulus!r}")
+    if not (0.0 <= nu <= 0.5):
+        raise ValueError(f"poisson must be in [0, 0.5], got {poisson!r}")
     inputs = [
         FmuVariable("creep_long", "input", "1",
                     "Longitudinal creepage xi = (V - omega R)/V; braking > 0, traction < 0", 0.0),
@@ -323,9 +331,9 @@ def creep_force_variables(model: str) -> list[FmuVariable]:
                         min=0.0)
         )  # fmt: skip
     parameters = [
-        FmuVariable("shear_modulus", "parameter", "Pa", "Combined shear modulus G", 8.2e10,
+        FmuVariable("shear_modulus", "parameter", "Pa", "Combined shear modulus G", g,
                     min=0.0),
-        FmuVariable("poisson", "parameter", "1", "Combined Poisson's ratio nu", 0.28,
+        FmuVariable("poisson", "parameter", "1", "Combined Poisson's ratio nu", nu,
                     min=0.0, max=0.5),
     ]  # fmt: skip
     outputs = [
@@ -532,18 +540,7 @@ def build_creep_force_fmu(
     import railadhesion
 
     resolved = resolve_parameters(model, params, parameter_set)
-    variables = creep_force_variables(model)
-    starts = {"shear_modulus": float(shear_modulus), "poisson": float(poisson)}
-    if not (starts["shear_modulus"] > 0):
-        raise ValueError(f"shear_modulus must be > 0, got {shear_modulus!r}")
-    if not (0.0 <= starts["poisson"] <= 0.5):
-        raise ValueError(f"poisson must be in [0, 0.5], got {poisson!r}")
-    variables = [
-        FmuVariable(v.name, v.causality, v.unit, v.description, starts[v.name], v.min, v.max)
-        if v.name in starts
-        else v
-        for v in variables
-    ]
+    variables = creep_force_variables(model, shear_modulus=shear_modulus, poisson=poisson)
     description = resolved.describe(f"Embedded as resources/{_PARAMETER_FILE}.")
     config = {
         "model": model,

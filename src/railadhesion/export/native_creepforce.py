@@ -23,7 +23,6 @@ from pathlib import Path
 import numpy as np
 
 from railadhesion.export.fmu import (
-    FmuVariable,
     creep_force_documentation,
     creep_force_variables,
     resolve_parameters,
@@ -94,18 +93,7 @@ def creep_force_step_model(model: str, params, *, shear_modulus: float = 8.2e10,
     :class:`~railadhesion.models.wilac.WilacParameters`) as a :class:`StepModel`."""
     from railadhesion.models.kernels import pack_wilac
 
-    variables = creep_force_variables(model)
-    starts = {"shear_modulus": float(shear_modulus), "poisson": float(poisson)}
-    if not (0.0 < starts["shear_modulus"] < math.inf):
-        raise ValueError(f"shear_modulus must be in (0, inf), got {shear_modulus!r}")
-    if not (0.0 <= starts["poisson"] <= 0.5):
-        raise ValueError(f"poisson must be in [0, 0.5], got {poisson!r}")
-    variables = [
-        FmuVariable(v.name, v.causality, v.unit, v.description, starts[v.name], v.min, v.max)
-        if v.name in starts
-        else v
-        for v in variables
-    ]
+    variables = creep_force_variables(model, shear_modulus=shear_modulus, poisson=poisson)
     names = [v.name for v in variables if v.causality == "input"]
     inputs_t = np.dtype([(n, "f8") for n in names], align=True)
     if model == "wilac":
