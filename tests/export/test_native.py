@@ -806,3 +806,18 @@ def test_build_refuses_bad_elastic_constants(tmp_path, kwargs, message):
     with pytest.raises(ValueError, match=message):
         build_native_creep_force_fmu(tmp_path / "x.fmu", "polach", **kwargs)
     assert not (tmp_path / "x.fmu").exists()
+
+
+def test_step_model_checks_its_variables():
+    model = _bogie_model()
+    unbounded = RecordVariable(FmuVariable("valve_x", "input", "1", "no bounds", 0.0), "valve",
+                               (0,))  # fmt: skip
+    missing = RecordVariable(FmuVariable("nope", "output", "1", "no such field"), "wheels.mass")
+    twice = model.variables[0]
+    cases = [(unbounded, "integer field: its min and max must be given"),
+             (missing, "which is not a field"), (twice, "appears twice")]
+    for extra, message in cases:
+        broken = StepModel(model.identifier, model.step, model.state, model.settings,
+                           model.inputs, [*model.variables, extra])  # fmt: skip
+        with pytest.raises(ValueError, match=message):
+            broken.check()

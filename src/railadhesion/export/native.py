@@ -127,6 +127,9 @@ _C_TYPES = {
     "b1": ("uint8_t", "RA_U8"),
 }
 _RECORDS = {"output": "state", "parameter": "settings", "input": "inputs"}
+# Values fmi2SetReal may store in integer fields (exact in a double, in the C type's range).
+_INTEGER_LIMITS = {"i8": (-(2**53), 2**53), "i4": (-(2**31), 2**31 - 1), "u1": (0, 255),
+                   "b1": (0, 1)}  # fmt: skip
 
 
 class NativeBuildError(RuntimeError):
@@ -551,6 +554,12 @@ class StepModel:
                 raise ValueError(f"variables: {v.name}: {rv.record}.{rv.field}{list(rv.index)} "
                                  f"is not one number of shape {shape}")  # fmt: skip
             _c_scalar(base, f"{rv.record}.{rv.field}")
+            limits = _INTEGER_LIMITS.get(f"{base.kind}{base.itemsize}")
+            if limits and v.causality != "output" and (
+                v.min is None or v.max is None or v.min < limits[0] or v.max > limits[1]
+            ):
+                raise ValueError(f"variables: {v.name} is stored in an integer field: its min "
+                                 f"and max must be given, within {limits}")  # fmt: skip
             if v.causality != "output":
                 lo = -np.inf if v.min is None else v.min
                 hi = np.inf if v.max is None else v.max
