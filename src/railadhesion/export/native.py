@@ -651,10 +651,10 @@ def _build_description(identifier: str) -> str:
     root = ET.Element("fmiBuildDescription", {"fmiVersion": "3.0"})
     config = ET.SubElement(root, "BuildConfiguration", {
         "modelIdentifier": identifier,
-        "description": "The C layer (C99) and the compiled model as LLVM IR: build with clang, "
+        "description": "The C layer (C11) and the compiled model as LLVM IR: build with clang, "
                        "which reads .ll files (see README.txt)",
     })  # fmt: skip
-    c_files = ET.SubElement(config, "SourceFileSet", {"language": "C99"})
+    c_files = ET.SubElement(config, "SourceFileSet", {"language": "C11"})
     for name in ("ra_fmi2.c",):
         ET.SubElement(c_files, "SourceFile", {"name": name})
     ir_files = ET.SubElement(config, "SourceFileSet", {"language": "LLVM IR", "compiler": "clang"})

@@ -16,7 +16,7 @@
  * - the FMU state is the three records plus time and phase: saving it is a memcpy.
  *
  * Build (what railadhesion.export.native does for linux64):
- *   cc -std=c99 -O2 -fPIC -fvisibility=hidden -shared -I<FMI 2.0 headers> -I. ra_fmi2.c
+ *   cc -std=c11 -O2 -fPIC -fvisibility=hidden -shared -I<FMI 2.0 headers> -I. ra_fmi2.c
  *      <law object> -o <modelIdentifier>.so -lm
  */
 #include <math.h>
