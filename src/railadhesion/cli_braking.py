@@ -112,7 +112,10 @@ def register(app: typer.Typer) -> None:
             table.add_row(escape("extension vs dry [m, %]"),
                           f"{s['extension_m']:.1f}  ({s['extension_percent']:.1f} %)")
         table.add_row(escape("max slip [%]"), f"{100 * s['max_slip']:.1f}")
-        table.add_row(escape("longest lock [s]"), f"{s['longest_lock_s']:.2f}")
+        table.add_row(escape("longest lock [s] (wheel < 10 % of train speed)"),
+                      f"{s['longest_lock_s']:.2f}")
+        table.add_row(escape("deep slide [s, m slid] (creepage >= 0.5)"),
+                      f"{s['deep_slide_s']:.2f}, {s['deep_slide_distance_m']:.1f}")
         table.add_row("mean adhesion utilisation", f"{s['mean_adhesion_utilisation']:.3f}")
         table.add_row(escape("WSP vent actions / vented air [l]"),
                       f"{s['vent_actions']} / {s['vented_air_l']:.0f}")
