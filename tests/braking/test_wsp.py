@@ -32,8 +32,8 @@ R = COACH.wheel_radius
 def test_every_setting_has_a_default_and_a_source_or_says_assumption():
     for name, (_default, _unit, source) in WSPSettings.sources().items():
         assert source, name
-        assert ("assumption" in source or "vehicle" in source or "MODELS.md" in source
-                or "seed" in source or "sensor" in source or "cylinders" in source), name
+        assert ("assumption" in source or "vehicle" in source or "seed 002" in source
+                or "sensor" in source or "cylinders" in source), name
     assert set(WSPSettings.sources()) == {f for f in WSPSettings().as_dict()}
     keys = settings_file_keys()
     assert keys["hold_slip_min_m_s"][0] == "hold_slip_min"
@@ -244,3 +244,11 @@ def test_dry_rail_no_wsp_action_and_same_stop_as_without_wsp():
     assert res.stopping_distance == pytest.approx(bare.stopping_distance, rel=1e-12)
     assert (res.histories[[f"valve_{i}" for i in range(1, 5)]].to_numpy() == APPLY).all()
     assert HOLD == 1
+
+
+def test_docs_list_every_setting():
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "wsp.md").read_text(encoding="utf-8")
+    for name in WSPSettings.sources():
+        assert f"| `{name}` |" in text, name

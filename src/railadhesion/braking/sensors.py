@@ -42,7 +42,7 @@ the true train speed every ``period`` with white noise ``noise`` [m/s] and deliv
 ``latency`` [s] later; a sample is lost with probability ``dropout_probability``, and below
 ``min_speed`` (a Doppler radar's low-speed loss) the sensor gives nothing. Lost samples read
 NaN. Default noise 0.13 m/s: the twin-radar error of about 0.47 km/h up to 130 km/h reported by
-a 2023 study (MODELS.md §10), taken as a standard deviation; latency 0.05 s, period 0.02 s,
+a 2023 study of twin Doppler radars, taken as a standard deviation; latency 0.05 s, period 0.02 s,
 min_speed 0.3 m/s: assumptions.
 
 Random numbers
@@ -349,7 +349,7 @@ class ExternalSpeedSettings:
     Parameters
     ----------
     noise : float
-        Standard deviation of a sample [m/s], [0, 10]; default 0.13 (twin radar, MODELS.md §10).
+        Standard deviation of a sample [m/s], [0, 10]; default 0.13 (twin radar, a 2023 study).
     latency : float
         Age of a sample when it is delivered [s], [0, 5]; default 0.05 (assumption).
     period : float
