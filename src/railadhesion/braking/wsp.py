@@ -67,6 +67,7 @@ from numba import njit
 from railadhesion.braking.cylinders import APPLY, HOLD, VENT
 
 __all__ = ["WSPSettings", "WheelSlideProtection", "as_controller", "call_controller",
+           "accepts_measurements",
            "wsp_update", "settings_file_keys", "state_diagnostics", "SETTINGS_DTYPE",
            "STATE_DTYPE", "PHASES"]
 
@@ -688,6 +689,12 @@ def state_diagnostics(state) -> dict:
             "vent_commands": int(r["vent_commands"]),
             "cut_out_groups": [g + 1 for g in range(ng) if r["cutout"][g]],
             "phases": [PHASES[int(r["phase"][g])] for g in range(ng)]}
+
+
+def accepts_measurements(fn) -> bool:
+    """True if the controller ``fn`` takes ``brake_pressures`` and ``external_speed`` keyword
+    arguments (or ``**kwargs``)."""
+    return _accepts(fn, ("brake_pressures", "external_speed"))
 
 
 def _accepts(fn, names) -> bool:
