@@ -361,11 +361,11 @@ def wsp_update(settings, state, t, omega_meas, pressure_meas, command, external_
                     st.t_step[g] = 0.0
                     step = s.reapply_step_fraction * st.p_slide[g]
                     middle = 0.5 * (reapply + hold)
-                    if dec > 2.0 * s.reapply_deceleration or (slip > middle
-                                                              and not accelerating):
+                    if dec > 2.0 * s.reapply_deceleration or (
+                            slip > middle and dec > 0.5 * s.reapply_deceleration):
                         st.turned[g] = 1  # a release step
                         st.p_target[g] = p - step
-                    elif slip < reapply and dec < s.reapply_deceleration:
+                    elif slip < middle and dec < s.reapply_deceleration:
                         st.turned[g] = 0  # an apply step
                         st.p_target[g] = p + step
                     else:
