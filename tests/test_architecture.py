@@ -35,7 +35,7 @@ FLOORS: tuple[tuple[str, ...], ...] = (
     ("calibration", "braking"),
     ("identification", "plotting", "export", "sweeps"),
     ("demo",),
-    ("cli_braking", "cli_export", "cli_identification", "cli_sweeps"),
+    ("cli_braking", "cli_export", "cli_identification", "cli_sweeps", "cli_wsp"),
     ("cli",),
     ("__main__",),
 )
