@@ -691,10 +691,12 @@ def exact_table_forces(
         _is_real(x) for x in (creep_long, creep_lat, spin, normal_force, a, b, mu,
                               shear_modulus, poisson, friction_ratio, friction_decay)
     ):  # fmt: skip
-        # one contact in Python numbers (ODE right-hand sides): checks in plain Python
-        res = _scalar_forces(creep_long, creep_lat, spin, normal_force, a, b, mu,
-                             shear_modulus, poisson, speed, friction_ratio,
-                             friction_decay)  # fmt: skip
+        # one contact in Python numbers (ODE right-hand sides): checks in plain Python; ints
+        # become floats (the compiled lookup is typed for float64)
+        res = _scalar_forces(*(float(x) for x in (creep_long, creep_lat, spin, normal_force, a,
+                                                  b, mu, shear_modulus, poisson)),
+                             float(speed) if _is_real(speed) else speed,
+                             float(friction_ratio), float(friction_decay))  # fmt: skip
         if res is not None:
             return res
     xi = check_finite(creep_long, "creep_long")
