@@ -447,6 +447,7 @@ class FletcherCondition:
             creep, self.normal_load, self.half_width, self.radius, self.mu, self.k_a, self.k_s
         )
 
+    @labelled(units="1")
     def adhesion(self, creep):
         """Adhesion coefficient |Q|/P [-] of Fletcher's fitted model at creep xi [-] (fraction).
 
@@ -458,6 +459,7 @@ class FletcherCondition:
         res = self.traction(creep)
         return np.abs(res.traction) / self.normal_load
 
+    @labelled(units="1")
     def elastic_foundation_adhesion(self, creep):
         """Adhesion coefficient |Q|/P [-] of the unmodified model (k_a = k_s = 1), Fig. 4/5's
         "original model", at creep xi [-]."""

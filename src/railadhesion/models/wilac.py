@@ -357,8 +357,10 @@ class Wilac:
             shear_modulus=self.shear_modulus, poisson=self.poisson,
         )
 
+    @labelled(units="1")
     def adhesion(self, creep_long, creep_lat, spin, normal_force, speed, a, b, water_flow):
-        """Adhesion coefficient |T|/Q [-] of :func:`wilac_forces`."""
+        """Adhesion coefficient |T|/Q [-] of :func:`wilac_forces` (pandas and xarray inputs
+        give results labelled with units "1")."""
         fx, fy = self.forces(creep_long, creep_lat, spin, normal_force, speed, a, b, water_flow)
         return np.hypot(fx, fy) / np.asarray(normal_force, dtype=float)
 
