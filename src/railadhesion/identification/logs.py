@@ -41,6 +41,8 @@ from pathlib import Path
 
 import numpy as np
 
+from railadhesion.plausibility import AlteredResultWarning
+
 __all__ = [
     "BAR",
     "BrakingLog",
@@ -57,8 +59,9 @@ _WHEEL = re.compile(r"^wheel_speed_(\d+)$")
 _PRESSURE = re.compile(r"^brake_pressure_(\d+)$")
 
 
-class BrakingLogWarning(UserWarning):
-    """A braking log had defects (see :attr:`BrakingLog.issues`)."""
+class BrakingLogWarning(AlteredResultWarning):
+    """A braking log had defects, repaired or marked (see :attr:`BrakingLog.issues`): the data
+    differ from the file's (an :class:`~railadhesion.plausibility.AlteredResultWarning`)."""
 
 
 @dataclass(frozen=True)
