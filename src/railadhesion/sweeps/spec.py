@@ -24,7 +24,10 @@ Format (``format = "railadhesion-sweep"``, ``format_version = 1``)::
 
 Every field is validated; errors name the file and the field
 (``map.toml: grid.speed.num: expected an integer >= 1, got 'ten'``). Unknown fields are
-errors. Relative parameter-file paths are taken relative to the spec file.
+errors. Relative parameter-file paths are taken relative to the spec file. Careless values
+give a warning naming the file and the field (``docs/checks.md``): a creepage above 1 (given
+in percent?), a speed above 100 m/s (km/h?), a normal force outside 500 N to 500 kN (kN?), a
+water flow above 1000 µl/s; they are kept in :attr:`SweepSpec.warnings`.
 """
 
 from __future__ import annotations
@@ -68,6 +71,8 @@ class SweepSpec:
     chunk_points: int = DEFAULT_CHUNK_POINTS
     title: str = ""
     source: str = ""
+    #: Careless values found when loading (each also issued as a warning).
+    warnings: tuple = ()
 
     def plan(self) -> SweepPlan:
         return plan_sweep(self.model, self.grid, fixed=self.fixed, chunks=self.chunks,
@@ -231,7 +236,24 @@ def parse_sweep_spec(doc: dict, *, base: Path = Path("."), source: str = "") -> 
         spec.plan()  # the plan's checks name grid.<dim>, fixed.<input>, chunks.<dim>
     except ValueError as exc:
         raise SpecError(str(exc)) from None
+    spec.warnings = _plausible_inputs(Path(source).name if source else "spec", grid, fixed)
     return spec
+
+
+def _plausible_inputs(name: str, grid: dict, fixed: dict) -> tuple[str, ...]:
+    """Warnings for careless numeric inputs of a spec (module notes), naming the field."""
+    from railadhesion.plausibility import ARGUMENT_QUANTITY, check_plausible
+
+    found = []
+    for where, values in [*((f"grid.{k}", v) for k, v in grid.items()),
+                          *((f"fixed.{k}", v) for k, v in fixed.items())]:  # fmt: skip
+        columns = values if isinstance(values, dict) else {where.split(".", 1)[1]: values}
+        for key, column in columns.items():
+            if key in ARGUMENT_QUANTITY and not isinstance(column, str):
+                label = where if not isinstance(values, dict) else f"{where}.{key}"
+                found.append(check_plausible(np.asarray(column, dtype=float), key,
+                                             where=f"{name}: {label}"))  # fmt: skip
+    return tuple(f for f in found if f)
 
 
 def load_sweep_spec(path) -> SweepSpec:
