@@ -88,6 +88,19 @@ def test_every_argument_has_a_quantity_of_the_table():
         assert rng.low < rng.high and rng.source
 
 
+def test_docs_table_lists_every_range():
+    """docs/checks.md prints the table: each quantity with its key and bounds."""
+    text = (DOCS / "checks.md").read_text(encoding="utf-8")
+    for key, rng in PLAUSIBLE.items():
+        row = next((line for line in text.splitlines() if f"(`{key}`)" in line), None)
+        assert row is not None, key
+        cells = row.split("|")
+        numbers = [float(x) for x in re.findall(r"-?\d+(?:\.\d+)?(?:e-?\d+)?", cells[3])]
+        assert numbers[:2] == [rng.low, rng.high], (key, cells[3])
+        for unit, _ in rng.other_units:
+            assert unit.split(" ")[0] in cells[4], (key, unit)
+
+
 def test_nan_is_left_to_the_errors_and_ints_are_checked():
     assert pl.check_plausible(float("nan"), "speed") is None
     assert pl.check_plausible(np.array([np.nan, 10.0]), "speed") is None
