@@ -234,6 +234,7 @@ def test_cli_brake_with_a_demand_in_bar_exits_non_zero(tmp_path):
     assert "braking result not trusted" in res.output
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["trusted"] is False and summary["warnings"]
+    assert "brake.pressure_Pa" in summary["scenario_warnings"][0]
 
 
 def test_study_with_a_demand_in_bar_counts_failed_stops(tmp_path):
@@ -275,6 +276,21 @@ def test_sweep_spec_with_creep_in_percent_warns(tmp_path):
                       r"in percent\?"):
         spec = load_sweep_spec(path)
     assert len(spec.warnings) == 1
+
+
+def test_wilac_map_outside_the_calibrated_range_is_flagged_in_the_map():
+    """Clipping is always reported: the spec loader names the field, the map records it."""
+    from railadhesion.sweeps.spec import parse_sweep_spec
+
+    doc = {"format": "railadhesion-sweep", "format_version": 1, "model": {"name": "wilac"},
+           "grid": {"creep_long": [0.01, 0.1], "normal_force": [2000.0, 5000.0]},
+           "fixed": {"speed": 10.0, "water_flow": 0.0}}  # fmt: skip
+    with pytest.warns(AlteredResultWarning, match=r"map.toml: grid.normal_force = from 2000 to "
+                      r"5000 N is outside the calibrated range \[4200, 1.5e\+05\] N"):
+        spec = parse_sweep_spec(doc, source="/somewhere/map.toml")
+    with pytest.warns(AlteredResultWarning, match="normal_force"):  # the model, per chunk
+        res = spec.run(scheduler="synchronous")
+    assert "grid.normal_force" in json.loads(res.dataset.attrs["warnings"])[0]
 
 
 # ------------------------------------------------- 5. fits reported as if good

@@ -372,6 +372,8 @@ def run_scenario(scenario: BrakeScenario, progress=None, dt: float | None = None
         dry = scenario.simulate(dry=True, dt=dt)
         result.compare_dry(dry)
     result.summary["scenario"] = scenario.name
+    if scenario.warnings:  # the summary records what the file was warned for
+        result.summary["scenario_warnings"] = list(scenario.warnings)
     return result, dry
 
 

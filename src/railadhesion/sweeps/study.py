@@ -445,6 +445,10 @@ def run_study(spec: StudySpec, out_dir, **kwargs):
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     attrs = {"spec_file": spec.source, "title": spec.title or "braking study"}
+    if spec.warnings:  # the study records what its spec was warned for
+        import json
+
+        attrs["warnings"] = json.dumps(list(spec.warnings))
     result = run_sweep(spec.plan(), out=out_dir / "study.zarr", attrs=attrs, **kwargs)
     ds = result.dataset.load()
     ds.to_dataframe().reset_index().to_csv(out_dir / "study.csv", index=False)
