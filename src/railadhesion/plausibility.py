@@ -214,7 +214,7 @@ PLAUSIBLE: dict[str, PlausibleRange] = {
     "wheel_radius": PlausibleRange(
         "railway wheel radius", "m", 0.15, 0.75,
         "assumption: small tram and freight wheels (about 0.3 m) to locomotive wheels "
-        "(0.625 m, MODELS.md §3)",
+        "(CONTACT's Eurosprinter example: 0.625 m)",
         (("mm", 1e-3),),
     ),
     "line_half_width": PlausibleRange(
@@ -234,15 +234,15 @@ PLAUSIBLE: dict[str, PlausibleRange] = {
     ),
     "brake_pressure": PlausibleRange(
         "brake-cylinder pressure", "Pa", 5e3, 2e6,
-        "issue 18: below 0.05 bar no brake acts, above 20 bar no railway brake cylinder works "
-        "(pneumatic cylinders reach about 3.8-6 bar, MODELS.md §10)",
+        "passenger brake cylinders reach about 3.8 bar (UIC 543, via a secondary source), the "
+        "examples 5.5-6 bar; the bounds 0.05 bar (no brake acts) and 20 bar (no railway "
+        "cylinder works) are issue 18's",
         (("bar", 1e5), ("kPa", 1e3), ("psi", 6894.757), ("MPa", 1e6)),
     ),
     "log_pressure": PlausibleRange(
         "brake-cylinder pressure in a braking-test log", "bar", -1.0, 20.0,
-        "the log format records bar (docs/braking-log.md); pneumatic cylinders reach about "
-        "3.8-6 bar (MODELS.md §10), 20 bar is the brake_pressure bound; down to -1 bar for "
-        "sensor offsets and noise (assumption)",
+        "the log format records bar (docs/braking-log.md); 20 bar as brake_pressure; down to "
+        "-1 bar for sensor offsets and noise (assumption)",
         (("Pa", 1e-5), ("kPa", 1e-2), ("psi", 0.06894757)),
         "the braking-log format records bar",
     ),
