@@ -265,6 +265,15 @@ def test_cli_export_table_rejects_creep_percent_above_100(tmp_path):
     assert "--creep-long-percent" in res.output and "[-100, 100] %" in res.output
 
 
+def test_cli_export_fmu_with_a_modulus_in_n_per_mm2_warns(tmp_path):
+    """Not in the issue's list, answered the same way: CONTACT's G = 82000 N/mm^2 typed as Pa."""
+    res = runner.invoke(app, ["export", "fmu", "--model", "polach", "--set", "polach2005_dry",
+                              "--shear-modulus", "82000", "--out", str(tmp_path / "c.fmu")])
+    assert res.exit_code == 0, res.output
+    assert "shear_modulus (start value) = 8.2e+04 Pa" in res.output
+    assert "given in MPa (N/mm^2)?" in res.output
+
+
 def test_sweep_spec_with_creep_in_percent_warns(tmp_path):
     from railadhesion.sweeps import load_sweep_spec
 

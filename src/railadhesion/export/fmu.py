@@ -30,6 +30,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
+from railadhesion.plausibility import check_plausible
+
 __all__ = [
     "FMU_MODELS",
     "UNIT_DEFINITIONS",
@@ -499,6 +501,8 @@ def build_creep_force_fmu(
         raise ValueError(f"shear_modulus must be > 0, got {shear_modulus!r}")
     if not (0.0 <= starts["poisson"] <= 0.5):
         raise ValueError(f"poisson must be in [0, 0.5], got {poisson!r}")
+    for name, value in starts.items():  # e.g. G = 82000 (CONTACT's N/mm^2): a warning
+        check_plausible(value, name, where=f"{name} (start value)")
     variables = [
         FmuVariable(v.name, v.causality, v.unit, v.description, starts[v.name], v.min, v.max)
         if v.name in starts
