@@ -465,8 +465,8 @@ def _log_from_columns(
                 ))
     # -- units (each finding a UnitWarning naming the column; values left as they are)
     found = (
-        check_plausible(press / BAR, "brake_pressure", quantity="log_pressure",
-                        where=f"{where}brake_pressure_i (columns)"),
+        check_plausible(np.array([press.min(), press.max()]) / BAR, "brake_pressure",
+                        quantity="log_pressure", where=f"{where}brake_pressure_i (columns)"),
         sniff_speed_ratio(v, wheel, where=f"{where}train_speed"),
         sniff_sample_period(med, where=f"{where}time"),
     )  # fmt: skip
