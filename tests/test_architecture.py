@@ -34,7 +34,7 @@ FLOORS: tuple[tuple[str, ...], ...] = (
     ("", "io"),
     ("calibration", "braking"),
     ("identification", "plotting", "export", "sweeps"),
-    ("demo",),
+    ("demo", "cli_checks"),
     ("cli_braking", "cli_export", "cli_identification", "cli_sweeps", "cli_wsp"),
     ("cli",),
     ("__main__",),

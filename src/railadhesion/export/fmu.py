@@ -31,6 +31,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
+from railadhesion.plausibility import check_plausible
+
 __all__ = [
     "FMU_MODELS",
     "UNIT_DEFINITIONS",
@@ -311,6 +313,8 @@ def creep_force_variables(model: str, *, shear_modulus: float = 8.2e10,
         raise ValueError(f"shear_modulus must be in (0, inf), got {shear_modulus!r}")
     if not (0.0 <= nu <= 0.5):
         raise ValueError(f"poisson must be in [0, 0.5], got {poisson!r}")
+    for name, value in (("shear_modulus", g), ("poisson", nu)):  # G = 82000 (N/mm^2): a warning
+        check_plausible(value, name, where=f"{name} (start value)")
     inputs = [
         FmuVariable("creep_long", "input", "1",
                     "Longitudinal creepage xi = (V - omega R)/V; braking > 0, traction < 0", 0.0),
