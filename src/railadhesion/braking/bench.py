@@ -82,6 +82,8 @@ __all__ = [
     "load_wsp_programme",
     "load_controller",
     "adhesion_limited_stop",
+    "json_ready",
+    "programme_from_document",
     "run_wsp_case",
     "run_wsp_programme",
     "write_programme_outputs",
@@ -357,6 +359,16 @@ def _programme_from_document(doc, base: Path) -> WSPProgramme:
                              sensors, diameter, external, seed, dt, max_time, gradient,
                              case_criteria))
     return WSPProgramme(name, out, description, wsp)
+
+
+def programme_from_document(doc, base=".") -> WSPProgramme:
+    """A programme from a parsed TOML document (``base``: the folder vehicle files are relative
+    to). Errors are :class:`~railadhesion.braking.BrakingFileError` naming the field (the
+    odometry bench reads its vehicle runs this way)."""
+    try:
+        return _programme_from_document(doc, Path(os.fspath(base)))
+    except FieldError as exc:
+        raise BrakingFileError(str(exc)) from None
 
 
 def load_wsp_programme(path="default") -> WSPProgramme:
@@ -986,6 +998,11 @@ def run_wsp_programme(programme="default", controller=None, *, out=None,
     if outdir is not None and figures and results:
         write_programme_outputs(result, outdir, summary_figure=True)
     return result
+
+
+def json_ready(obj):
+    """``obj`` with NaN and infinities as None and NumPy scalars as Python numbers (for JSON)."""
+    return _clean(obj)
 
 
 def _clean(obj):
