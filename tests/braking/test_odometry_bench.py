@@ -62,6 +62,12 @@ def mu030():
     return run_odometry_case(prog.cases[0], load_odometry())
 
 
+@pytest.fixture(scope="module")
+def default_run():
+    """The whole default programme with the reference odometry (no figures)."""
+    return run_odometry_programme("default")
+
+
 def test_default_programme_covers_what_issue_23_asks():
     prog = load_odometry_programme("default")
     cases = {c.name: c for c in prog.cases}
@@ -144,9 +150,26 @@ def test_small_programme_writes_every_output_and_is_deterministic(tmp_path):
     assert all(f["inside"] for f in spin["fits"])
 
 
-def test_bad_input_is_flagged_and_widens_the_interval():
-    prog = load_odometry_programme("default").select(["faults-mu050"])
-    summary, tr = run_odometry_case(prog.cases[0], load_odometry())
+def test_reference_keeps_the_true_position_inside_in_every_case(default_run):
+    res = default_run
+    assert res.overall["cases"] == 13 and not res.overall["errors"]
+    assert res.overall["inside_everywhere"] and res.overall["violation_events"] == 0
+    assert not res.failed and not res.overall["fit_errors"]
+    for c in res.cases:
+        assert c["status"] == "ok", c["name"]
+        for f in c["fits"]:
+            assert f["inside"] and f["estimate_outside_interval_samples"] == 0, (c["name"],
+                                                                                f["fit"])
+            assert f["interval_below_at_stop_m"] > 0 and f["interval_above_at_stop_m"] > 0
+    assert res.overall["worst_stop_error_fraction_with_accelerometer"] < 0.02
+    frame = res.frame()
+    assert len(frame) == res.overall["fits_run"] == 54
+    spins = [c for c in res.cases if c["traction_torque_N_m"] > 0]
+    assert all(c["spin_time_s"] > 1.0 for c in spins)
+
+
+def test_bad_input_is_flagged_and_widens_the_interval(default_run):
+    summary = next(c for c in default_run.cases if c["name"] == "faults-mu050")
     fits = {f["fit"]: f for f in summary["fits"]}
     for f in fits.values():
         assert f["inside"], f["fit"]
@@ -158,6 +181,9 @@ def test_bad_input_is_flagged_and_widens_the_interval():
     assert 30.0 <= stuck < 33.0
     assert fits["radar-outage"]["flags"]["radar_lost"]["first_s"] == pytest.approx(20.55,
                                                                                   abs=0.1)
+    sat = next(c for c in default_run.cases if c["name"] == "saturation-mu080")
+    bad = {f["fit"]: f for f in sat["fits"]}["saturating-accelerometer"]
+    assert bad["checks"]["flagged"]["passed"] and bad["interval_widening_ratio"] > 2
 
 
 def _naive():
