@@ -702,12 +702,15 @@ def odometry_update(settings, state, t, wheel_speeds, radar, accel, drive, out):
                                   + s.speed_tolerance_abs ** 2)
                     fixes += 1
                     st.q_env[i] = max(st.q_env[i], peak)
-        if steady and abs(u - v_pred) <= gate and coasting:
+        # a rolling wheel while coasting: inside the innovation gate (its tolerances and the
+        # prediction's uncertainty) and steady, for admit_time
+        r = (e * u) ** 2 / 3.0 + (s.speed_tolerance * u) ** 2 + s.speed_tolerance_abs ** 2
+        gate_i = max(gate, s.gate_sigmas * math.sqrt(max(st.p[1, 1], 0.0) + r))
+        if steady and abs(u - v_pred) <= gate_i and coasting:
             st.ok_time[i] += T
         else:
             st.ok_time[i] = 0.0
         if st.ok_time[i] >= s.admit_time:
-            r = (e * u) ** 2 / 3.0 + (s.speed_tolerance * u) ** 2 + s.speed_tolerance_abs ** 2
             _update_speed(st, u, r)
             used += 1
         else:
