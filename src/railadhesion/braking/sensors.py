@@ -222,56 +222,19 @@ def _encoder(s, st, i, dt, omega, first):
     total = st.phase[i] + travel
     k = math.floor(total)
     reading = st.omega_out[i]
-    dead = s.fault_kind[i] == FAULT_DEAD and st.t_prev + dt >= s.fault_start[i]
-    if k >= 1.0 and (dead or s.encoder_dropout > 0.0):
-        return _encoder_lossy(s, st, i, dt, travel, total, k, reading, dead)
-    if k >= 1.0:
-        # time of the last edge inside the period (speed taken constant over the period)
-        t_edge = st.t_prev + (k - st.phase[i]) / travel * dt
-        pitch_time = dt / travel
-        if s.edge_jitter > 0.0:
-            t_edge += s.edge_jitter * pitch_time * random_normal(st)
-        if s.clock_resolution > 0.0:
-            t_edge = math.floor(t_edge / s.clock_resolution + 0.5) * s.clock_resolution
-        span = t_edge - st.edge_time[i]
-        if span > 0.0:
-            reading = _TWO_PI / n_teeth * k / span
-        st.edge_time[i] = t_edge
-        st.pulses[i] += np.int64(k)
-        st.phase[i] = total - k
-    else:
+    if k < 1.0:
         st.phase[i] = total
-        since = st.t_prev + dt - st.edge_time[i]
-        if since > 0.0:
-            bound = _TWO_PI / n_teeth / since
-            if bound < reading:
-                reading = bound
-    return reading
-
-
-@njit(cache=True)
-def _encoder_lossy(s, st, i, dt, travel, total, k, reading, dead):
-    """:func:`_encoder` for edges some of which are lost (``encoder_dropout`` per pulse, or
-    every one after a "dead" fault): the unit counts the pulses it detects over the time
-    between its last detected edges, so a lost pulse makes the reading low; with none
-    detected the reading decays as one pitch over the time since the last edge."""
-    n_teeth = s.pulses_per_revolution
-    detected = 0
-    last = -1.0
-    for j in range(1, int(k) + 1):
-        if dead or random_uniform(st) < s.encoder_dropout:
-            continue
-        detected += 1
-        last = j
-    st.phase[i] = total - k
-    if detected == 0:
-        since = st.t_prev + dt - st.edge_time[i]
-        if since > 0.0:
-            bound = _TWO_PI / n_teeth / since
-            if bound < reading:
-                reading = bound
-        return reading
-    t_edge = st.t_prev + (last - (total - travel)) / travel * dt
+        return _no_edge(s, st, i, dt, reading)
+    detected = k
+    last = k
+    if s.encoder_dropout > 0.0 or (s.fault_kind[i] == FAULT_DEAD
+                                   and st.t_prev + dt >= s.fault_start[i]):
+        detected, last = _detected(s, st, i, dt, k)
+    if detected < 1.0:
+        st.phase[i] = total - k
+        return _no_edge(s, st, i, dt, reading)
+    # time of the last detected edge inside the period (speed taken constant over it)
+    t_edge = st.t_prev + (last - st.phase[i]) / travel * dt
     pitch_time = dt / travel
     if s.edge_jitter > 0.0:
         t_edge += s.edge_jitter * pitch_time * random_normal(st)
@@ -282,7 +245,36 @@ def _encoder_lossy(s, st, i, dt, travel, total, k, reading, dead):
         reading = _TWO_PI / n_teeth * detected / span
     st.edge_time[i] = t_edge
     st.pulses[i] += np.int64(detected)
+    st.phase[i] = total - k
     return reading
+
+
+@njit(cache=True)
+def _no_edge(s, st, i, dt, reading):
+    """With no new edge the speed is at most one pitch over the time since the last edge."""
+    since = st.t_prev + dt - st.edge_time[i]
+    if since > 0.0:
+        bound = _TWO_PI / s.pulses_per_revolution / since
+        if bound < reading:
+            reading = bound
+    return reading
+
+
+@njit(cache=True)
+def _detected(s, st, i, dt, k):
+    """(pulses detected, position of the last detected one) among the k edges of a period:
+    each is lost with probability ``encoder_dropout``, every one after a "dead" fault. The unit
+    counts only what it detects over the time between its detected edges, so a lost pulse
+    makes the reading low."""
+    dead = s.fault_kind[i] == FAULT_DEAD and st.t_prev + dt >= s.fault_start[i]
+    detected = 0.0
+    last = 0.0
+    for j in range(1, int(k) + 1):
+        if dead or random_uniform(st) < s.encoder_dropout:
+            continue
+        detected += 1.0
+        last = float(j)
+    return detected, last
 
 
 @njit(cache=True)
