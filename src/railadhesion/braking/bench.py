@@ -83,7 +83,9 @@ __all__ = [
     "load_controller",
     "adhesion_limited_stop",
     "json_ready",
+    "load_attribute",
     "programme_from_document",
+    "read_cosim_fmu",
     "run_wsp_case",
     "run_wsp_programme",
     "write_programme_outputs",
@@ -468,6 +470,51 @@ class _PythonController:
     def diagnostics(self):
         d = getattr(self.obj, "diagnostics", None)
         return d() if callable(d) else {}
+
+
+def read_cosim_fmu(path, period: float | None = None, what: str = "FMU"):
+    """Open an FMI 2.0 co-simulation FMU with FMPy: ``(path, model description, variables by
+    name, period)``; the period is ``period``, else the FMU's DefaultExperiment step size, else
+    5 ms. ``what`` names the FMU in the ImportError without FMPy."""
+    try:
+        from fmpy import read_model_description
+    except ImportError as exc:  # pragma: no cover - fmpy is in the fmu extra
+        raise ImportError(f"{what} needs FMPy: pip install 'railadhesion[fmu]'") from exc
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"FMU file not found: {path}")
+    try:
+        md = read_model_description(str(path))
+    except Exception as exc:  # FMPy raises several kinds for a broken archive
+        raise ValueError(f"{path}: not a readable FMU: {exc}") from None
+    if md.coSimulation is None:
+        raise ValueError(f"{path}: not a co-simulation FMU (FMI 2.0 CS needed)")
+    variables = {v.name: v for v in md.modelVariables}
+    step = getattr(md.defaultExperiment, "stepSize", None) if (
+        md.defaultExperiment is not None) else None
+    if period is None:
+        period = float(step) if step else 5e-3
+    if not (math.isfinite(period) and period > 0):
+        raise ValueError(f"period must be in (0, inf) s, got {period!r}")
+    return path, md, variables, float(period)
+
+
+def load_attribute(text: str, what: str, prefix: str):
+    """The object ``"module:name"`` or ``"file.py:name"`` names (a file is imported as module
+    ``prefix + its stem``); errors name ``what`` and the specification."""
+    where, name = text.rsplit(":", 1)
+    if where.endswith(".py"):
+        path = Path(where)
+        if not path.is_file():
+            raise ValueError(f"{what} file not found: {path}")
+        mspec = importlib.util.spec_from_file_location(f"{prefix}{path.stem}", path)
+        module = importlib.util.module_from_spec(mspec)
+        mspec.loader.exec_module(module)
+    else:
+        module = importlib.import_module(where)
+    if not hasattr(module, name):
+        raise ValueError(f"{what} {text!r}: {where} has no attribute {name!r}")
+    return getattr(module, name)
 
 
 class FmuController:

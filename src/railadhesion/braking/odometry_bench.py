@@ -25,8 +25,6 @@ the others go on.
 from __future__ import annotations
 
 import copy
-import importlib
-import importlib.util
 import json
 import math
 import os
@@ -50,8 +48,10 @@ from railadhesion.braking._fields import (
 from railadhesion.braking.bench import (
     BenchCase,
     json_ready,
+    load_attribute,
     load_controller,
     programme_from_document,
+    read_cosim_fmu,
 )
 from railadhesion.braking.odometry import STATUS_BITS, ReferenceOdometry
 from railadhesion.braking.sensors import (
@@ -560,28 +560,10 @@ class FmuOdometry:
     """
 
     def __init__(self, path, period: float | None = None):
-        try:
-            from fmpy import extract, read_model_description
-        except ImportError as exc:  # pragma: no cover - fmpy is in the fmu extra
-            raise ImportError("FMU odometries need FMPy: pip install 'railadhesion[fmu]'") \
-                from exc
-        self.path = Path(path)
-        if not self.path.is_file():
-            raise ValueError(f"FMU file not found: {self.path}")
-        try:
-            self.md = read_model_description(str(self.path))
-        except Exception as exc:  # FMPy raises several kinds for a broken archive
-            raise ValueError(f"{self.path}: not a readable FMU: {exc}") from None
-        if self.md.coSimulation is None:
-            raise ValueError(f"{self.path}: not a co-simulation FMU (FMI 2.0 CS needed)")
-        self.vars = {v.name: v for v in self.md.modelVariables}
-        step = getattr(self.md.defaultExperiment, "stepSize", None) if (
-            self.md.defaultExperiment is not None) else None
-        if period is None:
-            period = float(step) if step else 5e-3
-        if not (math.isfinite(period) and period > 0):
-            raise ValueError(f"period must be in (0, inf) s, got {period!r}")
-        self.period = float(period)
+        self.path, self.md, self.vars, self.period = read_cosim_fmu(path, period,
+                                                                    "FMU odometries")
+        from fmpy import extract
+
         self.label = f"FMU {self.path.name}"
         self.dir = extract(str(self.path))
 
@@ -705,19 +687,7 @@ def load_odometry(spec=None, *, period: float | None = None):
         if ":" not in text:
             raise ValueError(f"odometry {text!r}: give 'reference', a .fmu file, or "
                              "'module:name' / 'file.py:name'")
-        where, name = text.rsplit(":", 1)
-        if where.endswith(".py"):
-            path = Path(where)
-            if not path.is_file():
-                raise ValueError(f"odometry file not found: {path}")
-            mspec = importlib.util.spec_from_file_location(f"odometry_{path.stem}", path)
-            module = importlib.util.module_from_spec(mspec)
-            mspec.loader.exec_module(module)
-        else:
-            module = importlib.import_module(where)
-        if not hasattr(module, name):
-            raise ValueError(f"odometry {text!r}: {where} has no attribute {name!r}")
-        return _PythonOdometry(getattr(module, name), period)
+        return _PythonOdometry(load_attribute(text, "odometry", "odometry_"), period)
     return _PythonOdometry(spec, period)
 
 
