@@ -532,28 +532,10 @@ class FmuController:
     """
 
     def __init__(self, path, period: float | None = None):
-        try:
-            from fmpy import extract, read_model_description
-        except ImportError as exc:  # pragma: no cover - fmpy is in the fmu extra
-            raise ImportError("FMU controllers need FMPy: pip install 'railadhesion[fmu]'") \
-                from exc
-        self.path = Path(path)
-        if not self.path.is_file():
-            raise ValueError(f"FMU file not found: {self.path}")
-        try:
-            self.md = read_model_description(str(self.path))
-        except Exception as exc:  # FMPy raises several kinds for a broken archive
-            raise ValueError(f"{self.path}: not a readable FMU: {exc}") from None
-        if self.md.coSimulation is None:
-            raise ValueError(f"{self.path}: not a co-simulation FMU (FMI 2.0 CS needed)")
-        self.vars = {v.name: v for v in self.md.modelVariables}
-        step = getattr(self.md.defaultExperiment, "stepSize", None) if (
-            self.md.defaultExperiment is not None) else None
-        if period is None:
-            period = float(step) if step else 5e-3
-        if not (math.isfinite(period) and period > 0):
-            raise ValueError(f"period must be in (0, inf) s, got {period!r}")
-        self.period = float(period)
+        self.path, self.md, self.vars, self.period = read_cosim_fmu(path, period,
+                                                                    "FMU controllers")
+        from fmpy import extract
+
         self.label = f"FMU {self.path.name}"
         self._extract = extract
         self.fmu = None
@@ -663,19 +645,7 @@ def load_controller(spec=None, *, control_period: float | None = None, wsp_setti
         if ":" not in text:
             raise ValueError(f"controller {text!r}: give 'default', a .fmu file, or "
                              "'module:name' / 'file.py:name'")
-        where, name = text.rsplit(":", 1)
-        if where.endswith(".py"):
-            path = Path(where)
-            if not path.is_file():
-                raise ValueError(f"controller file not found: {path}")
-            mspec = importlib.util.spec_from_file_location(f"wsp_controller_{path.stem}", path)
-            module = importlib.util.module_from_spec(mspec)
-            mspec.loader.exec_module(module)
-        else:
-            module = importlib.import_module(where)
-        if not hasattr(module, name):
-            raise ValueError(f"controller {text!r}: {where} has no attribute {name!r}")
-        obj = getattr(module, name)
+        obj = load_attribute(text, "controller", "wsp_controller_")
         if isinstance(obj, WheelSlideProtection):
             return _DefaultController(obj)
         return _PythonController(obj, control_period)
