@@ -189,6 +189,7 @@ STATE_DTYPE = np.dtype([
     ("mode", "i8"),                     # 1 accelerometer, 0 none, -1 not yet
     ("x", "f8", (3,)),                  # distance, speed, bias (or acceleration)
     ("p", "f8", (3, 3)),                # covariance
+    ("fp", "f8", (3, 3)),               # work: F P
     ("v_lo", "f8"), ("v_hi", "f8"), ("d_lo", "f8"), ("d_hi", "f8"),
     ("hi_v", "f8"), ("hi_s", "f8"), ("hi_t", "f8"), ("hi_t2", "f8"),   # upper anchor
     ("lo_v", "f8"), ("lo_s", "f8"), ("lo_t", "f8"), ("lo_t2", "f8"),   # lower anchor
@@ -317,23 +318,15 @@ def _predict(st, T, with_accel, a_in, s):
     x[0] += x[1] * T + c1 * x[2] + 0.5 * T * T * drive
     x[1] += c2 * x[2] + T * drive
     # P <- F P F', F = [[1, T, c1], [0, 1, c2], [0, 0, 1]]
-    f = np.empty((3, 3))
-    f[0, 0], f[0, 1], f[0, 2] = 1.0, T, c1
-    f[1, 0], f[1, 1], f[1, 2] = 0.0, 1.0, c2
-    f[2, 0], f[2, 1], f[2, 2] = 0.0, 0.0, 1.0
-    fp = np.zeros((3, 3))
+    fp = st.fp
+    for j in range(3):
+        fp[0, j] = p[0, j] + T * p[1, j] + c1 * p[2, j]
+        fp[1, j] = p[1, j] + c2 * p[2, j]
+        fp[2, j] = p[2, j]
     for i in range(3):
-        for j in range(3):
-            acc = 0.0
-            for k in range(3):
-                acc += f[i, k] * p[k, j]
-            fp[i, j] = acc
-    for i in range(3):
-        for j in range(3):
-            acc = 0.0
-            for k in range(3):
-                acc += fp[i, k] * f[j, k]
-            p[i, j] = acc
+        p[i, 0] = fp[i, 0] + T * fp[i, 1] + c1 * fp[i, 2]
+        p[i, 1] = fp[i, 1] + c2 * fp[i, 2]
+        p[i, 2] = fp[i, 2]
     if with_accel:
         g0 = 0.5 * T * T
         q = s.accel_noise * s.accel_noise
@@ -408,8 +401,8 @@ def odometry_update(settings, state, t, wheel_speeds, radar, accel, drive, out):
     ``settings``/``state``: the records of :meth:`OdometrySettings.settings_record` and
     :func:`state_record`; ``wheel_speeds`` [rad/s] of the axles read; ``radar`` [m/s] and
     ``accel`` [m/s²] or NaN; ``drive`` -1, 0 or +1. Writes ``out[:5] = (speed, distance,
-    distance_min, distance_max, status)``. numba ``@njit``, raises nothing, allocates only
-    two 3×3 work arrays.
+    distance_min, distance_max, status)``. numba ``@njit``, raises nothing, allocates
+    nothing (its state is the record).
     """
     s = settings[0]
     st = state[0]

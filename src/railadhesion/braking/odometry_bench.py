@@ -75,6 +75,7 @@ __all__ = [
     "OdometryProgrammeResult",
     "OdometryInterfaceError",
     "FmuOdometry",
+    "check_output",
     "load_odometry_programme",
     "load_odometry",
     "run_odometry_case",
