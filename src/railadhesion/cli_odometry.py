@@ -11,6 +11,7 @@ from rich.markup import escape
 from rich.table import Table
 
 console = Console()
+_ROUTINE = ("slide", "spin", "dead_reckoning")
 
 
 def _fmt(value, spec):
@@ -63,33 +64,36 @@ def register(app: typer.Typer) -> None:
 
         result = run_odometry_programme(prog, odo, out=out, figures=figures,
                                         histories=histories, progress=progress)
-        table = Table(title=escape(f"{prog.name or programme} — {result.odometry}"))
-        # stop error over the stopping distance; max speed error; interval below and above
-        # the true position at the stop; violations of the interval
-        for col in ("case", "fit", "stop [m]", "error [%]", "speed err [m/s]", "below [m]",
-                    "above [m]", "inside", "flags", "ok"):
-            table.add_column(escape(col), justify="left" if col in ("case", "fit", "flags")
-                             else "right", no_wrap=col in ("case", "fit"))
+        console.print(escape(f"{prog.name or programme} — {result.odometry}"),
+                      style="bold", highlight=False)
+        # per case: the error at the stop over the stopping distance; the largest speed
+        # error; the interval below and above the true position at the stop; the checks
+        # (violations of the interval counted); flags other than slide, spin, dead reckoning
         for c in result.cases:
             if c.get("status") == "error":
-                table.add_row(escape(c["name"]), "", "", "", "", "", "", "",
-                              "[red]error[/red]", "no")
+                console.print(f"[red]{escape(c['name'])}: error[/red]")
                 continue
+            table = Table(title=escape(f"{c['name']}: stop {_fmt(c['stopping_distance_m'], '.0f')}"
+                                       f" m"), title_justify="left")
+            for col in ("fit", "err [%]", "dv [m/s]", "-int [m]", "+int [m]", "check"):
+                table.add_column(escape(col), justify="left" if col == "fit" else "right",
+                                 no_wrap=True)
+            alerts = []
             for f in c["fits"]:
                 if f.get("status") == "error":
-                    table.add_row(escape(c["name"]), escape(f["fit"]), "", "", "", "", "", "",
-                                  "[red]error[/red]", "no")
+                    table.add_row(escape(f["fit"]), "", "", "", "", "[red]error[/red]")
                     continue
-                inside = "yes" if f["inside"] else f"[red]{len(f['violations'])} events[/red]"
-                table.add_row(escape(c["name"]), escape(f["fit"]),
-                              _fmt(c["stopping_distance_m"], ".0f"),
-                              _fmt(100 * f["stop_error_fraction"], "+.2f"),
+                alerts += [f"{f['fit']}: {k} from {v['first_s']:.2f} s"
+                           for k, v in f["flags"].items() if k not in _ROUTINE]
+                check = ("ok" if f.get("passed") else "[red]fail[/red]") if f["inside"] else (
+                    f"[red]{len(f['violations'])} viol.[/red]")
+                table.add_row(escape(f["fit"]), _fmt(100 * f["stop_error_fraction"], "+.2f"),
                               _fmt(f["speed_error_max_m_s"], ".2f"),
                               _fmt(f["interval_below_at_stop_m"], ".0f"),
-                              _fmt(f["interval_above_at_stop_m"], ".0f"), inside,
-                              escape(" ".join(f["flags"])),
-                              "yes" if f.get("passed") else "[red]no[/red]")
-        console.print(table)
+                              _fmt(f["interval_above_at_stop_m"], ".0f"), check)
+            console.print(table)
+            for line in alerts:
+                console.print(f"  flagged {escape(line)}", highlight=False)
         for c in result.cases:
             if c.get("status") == "error":
                 console.print(f"[red]{escape(c['name'])}:[/red] {escape(c['message'])}")
