@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
-import inspect
 import json
 import math
 import os
@@ -65,6 +64,7 @@ from railadhesion.braking.vehicle import GRAVITY, Vehicle, load_vehicle
 from railadhesion.braking.wsp import (
     WheelSlideProtection,
     WSPSettings,
+    accepts_measurements,
     settings_file_keys,
     state_diagnostics,
     wsp_update,
@@ -82,13 +82,13 @@ __all__ = [
     "load_wsp_programme",
     "load_controller",
     "adhesion_limited_stop",
-    "json_ready",
     "load_attribute",
     "programme_from_document",
     "read_cosim_fmu",
     "run_wsp_case",
     "run_wsp_programme",
     "write_programme_outputs",
+    "json_safe",
 ]
 
 PROGRAMME_FORMAT = "railadhesion-wsp-programme"
@@ -418,16 +418,6 @@ class _DefaultController:
         return state_diagnostics(self.state)
 
 
-def _accepts(fn, names) -> bool:
-    try:
-        params = inspect.signature(fn).parameters
-    except (TypeError, ValueError):
-        return False
-    if any(p.kind == p.VAR_KEYWORD for p in params.values()):
-        return True
-    return all(n in params for n in names)
-
-
 class _PythonController:
     """A user's controller object (``period``, ``reset``, ``__call__``) or plain function."""
 
@@ -444,7 +434,7 @@ class _PythonController:
             type(obj), "__qualname__", type(obj).__name__)
         if not callable(obj):
             raise ValueError(f"the controller {self.label!r} is not callable")
-        self.extra = _accepts(obj, ("brake_pressures", "external_speed"))
+        self.extra = accepts_measurements(obj)
 
     def prepare(self, case: BenchCase):
         if isinstance(self.obj, WheelSlideProtection):
@@ -1017,20 +1007,17 @@ def run_wsp_programme(programme="default", controller=None, *, out=None,
     return result
 
 
-def json_ready(obj):
-    """``obj`` with NaN and infinities as None and NumPy scalars as Python numbers (for JSON)."""
-    return _clean(obj)
-
-
-def _clean(obj):
+def json_safe(obj):
+    """A JSON-safe copy of nested dicts and lists: NaN and inf become null, NumPy scalars
+    Python numbers."""
     if isinstance(obj, dict):
-        return {str(k): _clean(v) for k, v in obj.items()}
+        return {str(k): json_safe(v) for k, v in obj.items()}
     if isinstance(obj, list | tuple):
-        return [_clean(v) for v in obj]
+        return [json_safe(v) for v in obj]
     if isinstance(obj, float) and not math.isfinite(obj):
         return None
-    if isinstance(obj, np.generic):
-        return _clean(obj.item())
+    if hasattr(obj, "item") and not isinstance(obj, str | bytes):
+        return json_safe(obj.item())
     return obj
 
 
@@ -1048,7 +1035,7 @@ def write_programme_outputs(result: WSPProgrammeResult, out, *, case=None,
            "controller": result.controller, "overall": result.overall, "cases": result.cases}
     path = out / "summary.json"
     tmp = path.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(_clean(doc), indent=2, ensure_ascii=False) + "\n",
+    tmp.write_text(json.dumps(json_safe(doc), indent=2, ensure_ascii=False) + "\n",
                    encoding="utf-8")
     tmp.replace(path)
     written.append(path)
@@ -1061,7 +1048,7 @@ def write_programme_outputs(result: WSPProgrammeResult, out, *, case=None,
         bench_case, summary, h, trace = case
         (out / "cases").mkdir(exist_ok=True)
         path = out / "cases" / f"{bench_case.name}.json"
-        path.write_text(json.dumps(_clean(summary), indent=2, ensure_ascii=False) + "\n",
+        path.write_text(json.dumps(json_safe(summary), indent=2, ensure_ascii=False) + "\n",
                         encoding="utf-8")
         written.append(path)
         if h is not None and figures:

@@ -47,7 +47,7 @@ from railadhesion.braking._fields import (
 )
 from railadhesion.braking.bench import (
     BenchCase,
-    json_ready,
+    json_safe,
     load_attribute,
     load_controller,
     programme_from_document,
@@ -1096,7 +1096,7 @@ def write_odometry_outputs(result: OdometryProgrammeResult, out, *, case=None,
            "odometry": result.odometry, "overall": result.overall, "cases": result.cases}
     path = out / "summary.json"
     tmp = path.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(json_ready(doc), indent=2, ensure_ascii=False) + "\n",
+    tmp.write_text(json.dumps(json_safe(doc), indent=2, ensure_ascii=False) + "\n",
                    encoding="utf-8")
     tmp.replace(path)
     written.append(path)
@@ -1107,7 +1107,7 @@ def write_odometry_outputs(result: OdometryProgrammeResult, out, *, case=None,
         ocase, summary, tr = case
         (out / "cases").mkdir(exist_ok=True)
         path = out / "cases" / f"{ocase.name}.json"
-        path.write_text(json.dumps(json_ready(summary), indent=2, ensure_ascii=False) + "\n",
+        path.write_text(json.dumps(json_safe(summary), indent=2, ensure_ascii=False) + "\n",
                         encoding="utf-8")
         written.append(path)
         if tr is not None and figures:

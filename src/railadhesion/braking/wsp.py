@@ -67,6 +67,7 @@ from numba import njit
 from railadhesion.braking.cylinders import APPLY, HOLD, VENT
 
 __all__ = ["WSPSettings", "WheelSlideProtection", "as_controller", "call_controller",
+           "accepts_measurements",
            "wsp_update", "settings_file_keys", "state_diagnostics", "SETTINGS_DTYPE",
            "STATE_DTYPE", "PHASES"]
 
@@ -360,11 +361,11 @@ def wsp_update(settings, state, t, omega_meas, pressure_meas, command, external_
                     st.t_step[g] = 0.0
                     step = s.reapply_step_fraction * st.p_slide[g]
                     middle = 0.5 * (reapply + hold)
-                    if dec > 2.0 * s.reapply_deceleration or (slip > middle
-                                                              and not accelerating):
+                    if dec > 2.0 * s.reapply_deceleration or (
+                            slip > middle and dec > 0.5 * s.reapply_deceleration):
                         st.turned[g] = 1  # a release step
                         st.p_target[g] = p - step
-                    elif slip < reapply and dec < s.reapply_deceleration:
+                    elif slip < middle and dec < s.reapply_deceleration:
                         st.turned[g] = 0  # an apply step
                         st.p_target[g] = p + step
                     else:
@@ -688,6 +689,12 @@ def state_diagnostics(state) -> dict:
             "vent_commands": int(r["vent_commands"]),
             "cut_out_groups": [g + 1 for g in range(ng) if r["cutout"][g]],
             "phases": [PHASES[int(r["phase"][g])] for g in range(ng)]}
+
+
+def accepts_measurements(fn) -> bool:
+    """True if the controller ``fn`` takes ``brake_pressures`` and ``external_speed`` keyword
+    arguments (or ``**kwargs``)."""
+    return _accepts(fn, ("brake_pressures", "external_speed"))
 
 
 def _accepts(fn, names) -> bool:
