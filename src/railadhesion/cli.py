@@ -735,11 +735,12 @@ from railadhesion import (  # noqa: E402
     cli_braking,
     cli_export,
     cli_identification,
+    cli_odometry,
     cli_sweeps,
     cli_wsp,
 )
 
-for _module in (cli_braking, cli_identification, cli_sweeps, cli_export, cli_wsp):
+for _module in (cli_braking, cli_identification, cli_sweeps, cli_export, cli_wsp, cli_odometry):
     _module.register(app)
 
 if __name__ == "__main__":  # pragma: no cover
