@@ -35,7 +35,8 @@ FLOORS: tuple[tuple[str, ...], ...] = (
     ("calibration", "braking"),
     ("identification", "plotting", "export", "sweeps"),
     ("demo", "cli_checks"),
-    ("cli_braking", "cli_export", "cli_identification", "cli_sweeps", "cli_wsp"),
+    ("cli_braking", "cli_export", "cli_identification", "cli_sweeps", "cli_wsp",
+     "cli_odometry"),
     ("cli",),
     ("__main__",),
 )
