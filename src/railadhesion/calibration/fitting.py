@@ -517,8 +517,8 @@ def fit_polach(
     origin on the points before the peak and below 0.6 x the peak) to Kalker's, since
     Polach's slope at small creep is (k_A + k_S)/2 times Kalker's (Polach 2005). The fit is
     started from a few variants (k_A above/at k_S with B = 1/w_max and 5/w_max, w_max the
-    largest slip velocity |xi|V; and four fixed (k_A, k_S) pairs from (1, 1) to
-    (0.05, 0.02)) and the lowest cost is kept. Standard errors: ``sqrt(diag(s² (JᵀJ)⁻¹))``,
+    largest slip velocity |xi|V; and six fixed (k_A, k_S) pairs from (1, 1) to
+    (0.05, 0.005)) and the lowest cost is kept. Standard errors: ``sqrt(diag(s² (JᵀJ)⁻¹))``,
     s² = SSR/(n - p), the Jacobian at the solution (as :func:`scipy.optimize.curve_fit`);
     they are unreliable for a parameter at a bound. With B = 0 (or A = 1) the other of the
     pair is not identifiable.
@@ -623,7 +623,9 @@ def fit_polach(
     b_starts = [1.0 / w_max, 5.0 / w_max] if w_max > 0 else [b_lo]
     # Data-driven slope pairs with two B values, plus a fixed spread of slopes (for curves
     # whose first points are already past the k_A hump, or have no rising part at all).
-    spread = [(1.0, 1.0), (1.0, 0.2), (0.3, 0.1), (0.05, 0.02)]
+    # k_S down to a tenth of k_A: a curve still rising at its largest creep (a small k_S)
+    # has a second minimum near k_S/k_A ~ 0.3 that starts above it do not leave.
+    spread = [(1.0, 1.0), (1.0, 0.2), (0.3, 0.1), (0.3, 0.03), (0.05, 0.02), (0.05, 0.005)]
     variants = [(1.5 * k_mean, 0.5 * k_mean, b0) for b0 in b_starts] if k_mean else []
     variants += [(k_mean, k_mean, b_starts[0])] if k_mean else []
     variants += [(ka, ks, b_starts[-1]) for ka, ks in spread]
