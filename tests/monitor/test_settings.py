@@ -49,3 +49,24 @@ def test_round_trip_and_unknown_names():
     assert s.replace(threshold=0.1).threshold == 0.1
     with pytest.raises(ValueError, match="treshold"):
         MonitorSettings.from_dict({"treshold": 0.1})
+
+
+def test_slope_bound_is_twice_kalkers_linear_theory():
+    """Default max_slope: 2 x G a b C11 / Q of the coach's wheel (Hertz on a 0.3 m crown)."""
+    import math
+
+    from railadhesion.braking import ContactGeometry, load_vehicle
+    from railadhesion.contact import hertz_3d, kalker_coefficients
+    from railadhesion.monitor.estimator import max_slope
+
+    coach = load_vehicle("coach_default")
+    q = 0.5 * float(coach.axle_normal_loads(0.0).mean())
+    h = hertz_3d(q, coach.wheel_radius, math.inf, 0.3)
+    c11 = float(kalker_coefficients(h.a / h.b, 0.28)[0])
+    kalker = 8.2e10 * h.a * h.b * c11 / q
+    assert max_slope(coach, MonitorSettings()) == pytest.approx(2.0 * kalker, rel=1e-9)
+    assert 170.0 < kalker < 185.0  # 177 for this contact
+    assert ContactGeometry(coach.wheel_radius).shear_modulus == 8.2e10
+    assert max_slope(coach, MonitorSettings(max_slope=250.0)) == 250.0
+    with pytest.raises(ValueError, match="max_slope"):
+        MonitorSettings(max_slope=0.5)

@@ -16,15 +16,17 @@ from railadhesion.monitor import layout
 from railadhesion.monitor.settings import POLACH_RATIO, MonitorSettings
 
 __all__ = ["AdhesionMonitor", "MonitorInputs", "MonitorOutputs", "MonitorSnapshot",
-           "build_config"]
+           "build_config", "max_slope"]
 
 #: Ratio of neighbouring hypotheses of the friction level, and the lowest one.
 _NODE_RATIO = 1.1
 _NODE_LOW = 0.02
 #: Random walk of ln(initial slope) per block (its variance): slow changes are followed.
 _SLOPE_WALK = 0.02 ** 2
-#: Slopes outside [1, 5000] are not considered.
-_SLOPE_RANGE = (1.0, 5000.0)
+#: Smallest initial slope considered [-].
+_SLOPE_MIN = 1.0
+#: Margin on Kalker's linear-theory slope for the default ``max_slope`` (our choice).
+_KALKER_MARGIN = 2.0
 #: Braking time before the causal eq. 14 value may replace the vehicle's c [s].
 _C_MIN_TIME = 5.0
 
@@ -40,6 +42,21 @@ def _per_axle_flags(value, n: int, name: str) -> np.ndarray:
     if len(flags) != n:
         raise ValueError(f"{name} must have {n} entries (one per axle), got {len(flags)}")
     return np.array(flags)
+
+
+def max_slope(vehicle, settings: MonitorSettings) -> float:
+    """The largest initial slope of the creep curve the estimator considers: the setting, or
+    twice Kalker's linear-theory slope ``G a b C11 / Q`` of the vehicle's wheel at its static
+    load on a 0.3 m rail crown (:class:`railadhesion.braking.ContactGeometry`, whose
+    ``stiffness_over_load`` is ``(pi/4) G a b C11 / Q``)."""
+    if settings.max_slope is not None:
+        return settings.max_slope
+    from railadhesion.braking import ContactGeometry
+
+    load = 0.5 * float(np.mean(vehicle.axle_normal_loads(0.0)))  # one wheel
+    geometry = ContactGeometry(wheel_radius=vehicle.wheel_radius)
+    kalker = 4.0 / math.pi * float(geometry.stiffness_over_load(load))
+    return _KALKER_MARGIN * kalker
 
 
 def build_config(vehicle, settings: MonitorSettings, pressure=True, torque=False) -> np.ndarray:
@@ -105,7 +122,8 @@ def build_config(vehicle, settings: MonitorSettings, pressure=True, torque=False
     c["c_min_time"] = _C_MIN_TIME
     c["log_slope0"] = math.log(s.slope_prior)
     c["var_slope0"] = s.slope_prior_spread ** 2
-    c["log_slope_min"], c["log_slope_max"] = (math.log(x) for x in _SLOPE_RANGE)
+    c["log_slope_min"] = math.log(_SLOPE_MIN)
+    c["log_slope_max"] = math.log(max_slope(vehicle, s))
     mus = _NODE_LOW * _NODE_RATIO ** np.arange(layout.FINITE_NODES)
     for f in range(len(layout.SHAPES)):
         first = f * layout.FAMILY

@@ -37,7 +37,9 @@ What one sample does
    weighted by their residuals (multiple-model adaptive estimation, Magill 1965), with the
    creep noise carried into the adhesion residual through the curve's slope ("effective
    variance", Orear 1982) and exponential forgetting of time constant ``memory``. The
-   weights give the available adhesion (median) and its band (quantiles). A block far off
+   weights give the available adhesion and its band (quantiles). The residuals are weighed as
+   Student-t (4 degrees of freedom) so that one odd block cannot swing the weights, and the
+   initial slope is bounded (``max_slope``: no contact is stiffer than Kalker's). A block far off
    the prediction, or whose creep is far from the remembered creeps at the same adhesion
    (``change_z`` standard deviations, ``change_blocks`` blocks in a row), restarts the
    estimate (a change of the rail).
@@ -89,6 +91,7 @@ R_TIME_NAN, R_RECOVERING, R_NUMERICAL = 33, 40, 41
 _NOMINAL, _LEARNED, _UNCONFIRMED_R = 0, 1, 2
 
 _C_MEMORY = 10.0  # s: memory of the causal eq. 14 mean
+_DOF = 4.0  # degrees of freedom of the Student-t residuals of the estimator (our choice)
 _C_MIN_PRESSURE = 0.5e5  # Pa: braking for eq. 14 (as identify_adhesion's window)
 
 # The kernels inline fletcher_scalar from railadhesion.models.kernels, which numba's cache of
@@ -489,18 +492,23 @@ def _estimate(cfg, st, bank, out, i, t, x, mu, var_x, var_mu):
         st.outliers[i] = 0
         # adaptive noise scale: the mean squared standardised residual of the best hypotheses
         st.nis[i] = min(max(0.95 * st.nis[i] + 0.05 * min(dist2, 100.0), 1.0), 100.0)
-    # update every hypothesis: EKF on ln(slope), log-weight by its residual
+    # update every hypothesis: EKF on ln(slope), log-weight by its residual; Student-t
+    # residuals (``_DOF`` degrees of freedom) so that one odd block cannot swing the weights
+    # (the EKF's measurement variance scaled by the same weight: a robust Kalman update)
     ok = True
     for j in range(_NODES):
         e = res[3 * j]
         h = res[3 * j + 1]
         s = res[3 * j + 2]
         p = bank[2, i, j]
-        k = p * h / s
+        z2 = e * e / s
+        robust = (_DOF + 1.0) / (_DOF + z2)
+        s_eff = h * h * p + (s - h * h * p) / robust
+        k = p * h / s_eff
         m = bank[1, i, j] + k * e
         bank[1, i, j] = min(max(m, cfg.log_slope_min), cfg.log_slope_max)
         bank[2, i, j] = max(p - k * h * p, 1e-12)
-        bank[0, i, j] += -0.5 * e * e / s
+        bank[0, i, j] += -0.5 * (_DOF + 1.0) * math.log1p(z2 / _DOF)
         if not (_finite(bank[0, i, j]) and _finite(bank[1, i, j])):
             ok = False
     if not ok:

@@ -168,6 +168,15 @@ class MonitorSettings:
         Log-normal prior of the initial slope of the creep curve [-] (median 60, spread 1.2
         in ln: slopes 18-200 within one spread; our choice, covering Polach's and WILAC's
         curves for wheel loads 30-80 kN).
+    max_slope : float, optional
+        Largest initial slope of the creep curve [-]. Default: twice Kalker's linear-theory
+        slope G a b C11 / Q of the vehicle's wheel at its static load on a 0.3 m rail crown
+        (the contact of :class:`railadhesion.braking.ContactGeometry`; 177 for the default
+        coach). No real contact is stiffer than Kalker's clean one (Polach's k_A <= 1,
+        Fletcher's k_a <= 1); the factor 2 leaves room for conformal, worn profiles (our
+        choice). Without a bound, a curve with a very steep start that saturates just above
+        the adhesion in use explains any creep scatter at a steady force: the bound keeps
+        such curves out.
     shapes : {"both", "fletcher", "polach"}
         Shapes of the creep curve the estimator fits (default both, mixed half and half).
         Low-creep data show the curve up to the creep they reach, not how it goes on: Fletcher's
@@ -220,6 +229,7 @@ class MonitorSettings:
     lone_shift: float = 1e-3
     slope_prior: float = 60.0
     slope_prior_spread: float = 1.2
+    max_slope: float | None = None
     shapes: str = "both"
     brake_coefficient: str = "vehicle"
 
@@ -242,6 +252,12 @@ class MonitorSettings:
                 object.__setattr__(self, name, x)
         if not isinstance(self.learn_radius, bool):
             raise ValueError(f"learn_radius must be True or False, got {self.learn_radius!r}")
+        if self.max_slope is not None:
+            x = self.max_slope
+            if isinstance(x, bool) or not isinstance(x, int | float) or not (
+                    math.isfinite(x) and 1.0 < x <= 1e5):
+                raise ValueError(f"max_slope must be None or in (1, 1e5], got {x!r}")
+            object.__setattr__(self, "max_slope", float(x))
         if self.shapes not in SHAPE_CHOICES:
             raise ValueError(f"shapes must be one of {list(SHAPE_CHOICES)}, got {self.shapes!r}")
         if self.brake_coefficient not in BRAKE_COEFFICIENT_SOURCES:
