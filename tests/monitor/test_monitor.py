@@ -114,8 +114,8 @@ def test_dry_rail_is_never_low():
 def test_steady_force_cannot_show_the_bend():
     """Braking steadily on a dry rail, then onto the low curve at the same force: one point of
     the new curve per axle, which any friction level above the adhesion in use fits. No level
-    is claimed; the reason says the force must vary. (Applying the brake on the low rail
-    would sweep the curve and show the bend: the ramp is on the dry part here.)"""
+    is claimed; the reason says the data must move along the curve. (Applying the brake on
+    the low rail would sweep the curve and show the bend: the ramp is on the dry part here.)"""
     def curve_at(t):
         return ("polach", 120.0, 0.4) if t < 6.0 else ("polach", 40.0, 0.07)
 
@@ -127,7 +127,7 @@ def test_steady_force_cannot_show_the_bend():
     assert (res["level"][-1] == UNKNOWN).all()
     assert (res["reason"][-1] == 6).all()
     assert np.all(np.isinf(res["upper"][-1]))
-    assert "force must vary" in layout.reason_text(6, 0.002, 0.04)
+    assert "must vary along the curve" in layout.reason_text(6, 0.002, 0.04)
 
 
 @settings(max_examples=4, deadline=None)

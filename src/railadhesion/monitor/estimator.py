@@ -27,6 +27,8 @@ _SLOPE_WALK = 0.02 ** 2
 _SLOPE_MIN = 1.0
 #: Margin on Kalker's linear-theory slope for the default ``max_slope`` (our choice).
 _KALKER_MARGIN = 2.0
+#: Prior weight of the "no bend" hypothesis, in levels of the grid.
+_NO_BEND_WEIGHT = 5.0
 #: Braking time before the causal eq. 14 value may replace the vehicle's c [s].
 _C_MIN_TIME = 5.0
 
@@ -106,7 +108,8 @@ def build_config(vehicle, settings: MonitorSettings, pressure=True, torque=False
     c["forget"] = math.exp(-s.block_time / s.memory)
     c["slope_walk"] = _SLOPE_WALK
     c["ring_len"] = max(2, min(layout.RING, int(round(s.memory / s.block_time))))
-    for name in ("min_speed", "min_creep", "min_adhesion", "max_fit_creep", "radius_tolerance",
+    for name in ("min_speed", "min_creep", "min_adhesion", "max_fit_creep", "min_variation",
+                 "radius_tolerance",
                  "radius_precision", "radius_change", "coast_pressure", "coast_torque",
                  "coast_time", "coast_settle", "change_z", "change_blocks", "confirm_time",
                  "recovery_time", "stuck_time", "stuck_pressure_time", "max_physical_adhesion",
@@ -131,7 +134,12 @@ def build_config(vehicle, settings: MonitorSettings, pressure=True, torque=False
         c["node_q"][first:first + layout.FINITE_NODES] = 1.0 / mus
         c["node_mu"][first + layout.FINITE_NODES] = math.inf
         c["node_q"][first + layout.FINITE_NODES] = 0.0
-    c["node_logprior"][:] = 0.0  # uniform in ln(mu), the "no bend" hypothesis as one more
+    # uniform in ln(mu); the "no bend" hypothesis stands for everything above the grid (0.9
+    # up to the straight line): the weight of five more levels (0.9-1.5, our choice), so that
+    # data that show no bend leave the band without an upper bound
+    c["node_logprior"][:] = 0.0
+    for f in range(len(layout.SHAPES)):
+        c["node_logprior"][f * layout.FAMILY + layout.FINITE_NODES] = math.log(_NO_BEND_WEIGHT)
     c["node_step"] = math.log(_NODE_RATIO)
     c["shape_weight"][:] = {"both": (0.5, 0.5), "fletcher": (1.0, 0.0),
                             "polach": (0.0, 1.0)}[s.shapes]

@@ -365,8 +365,10 @@ def _report(cfg, st, out, i, t, level, code, v1, v2):
 
 
 @njit(cache=True)
-def _decide(cfg, st, bank, i, totals):
-    """The estimator's verdict for axle i from its weights and the remembered data range."""
+def _decide(cfg, st, bank, i, totals, sd_x, sd_y):
+    """The estimator's verdict for axle i from its weights and the remembered data: their
+    range, and how much they moved along the curve (``sd_x``, ``sd_y``: a block's creep and
+    adhesion noise)."""
     lo = _quantile(cfg, bank, i, totals, cfg.q_low)
     hi = _quantile(cfg, bank, i, totals, cfg.q_high)
     # the estimate: the shapes' medians in their fixed proportions (the mixture's own median
@@ -382,15 +384,37 @@ def _decide(cfg, st, bank, i, totals):
     xmax = 0.0
     ymax = 0.0
     used = -_INF
-    for k in range(st.ring_n[i]):
-        xmax = max(xmax, st.ring_x[i, k])
-        ymax = max(ymax, st.ring_y[i, k])
+    ysum = 0.0
+    ysum2 = 0.0
+    xsum = 0.0
+    xsum2 = 0.0
+    m = st.ring_n[i]
+    for k in range(m):
+        y = st.ring_y[i, k]
+        x = st.ring_x[i, k]
+        xmax = max(xmax, x)
+        ymax = max(ymax, y)
         used = max(used, st.ring_ylo[i, k])
+        ysum += y
+        ysum2 += y * y
+        xsum += x
+        xsum2 += x * x
+    mm = max(m, 1)
+    ymean = ysum / mm
+    yspread = math.sqrt(max(ysum2 / mm - ymean * ymean, 0.0))
+    xmean = xsum / mm
+    xspread = math.sqrt(max(xsum2 / mm - xmean * xmean, 0.0))
+    # moved along the curve: the force, or the creep, varied beyond its noise
+    moved = (yspread >= max(cfg.min_variation * ymean, 3.0 * sd_y)
+             or xspread >= max(cfg.min_variation * xmean, 3.0 * sd_x))
     thr = cfg.threshold
     if used >= thr:
         verdict, code, v1, v2 = _NORMAL, R_USED, used, _NAN
     elif xmax < cfg.min_creep or ymax < cfg.min_adhesion:
         verdict, code, v1, v2 = _UNKNOWN, R_CREEP_SMALL, xmax, ymax
+    elif not moved:
+        # one point of the curve (its noise only), whatever the weights say
+        verdict, code, v1, v2 = _UNKNOWN, R_BEND, xmax, max(used, 0.0)
     elif lo >= thr:
         verdict, code, v1, v2 = _NORMAL, R_ABOVE, med, lo
     elif hi == _INF:
@@ -440,7 +464,7 @@ def _estimate(cfg, st, bank, out, i, t, x, mu, var_x, var_mu):
         # range only
         if st.updates[i] > 0:
             _normalise(cfg, bank, i, totals)
-            _decide(cfg, st, bank, i, totals)
+            _decide(cfg, st, bank, i, totals, sd_x, sd_y)
         return
     if st.updates[i] == 0:
         _bank_reset(cfg, st, bank, i, xe, ys)
@@ -516,7 +540,7 @@ def _estimate(cfg, st, bank, out, i, t, x, mu, var_x, var_mu):
         _mark_bad(cfg, st, i, t, R_NUMERICAL, _NAN, _NAN)
     st.updates[i] += 1
     _normalise(cfg, bank, i, totals)
-    _decide(cfg, st, bank, i, totals)
+    _decide(cfg, st, bank, i, totals, sd_x, sd_y)
 
 
 @njit(cache=True)

@@ -75,7 +75,7 @@ REASONS = {
         "bend of the curve"),
     6: ("bend not seen",
         "the curve is not seen to bend (creep up to {v1:.3%}): at least {v2:.3f} available, no "
-        "upper bound; the force must vary to show the bend"),
+        "upper bound; force or creep must vary along the curve to show the bend"),
     7: ("sliding", "axle sliding (creep {v1:.2%}): past the peak of the curve, not fitted"),
     10: ("speed too low", "train speed {v1:.2f} m/s below {v2:.2f} m/s: creep not defined"),
     11: ("radius not learned",
@@ -157,6 +157,7 @@ CONFIG_DTYPE = np.dtype([
     ("threshold", "f8"), ("q_low", "f8"), ("q_high", "f8"),
     ("forget", "f8"), ("slope_walk", "f8"), ("ring_len", "i8"),
     ("min_speed", "f8"), ("min_creep", "f8"), ("min_adhesion", "f8"), ("max_fit_creep", "f8"),
+    ("min_variation", "f8"),
     ("sig_v", "f8"), ("sig_w", "f8"), ("sig_p", "f8"), ("sig_tau", "f8"), ("sig_model", "f8"),
     ("learn_radius", "i8"), ("radius_tolerance", "f8"), ("radius_precision", "f8"),
     ("radius_change", "f8"), ("coast_pressure", "f8"), ("coast_torque", "f8"),

@@ -39,6 +39,7 @@ _RANGES = {
     "min_creep": (0.0, 0.1, False, False),
     "min_adhesion": (0.0, 1.0, False, False),
     "max_fit_creep": (1e-3, 1.0, False, False),
+    "min_variation": (0.0, 1.0, False, False),
     "speed_noise": (0.0, 10.0, True, False),
     "wheel_speed_noise": (0.0, 10.0, True, False),
     "pressure_noise": (0.0, 1e5, True, False),
@@ -104,6 +105,12 @@ class MonitorSettings:
         memory reach this creep [-] and this adhesion in use [-] (defaults 0.05 % and 0.02,
         our choice: 0.05 % is about seven times the creep noise of a 0.1 s block at the
         issue's sensor noise and 40 m/s).
+    min_variation : float
+        The data must have moved along the curve before the estimator's band may set a level:
+        over the memory, the adhesion in use or the creep must vary by at least this fraction
+        of its mean (standard deviation), and by three times a block's noise (default 0.05,
+        our choice). A steady point of the curve shows its noise only: creep noise at a steady
+        force looks like a flat curve as much as like a steep one, and the weights wander.
     max_fit_creep : float
         Blocks above this creep [-] are sliding, past the peak of the curve, and are not used
         to fit it (default 3 %, our choice).
@@ -201,6 +208,7 @@ class MonitorSettings:
     min_speed: float = 5.0
     min_creep: float = 5e-4
     min_adhesion: float = 0.02
+    min_variation: float = 0.05
     max_fit_creep: float = 0.03
     speed_noise: float = 0.01
     wheel_speed_noise: float = 0.02
