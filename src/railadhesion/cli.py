@@ -727,10 +727,11 @@ from railadhesion import (  # noqa: E402
     cli_braking,
     cli_export,
     cli_identification,
+    cli_monitor,
     cli_sweeps,
 )
 
-for _module in (cli_braking, cli_identification, cli_sweeps, cli_export):
+for _module in (cli_braking, cli_identification, cli_sweeps, cli_export, cli_monitor):
     _module.register(app)
 
 if __name__ == "__main__":  # pragma: no cover
