@@ -66,6 +66,28 @@ def monitor(
     console.print(f"outputs written to {escape(str(out))}")
 
 
+def monitor_fmu(
+    out: Path = typer.Argument(..., help="The .fmu file to write."),
+    vehicle: str = typer.Option("coach_default", "--vehicle",
+                                help="Vehicle TOML file or a shipped name."),
+    threshold: float = typer.Option(0.14, help="Level threshold (RSSB GM/GN2642: 0.14)."),
+    sample_period: float = typer.Option(2.4e-3, help="The master's communication step [s]."),
+    pressure: bool = typer.Option(True, help="Brake-pressure inputs."),
+    torque: bool = typer.Option(False, help="Torque inputs (N m, traction > 0)."),
+) -> None:
+    """Write the adhesion monitor as an FMI 2.0 co-simulation FMU (runs Python)."""
+    from railadhesion.export import build_monitor_fmu
+    from railadhesion.monitor import MonitorSettings
+
+    try:
+        settings = MonitorSettings(threshold=threshold, sample_period=sample_period)
+        path = build_monitor_fmu(out, vehicle, settings, pressure=pressure, torque=torque)
+    except (ValueError, OSError) as exc:
+        _fail(exc)
+    console.print(f"monitor FMU written to {escape(str(path))}")
+
+
 def register(app: typer.Typer) -> None:
-    """Add the ``monitor`` command to the main CLI."""
+    """Add the ``monitor`` and ``monitor-fmu`` commands to the main CLI."""
     app.command("monitor")(monitor)
+    app.command("monitor-fmu")(monitor_fmu)

@@ -3,6 +3,8 @@
 * :func:`build_creep_force_fmu`: a WILAC or Polach creep-force law as an FMU (pythonfmu);
 * :func:`build_braking_fmu`: the braking simulator's stepping API as an FMU (inputs: commanded
   pressure and WSP valve per axle);
+* :func:`build_monitor_fmu`: the on-board adhesion monitor as an FMU (inputs: speed
+  reference, wheel speeds, pressures and/or torques; outputs: estimates, levels, reasons);
 * :func:`creep_force_table`: a model evaluated on a grid, written as NetCDF
   (:func:`write_table_netcdf`) and as a plain CSV (:func:`write_table_csv`), with the error
   of multilinear interpolation in the table measured at the cell midpoints.
@@ -19,6 +21,7 @@ from railadhesion.export.fmu import (
     creep_force_variables,
     resolve_parameters,
 )
+from railadhesion.export.monitor_fmu import build_monitor_fmu, monitor_fmu_variables
 from railadhesion.export.tables import (
     DEFAULT_GRID,
     InterpolationError,
@@ -38,9 +41,11 @@ __all__ = [
     "build_braking_fmu",
     "build_creep_force_fmu",
     "build_fmu",
+    "build_monitor_fmu",
     "creep_force_table",
     "creep_force_variables",
     "interpolation_error",
+    "monitor_fmu_variables",
     "read_table_csv",
     "resolve_parameters",
     "write_table_csv",
