@@ -51,7 +51,7 @@ def test_replay_is_the_per_sample_monitor(low_run, log_files):
         np.testing.assert_array_equal(rep.frame[f"level_{i + 1}"].cat.codes.to_numpy(),
                                       ref["level"][:, i])
         np.testing.assert_array_equal(rep.frame[f"estimate_{i + 1}"].to_numpy(),
-                                      ref["estimate"][:, i])
+                                      ref["estimate"][:, i].astype(np.float32))
     assert (rep.frame["level_1"].iloc[-1]) == "low"
     assert len(rep.frame) == len(frame)
 

@@ -178,8 +178,10 @@ def _temper(cfg, bank, i, factor):
 
 
 @njit(cache=True)
-def _normalise(cfg, bank, i, totals):
-    """Per shape: subtract the largest log-weight, put the sum of the weights in ``totals``."""
+def _normalise(cfg, bank, i, totals, w):
+    """Per shape: subtract the largest log-weight; put each hypothesis' mixture weight in
+    ``w`` (the shapes in their fixed proportions, each normalised: their fit does not choose
+    between them) and each shape's sum of exp(log-weight) in ``totals``."""
     for f in range(_SHAPES):
         top = -_INF
         for j in range(f * _FAMILY, (f + 1) * _FAMILY):
@@ -188,54 +190,52 @@ def _normalise(cfg, bank, i, totals):
         total = 0.0
         for j in range(f * _FAMILY, (f + 1) * _FAMILY):
             bank[0, i, j] -= top
-            total += math.exp(bank[0, i, j])
+            e = math.exp(bank[0, i, j])
+            w[j] = e
+            total += e
         totals[f] = total
-
-
-@njit(cache=True, inline="always")
-def _weight(cfg, bank, i, j, totals):
-    """Weight of hypothesis j in the mixture: the shapes in fixed proportions, each
-    normalised (their fit does not choose between them)."""
-    f = j // _FAMILY
-    return cfg.shape_weight[f] * math.exp(bank[0, i, j]) / totals[f]
+        scale = cfg.shape_weight[f] / total
+        for j in range(f * _FAMILY, (f + 1) * _FAMILY):
+            w[j] *= scale
 
 
 @njit(cache=True)
-def _quantile(cfg, bank, i, totals, prob):
-    """Quantile ``prob`` of the friction level in the mixture: the weight of level j (both
-    shapes) spread evenly over its cell in ln(mu) (half a node step either side), the "no
-    bend" hypotheses' weight at +inf."""
+def _quantile(cfg, w, prob):
+    """Quantile ``prob`` of the friction level in the mixture (weights ``w``): the weight of
+    level j (both shapes) spread evenly over its cell in ln(mu) (half a node step either side),
+    the "no bend" hypotheses' weight at +inf."""
     acc = 0.0
     half = 0.5 * cfg.node_step
     for j in range(_FINITE):
-        w = 0.0
+        wj = 0.0
         for f in range(_SHAPES):
-            w += _weight(cfg, bank, i, f * _FAMILY + j, totals)
-        if acc + w >= prob and w > 0.0:
-            frac = (prob - acc) / w
+            wj += w[f * _FAMILY + j]
+        if acc + wj >= prob and wj > 0.0:
+            frac = (prob - acc) / wj
             return math.exp(math.log(cfg.node_mu[j]) - half + frac * cfg.node_step)
-        acc += w
+        acc += wj
     return _INF
 
 
 @njit(cache=True)
-def _shape_median(cfg, bank, i, totals, f):
+def _shape_median(cfg, w, f):
     """Median of the friction level under shape f alone (inf if the "no bend" hypothesis
     holds half its weight)."""
     acc = 0.0
     half = 0.5 * cfg.node_step
+    share = cfg.shape_weight[f]
     for j in range(_FINITE):
-        w = math.exp(bank[0, i, f * _FAMILY + j]) / totals[f]
-        if acc + w >= 0.5 and w > 0.0:
-            return math.exp(math.log(cfg.node_mu[j]) - half + (0.5 - acc) / w * cfg.node_step)
-        acc += w
+        wj = w[f * _FAMILY + j] / share
+        if acc + wj >= 0.5 and wj > 0.0:
+            return math.exp(math.log(cfg.node_mu[j]) - half + (0.5 - acc) / wj * cfg.node_step)
+        acc += wj
     return _INF
 
 
 @njit(cache=True)
 def _node_residual(cfg, bank, i, j, x, y, var_x, var_y, scale, res):
     """Hypothesis j against the block (x, y): the point of its curve closest to the block in
-    the metric of the block's noise (two Gauss-Newton steps from the measured creep), and the
+    the metric of the block's noise (a Gauss-Newton step from the measured creep), and the
     residual there. Writes (residual, d y/d ln S, variance) into ``res`` [3 j .. 3 j + 2].
 
     Linearising the curve at that point rather than at the measured creep keeps the residual
@@ -244,10 +244,8 @@ def _node_residual(cfg, bank, i, j, x, y, var_x, var_y, scale, res):
     slope = math.exp(bank[1, i, j])
     vx = scale * var_x
     vy = scale * var_y
-    xs = x
-    for _ in range(2):
-        f, fx, _ = _curve(cfg, j, xs, slope)
-        xs = max(xs + (vx * fx * (y - f) + vy * (x - xs)) / (vy + fx * fx * vx), 0.0)
+    f, fx, _ = _curve(cfg, j, x, slope)
+    xs = max(x + vx * fx * (y - f) / (vy + fx * fx * vx), 0.0)  # one Gauss-Newton step
     f, fx, fs = _curve(cfg, j, xs, slope)
     h = fs * slope
     res[3 * j] = y - f - fx * (x - xs)
@@ -365,18 +363,18 @@ def _report(cfg, st, out, i, t, level, code, v1, v2):
 
 
 @njit(cache=True)
-def _decide(cfg, st, bank, i, totals, sd_x, sd_y):
+def _decide(cfg, st, i, w, sd_x, sd_y):
     """The estimator's verdict for axle i from its weights and the remembered data: their
     range, and how much they moved along the curve (``sd_x``, ``sd_y``: a block's creep and
     adhesion noise)."""
-    lo = _quantile(cfg, bank, i, totals, cfg.q_low)
-    hi = _quantile(cfg, bank, i, totals, cfg.q_high)
+    lo = _quantile(cfg, w, cfg.q_low)
+    hi = _quantile(cfg, w, cfg.q_high)
     # the estimate: the shapes' medians in their fixed proportions (the mixture's own median
     # would sit at the edge of one shape's mass when the two disagree)
     med = 0.0
     for f in range(_SHAPES):
         if cfg.shape_weight[f] > 0.0:
-            med += cfg.shape_weight[f] * _shape_median(cfg, bank, i, totals, f)
+            med += cfg.shape_weight[f] * _shape_median(cfg, w, f)
     med = min(max(med, lo), hi)
     st.est[i] = med
     st.est_lo[i] = lo
@@ -458,13 +456,14 @@ def _estimate(cfg, st, bank, out, i, t, x, mu, var_x, var_mu):
     _ring_push(cfg, st, i, xs, ys, ys - 2.0 * sd_y)
     xe = max(xs, 0.0)
     totals = st.totals
+    w = st.weights[i]
     if ys < 4.0 * sd_y:
         # no force to speak of: the point says nothing about the curve beyond the origin (and
         # its creep, pure noise, would pull every slope towards zero); it counts for the data
         # range only
         if st.updates[i] > 0:
-            _normalise(cfg, bank, i, totals)
-            _decide(cfg, st, bank, i, totals, sd_x, sd_y)
+            _normalise(cfg, bank, i, totals, w)
+            _decide(cfg, st, i, w, sd_x, sd_y)
         return
     if st.updates[i] == 0:
         _bank_reset(cfg, st, bank, i, xe, ys)
@@ -472,7 +471,7 @@ def _estimate(cfg, st, bank, out, i, t, x, mu, var_x, var_mu):
     _temper(cfg, bank, i, cfg.forget)
     for j in range(_NODES):
         bank[2, i, j] = min(bank[2, i, j] + cfg.slope_walk, cfg.var_slope0)
-    _normalise(cfg, bank, i, totals)
+    _normalise(cfg, bank, i, totals, w)
     scale = max(st.nis[i], 1.0)
     res = st.scratch[i]
     for j in range(_NODES):
@@ -481,7 +480,7 @@ def _estimate(cfg, st, bank, out, i, t, x, mu, var_x, var_mu):
     like = 0.0
     for j in range(_NODES):
         e = res[3 * j]
-        like += _weight(cfg, bank, i, j, totals) * math.exp(-0.5 * e * e / res[3 * j + 2])
+        like += w[j] * math.exp(-0.5 * e * e / res[3 * j + 2])
     dist2 = -2.0 * math.log(max(like, 1e-300))
     if not _finite(dist2):
         dist2 = 0.0
@@ -508,7 +507,7 @@ def _estimate(cfg, st, bank, out, i, t, x, mu, var_x, var_mu):
         st.ring_pos[i] = 0
         _ring_push(cfg, st, i, xs, ys, ys - 2.0 * sd_y)
         _bank_reset(cfg, st, bank, i, xe, ys)
-        _normalise(cfg, bank, i, totals)
+        _normalise(cfg, bank, i, totals, w)
         scale = 1.0
         for j in range(_NODES):
             _node_residual(cfg, bank, i, j, xe, ys, var_x, var_mu, scale, res)
@@ -539,8 +538,8 @@ def _estimate(cfg, st, bank, out, i, t, x, mu, var_x, var_mu):
         _bank_reset(cfg, st, bank, i, xe, ys)
         _mark_bad(cfg, st, i, t, R_NUMERICAL, _NAN, _NAN)
     st.updates[i] += 1
-    _normalise(cfg, bank, i, totals)
-    _decide(cfg, st, bank, i, totals, sd_x, sd_y)
+    _normalise(cfg, bank, i, totals, w)
+    _decide(cfg, st, i, w, sd_x, sd_y)
 
 
 @njit(cache=True)
@@ -1010,7 +1009,7 @@ def step(config, inputs, state, outputs, bank):
 @njit(cache=True)
 def replay(config, inputs, state, outputs, bank, time, speed, wheel, pressure, torque,
            o_status, o_vehicle, o_creep, o_used, o_est, o_lo, o_hi, o_level, o_reason,
-           o_v1, o_v2, o_load):
+           o_v1, o_v2):
     """:func:`step` over every sample of a log (arrays of n samples; per-axle arrays (n, N)),
     writing the outputs of each sample into the ``o_*`` arrays."""
     inp = inputs[0]
@@ -1035,7 +1034,6 @@ def replay(config, inputs, state, outputs, bank, time, speed, wheel, pressure, t
             o_reason[k, i] = out.reason[i]
             o_v1[k, i] = out.reason_v1[i]
             o_v2[k, i] = out.reason_v2[i]
-            o_load[k, i] = out.normal_load[i]
     return time.size
 
 
