@@ -15,7 +15,7 @@ console = Console()
 
 
 def _fail(exc) -> None:
-    console.print(f"[red]error:[/red] {escape(str(exc))}")
+    console.print(f"[red]error:[/red] {escape(str(exc))}", soft_wrap=True)
     raise typer.Exit(code=2)
 
 
@@ -63,7 +63,7 @@ def monitor(
         console.print("[yellow]warning:[/yellow] no wheel radius was learned (the log has no "
                       "coasting): every level stays unknown; --no-learn-radius takes the "
                       "vehicle file's radius as exact")
-    console.print(f"outputs written to {escape(str(out))}")
+    console.print(f"outputs written to {escape(str(out))}", soft_wrap=True)
 
 
 def monitor_fmu(
@@ -84,7 +84,7 @@ def monitor_fmu(
         path = build_monitor_fmu(out, vehicle, settings, pressure=pressure, torque=torque)
     except (ValueError, OSError) as exc:
         _fail(exc)
-    console.print(f"monitor FMU written to {escape(str(path))}")
+    console.print(f"monitor FMU written to {escape(str(path))}", soft_wrap=True)
 
 
 def register(app: typer.Typer) -> None:
