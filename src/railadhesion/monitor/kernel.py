@@ -267,14 +267,11 @@ def _ring_push(cfg, st, i, x, y, ylo):
 @njit(cache=True)
 def _shift_at_equal_force(cfg, st, i, x, y):
     """Creep of the new point minus the mean creep of the remembered points at about the same
-    adhesion (within 15 %), NaN if fewer than 3 such points (the newest excluded)."""
-    newest = (st.ring_pos[i] - 1) % cfg.ring_len
+    adhesion (within 15 %), NaN if fewer than 3 such points."""
     tol = 0.15 * max(abs(y), 0.01)
     acc = 0.0
     cnt = 0
     for k in range(st.ring_n[i]):
-        if k == newest:
-            continue
         if abs(st.ring_y[i, k] - y) <= tol:
             acc += st.ring_x[i, k]
             cnt += 1
@@ -286,17 +283,14 @@ def _shift_at_equal_force(cfg, st, i, x, y):
 @njit(cache=True)
 def _creep_jump(cfg, st, i, x, y, sd_x, sd_y):
     """How many standard deviations the new block's creep lies from the remembered blocks at
-    about the same adhesion (within 10 % or 2 sd of it; at least 5 of them, the newest
-    excluded): 0 if there are too few. A creep that jumps while the force stays is a change of
-    the curve (or of the wheel), whatever the curve."""
-    newest = (st.ring_pos[i] - 1) % cfg.ring_len
+    about the same adhesion (within 10 % or 2 sd of it; at least 5 of them; the block is not
+    among them yet): 0 if there are too few. A creep that jumps while the force stays is a
+    change of the curve (or of the wheel), whatever the curve."""
     tol = max(0.1 * abs(y), 2.0 * sd_y)
     acc = 0.0
     acc2 = 0.0
     cnt = 0
     for k in range(st.ring_n[i]):
-        if k == newest:
-            continue
         if abs(st.ring_y[i, k] - y) <= tol:
             xk = st.ring_x[i, k]
             acc += xk
@@ -453,7 +447,7 @@ def _estimate(cfg, st, bank, out, i, t, x, mu, var_x, var_mu):
         st.slide_creep[i] = xs
         return
     st.sliding[i] = 0
-    _ring_push(cfg, st, i, xs, ys, ys - 2.0 * sd_y)
+    ylo = ys - 2.0 * sd_y
     xe = max(xs, 0.0)
     totals = st.totals
     w = st.weights[i]
@@ -461,6 +455,7 @@ def _estimate(cfg, st, bank, out, i, t, x, mu, var_x, var_mu):
         # no force to speak of: the point says nothing about the curve beyond the origin (and
         # its creep, pure noise, would pull every slope towards zero); it counts for the data
         # range only
+        _ring_push(cfg, st, i, xs, ys, ylo)
         if st.updates[i] > 0:
             _normalise(cfg, bank, i, totals, w)
             _decide(cfg, st, i, w, sd_x, sd_y)
@@ -488,7 +483,12 @@ def _estimate(cfg, st, bank, out, i, t, x, mu, var_x, var_mu):
     if (dist2 > cfg.change_z * cfg.change_z or jump > cfg.change_z) and st.updates[i] > 0:
         st.outliers[i] += 1
         if st.outliers[i] < cfg.change_blocks:
-            return  # one block off: wait for the next before calling it a change
+            # one block off: held (not remembered, so that it cannot blur the test of the
+            # next one) until the next tells whether the rail changed
+            st.held[i, 0] = xs
+            st.held[i, 1] = ys
+            st.held[i, 2] = ylo
+            return
         # a change of the rail (or of the wheel): restart on this block
         shift = _shift_at_equal_force(cfg, st, i, xs, ys)
         st.changed_at[i] = t
@@ -502,10 +502,12 @@ def _estimate(cfg, st, bank, out, i, t, x, mu, var_x, var_mu):
                     reach = max(reach, abs(cfg.offset[i] - cfg.offset[j]))
                 st.lone_pending[i] = 1
                 st.lone_deadline[i] = t + reach / max(st.v_f, 1.0) + cfg.lone_window
-        # the remembered points belong to the old rail: keep only this one
+        # the remembered points belong to the old rail: keep the blocks of the new one
         st.ring_n[i] = 0
         st.ring_pos[i] = 0
-        _ring_push(cfg, st, i, xs, ys, ys - 2.0 * sd_y)
+        if cfg.change_blocks > 1:
+            _ring_push(cfg, st, i, st.held[i, 0], st.held[i, 1], st.held[i, 2])
+        _ring_push(cfg, st, i, xs, ys, ylo)
         _bank_reset(cfg, st, bank, i, xe, ys)
         _normalise(cfg, bank, i, totals, w)
         scale = 1.0
@@ -513,6 +515,7 @@ def _estimate(cfg, st, bank, out, i, t, x, mu, var_x, var_mu):
             _node_residual(cfg, bank, i, j, xe, ys, var_x, var_mu, scale, res)
     else:
         st.outliers[i] = 0
+        _ring_push(cfg, st, i, xs, ys, ylo)
         # adaptive noise scale: the mean squared standardised residual of the best hypotheses
         st.nis[i] = min(max(0.95 * st.nis[i] + 0.05 * min(dist2, 100.0), 1.0), 100.0)
     # update every hypothesis: EKF on ln(slope), log-weight by its residual; Student-t

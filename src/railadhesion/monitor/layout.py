@@ -214,7 +214,7 @@ STATE_DTYPE = np.dtype([
     # estimator bookkeeping
     ("updates", "i8", _A), ("outliers", "i8", _A), ("nis", "f8", _A),
     ("scratch", "f8", (MAX_AXLES, 3 * NODES)), ("totals", "f8", (len(SHAPES),)),
-    ("weights", "f8", (MAX_AXLES, NODES)),
+    ("weights", "f8", (MAX_AXLES, NODES)), ("held", "f8", (MAX_AXLES, 3)),
     ("ring_x", "f8", (MAX_AXLES, RING)), ("ring_y", "f8", (MAX_AXLES, RING)),
     ("ring_ylo", "f8", (MAX_AXLES, RING)), ("ring_pos", "i8", _A), ("ring_n", "i8", _A),
     ("sliding", "i8", _A), ("slide_creep", "f8", _A), ("sign_blocks", "i8", _A),
