@@ -184,8 +184,7 @@ def _delay_figure(groups, path):
     series = {f"{c} (truth {g['truth_mean']:.3f})": np.array(
         [np.nan if d is None else d for d in g["delays"]]) for c, g in groups.items()
         if g["expected"] == "low"}
-    fig = plot_delays(series, title="level low after entering the section, 0.5 % creep, "
-                      "30-55 m/s, per axle")
+    fig = plot_delays(series, title="low after entry, 0.5 % creep, 30-55 m/s (per axle)")
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
