@@ -729,9 +729,11 @@ from railadhesion import (  # noqa: E402
     cli_identification,
     cli_monitor,
     cli_sweeps,
+    cli_wsp,
 )
 
-for _module in (cli_braking, cli_identification, cli_sweeps, cli_export, cli_monitor):
+for _module in (cli_braking, cli_identification, cli_sweeps, cli_export, cli_wsp,
+                cli_monitor):
     _module.register(app)
 
 if __name__ == "__main__":  # pragma: no cover
