@@ -9,6 +9,9 @@ FMU.
 
 What one sample does
 --------------------
+All helpers compile with numba's ``error_model="numpy"``: no exception path anywhere (a
+division by zero gives inf or NaN, which the checks catch), as a C function needs.
+
 1. **Time**: a time that is NaN or not after the previous one is rejected (nothing changes,
    every axle ``unknown`` until ``recovery_time`` after the last good sample); a step longer
    than ``gap_factor`` sample periods is a gap: the filters restart.
@@ -65,7 +68,7 @@ from railadhesion.models import kernels as _models_kernels
 from railadhesion.models.kernels import fletcher_scalar, polach_curve_scalar
 from railadhesion.monitor import layout
 
-__all__ = ["step", "replay", "reset_state", "KERNEL_FINGERPRINT"]
+__all__ = ["step", "step_record", "replay", "reset_state", "KERNEL_FINGERPRINT"]
 
 # constants frozen into the compiled code
 _UNKNOWN, _NORMAL, _CAUTION, _LOW = layout.UNKNOWN, layout.NORMAL, layout.CAUTION, layout.LOW
@@ -100,7 +103,7 @@ _C_MIN_PRESSURE = 0.5e5  # Pa: braking for eq. 14 (as identify_adhesion's window
 KERNEL_FINGERPRINT = _jit.source_checksum(_models_kernels, layout)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _compiled_fingerprint():
     return KERNEL_FINGERPRINT
 
@@ -108,19 +111,19 @@ def _compiled_fingerprint():
 _jit.guard_cache(_compiled_fingerprint, __file__, KERNEL_FINGERPRINT)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _finite(x):
     return x == x and x != _INF and x != -_INF
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _filt(z, x, b0, b1, a1):
     """One sample of the first-order IIR (direct form II transposed): (y, new state)."""
     y = b0 * x + z
     return y, b1 * x - a1 * y
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _curve(cfg, j, x, slope):
     """Hypothesis j's curve at creep x >= 0: (adhesion, d/d creep, d/d slope)."""
     if j < _FAMILY:
@@ -129,7 +132,7 @@ def _curve(cfg, j, x, slope):
     return polach_curve_scalar(x, slope, cfg.node_q[j], cfg.polach_ratio)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _slope_through(cfg, j, x, y):
     """ln of the initial slope that puts hypothesis j's curve through (x, y), x, y > 0 (the
     curve's largest slope if it cannot reach y)."""
@@ -153,7 +156,7 @@ def _slope_through(cfg, j, x, y):
     return m
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _bank_reset(cfg, st, bank, i, x, y):
     """Restart axle i's estimator on the point (x, y): every hypothesis' slope put through it
     (or at the prior for a point at the origin), wide variance, prior weights."""
@@ -169,7 +172,7 @@ def _bank_reset(cfg, st, bank, i, x, y):
     st.nis[i] = 1.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _temper(cfg, bank, i, factor):
     """Forget: log-weights times ``factor`` (<= 1), slope variances divided by it."""
     for j in range(_NODES):
@@ -177,7 +180,7 @@ def _temper(cfg, bank, i, factor):
         bank[2, i, j] = min(bank[2, i, j] / factor, cfg.var_slope0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _normalise(cfg, bank, i, totals, w):
     """Per shape: subtract the largest log-weight; put each hypothesis' mixture weight in
     ``w`` (the shapes in their fixed proportions, each normalised: their fit does not choose
@@ -199,7 +202,7 @@ def _normalise(cfg, bank, i, totals, w):
             w[j] *= scale
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _quantile(cfg, w, prob):
     """Quantile ``prob`` of the friction level in the mixture (weights ``w``): the weight of
     level j (both shapes) spread evenly over its cell in ln(mu) (half a node step either side),
@@ -217,7 +220,7 @@ def _quantile(cfg, w, prob):
     return _INF
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _shape_median(cfg, w, f):
     """Median of the friction level under shape f alone (inf if the "no bend" hypothesis
     holds half its weight)."""
@@ -232,7 +235,7 @@ def _shape_median(cfg, w, f):
     return _INF
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _node_residual(cfg, bank, i, j, x, y, var_x, var_y, scale, res):
     """Hypothesis j against the block (x, y): the point of its curve closest to the block in
     the metric of the block's noise (a Gauss-Newton step from the measured creep), and the
@@ -253,7 +256,7 @@ def _node_residual(cfg, bank, i, j, x, y, var_x, var_y, scale, res):
     res[3 * j + 2] = vy + fx * fx * vx + h * h * bank[2, i, j]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _ring_push(cfg, st, i, x, y, ylo):
     k = st.ring_pos[i]
     st.ring_x[i, k] = x
@@ -264,7 +267,7 @@ def _ring_push(cfg, st, i, x, y, ylo):
         st.ring_n[i] += 1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _shift_at_equal_force(cfg, st, i, x, y):
     """Creep of the new point minus the mean creep of the remembered points at about the same
     adhesion (within 15 %), NaN if fewer than 3 such points."""
@@ -280,7 +283,7 @@ def _shift_at_equal_force(cfg, st, i, x, y):
     return x - acc / cnt
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _creep_jump(cfg, st, i, x, y, sd_x, sd_y):
     """How many standard deviations the new block's creep lies from the remembered blocks at
     about the same adhesion (within 10 % or 2 sd of it; at least 5 of them; the block is not
@@ -303,7 +306,7 @@ def _creep_jump(cfg, st, i, x, y, sd_x, sd_y):
     return abs(x - mean) / max(spread, 1.5 * sd_x)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _lone_confirmed(cfg, st, i, t):
     """True if another axle restarted its estimate within the time the rail change takes to
     travel between them (plus ``lone_window``)."""
@@ -317,7 +320,7 @@ def _lone_confirmed(cfg, st, i, t):
     return False
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _mark_bad(cfg, st, i, t, code, v1, v2):
     """Bad data on axle i: its block is spoilt, the axle is unknown until ``recovery_time``
     after now (the reason and its values kept for the report)."""
@@ -328,7 +331,7 @@ def _mark_bad(cfg, st, i, t, code, v1, v2):
     st.recover_v2[i] = v2
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _report(cfg, st, out, i, t, level, code, v1, v2):
     """Report axle i's level: ``unknown`` at once, any other level once it has held
     ``confirm_time`` (meanwhile the previous level and reason stay)."""
@@ -356,7 +359,7 @@ def _report(cfg, st, out, i, t, level, code, v1, v2):
     out.reason_v2[i] = v2
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _decide(cfg, st, i, w, sd_x, sd_y):
     """The estimator's verdict for axle i from its weights and the remembered data: their
     range, and how much they moved along the curve (``sd_x``, ``sd_y``: a block's creep and
@@ -421,7 +424,7 @@ def _decide(cfg, st, i, w, sd_x, sd_y):
     st.verdict_v2[i] = v2
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _estimate(cfg, st, bank, out, i, t, x, mu, var_x, var_mu):
     """One block (creep x, adhesion mu, their variances) into axle i's estimator."""
     sgn = 1.0 if mu >= 0.0 else -1.0
@@ -545,7 +548,7 @@ def _estimate(cfg, st, bank, out, i, t, x, mu, var_x, var_mu):
     _decide(cfg, st, i, w, sd_x, sd_y)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _start(cfg, st, bank, t):
     """First sample (or after a reset): zero state, nominal radii, staggered blocks."""
     n = cfg.n_axles
@@ -599,7 +602,7 @@ def _start(cfg, st, bank, t):
         _bank_reset(cfg, st, bank, i, 0.0, 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def reset_state(config, state, bank):
     """Clear the state: the next sample starts afresh (radii to be learned again)."""
     st = state[0]
@@ -610,7 +613,7 @@ def reset_state(config, state, bank):
         _bank_reset(config[0], st, bank, i, 0.0, 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _reject(cfg, st, out, t, code):
     """A sample that cannot be placed in time: nothing changes but the axles go unknown."""
     st.rejected += 1
@@ -624,7 +627,7 @@ def _reject(cfg, st, out, t, code):
     _vehicle_level(cfg, st, out, st.t_last)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _vehicle_level(cfg, st, out, t):
     """The most severe level of the axles (low, caution, normal), unknown if none has one."""
     best = _UNKNOWN
@@ -643,7 +646,7 @@ def _vehicle_level(cfg, st, out, t):
     out.vehicle_since = st.vehicle_since
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def step(config, inputs, state, outputs, bank):
     """Process one sample (``inputs``); update ``state``, ``bank`` and ``outputs``.
 
@@ -651,10 +654,13 @@ def step(config, inputs, state, outputs, bank):
     (``bank`` the (3, MAX_AXLES, NODES) float array). Returns 0, or 1 when the sample was
     rejected (its time is NaN or not after the previous sample's).
     """
-    cfg = config[0]
-    inp = inputs[0]
-    st = state[0]
-    out = outputs[0]
+    return step_record(config[0], inputs[0], state[0], outputs[0], bank)
+
+
+@njit(cache=True, error_model="numpy")
+def step_record(cfg, inp, st, out, bank):
+    """:func:`step` on the records themselves (not one-element arrays): for a caller holding
+    them inside a record of its own, e.g. a native FMU's state."""
     n = cfg.n_axles
     t = inp.time
     out.time = t
@@ -1009,7 +1015,7 @@ def step(config, inputs, state, outputs, bank):
     return 0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def replay(config, inputs, state, outputs, bank, time, speed, wheel, pressure, torque,
            o_status, o_vehicle, o_creep, o_used, o_est, o_lo, o_hi, o_level, o_reason,
            o_v1, o_v2):
