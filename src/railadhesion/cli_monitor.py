@@ -74,15 +74,22 @@ def monitor_fmu(
     sample_period: float = typer.Option(2.4e-3, help="The master's communication step [s]."),
     pressure: bool = typer.Option(True, help="Brake-pressure inputs."),
     torque: bool = typer.Option(False, help="Torque inputs (N m, traction > 0)."),
+    native: bool = typer.Option(False, help="Native FMU: compiled, no Python at run time "
+                                "(needs a C compiler to build)."),
 ) -> None:
-    """Write the adhesion monitor as an FMI 2.0 co-simulation FMU (runs Python)."""
-    from railadhesion.export import build_monitor_fmu
+    """Write the adhesion monitor as an FMI 2.0 co-simulation FMU."""
+    from railadhesion.export import (
+        NativeBuildError,
+        build_monitor_fmu,
+        build_native_monitor_fmu,
+    )
     from railadhesion.monitor import MonitorSettings
 
+    build = build_native_monitor_fmu if native else build_monitor_fmu
     try:
         settings = MonitorSettings(threshold=threshold, sample_period=sample_period)
-        path = build_monitor_fmu(out, vehicle, settings, pressure=pressure, torque=torque)
-    except (ValueError, OSError) as exc:
+        path = build(out, vehicle, settings, pressure=pressure, torque=torque)
+    except (ValueError, OSError, NativeBuildError) as exc:
         _fail(exc)
     console.print(f"monitor FMU written to {escape(str(path))}", soft_wrap=True)
 

@@ -104,3 +104,80 @@ def test_cli_writes_the_fmu(tmp_path):
     assert validate_fmu(str(out)) == []
     bad = CliRunner().invoke(app, ["monitor-fmu", str(out), "--sample-period", "0"])
     assert bad.exit_code == 2 and "sample_period" in bad.output
+
+
+@pytest.fixture(scope="module")
+def native_fmu(tmp_path_factory):
+    from railadhesion.export import NativeBuildError, build_native_monitor_fmu
+
+    try:
+        return build_native_monitor_fmu(tmp_path_factory.mktemp("nfmu") / "native.fmu")
+    except NativeBuildError as exc:  # no C compiler here
+        pytest.skip(str(exc))
+
+
+def test_native_fmu_equals_the_per_sample_call(native_fmu, low_run):
+    """The native FMU (no Python at run time) runs the same compiled step: same outputs as the
+    per-sample call fed the same times (the FMU's time is the sum of its steps)."""
+    import zipfile
+
+    assert validate_fmu(str(native_fmu)) == []
+    with zipfile.ZipFile(native_fmu) as z:
+        names = z.namelist()
+    assert "binaries/linux64/railadhesion_monitor.so" in names
+    assert not any(n.endswith(".py") for n in names)  # nothing for Python to run
+    md = read_model_description(native_fmu)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    folder = extract(native_fmu)
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=folder,
+                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="n")
+    outs = ["vehicle_level"] + [f"{q}_{k}" for k in range(1, 5) for q in (
+        "creep", "adhesion_used", "adhesion_available", "adhesion_lower", "adhesion_upper",
+        "level", "reason", "level_since")]
+    inputs = ["train_speed"] + [f"wheel_speed_{k}" for k in range(1, 5)] + [
+        f"brake_pressure_{k}" for k in range(1, 5)]
+    ref = AdhesionMonitor("coach_default")
+    worst = 0.0
+    try:
+        slave.instantiate()
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        slave.exitInitializationMode()
+        t = 0.0
+        for k in range(3600):
+            slave.setReal([vr[n] for n in inputs], [low_run["train_speed"][k],
+                                                   *low_run["wheel_speed"][k],
+                                                   *low_run["brake_pressure"][k]])
+            h = low_run["time"][k] - (low_run["time"][k - 1] if k else 0.0)
+            slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+            t += h  # the FMU's own clock: the sum of the steps
+            out = ref.update(t, low_run["train_speed"][k], low_run["wheel_speed"][k],
+                             low_run["brake_pressure"][k])
+            got = slave.getReal([vr[n] for n in outs])
+            want = [float(ref.outputs["vehicle_level"][0])]
+            for i in range(4):
+                want += [out.creep[i], out.adhesion_used[i], out.estimate[i], out.lower[i],
+                         out.upper[i], out.level[i], out.reason[i], out.level_since[i]]
+            for a, b in zip(got, want, strict=True):
+                if math.isnan(b) or math.isinf(b):
+                    assert (math.isnan(a) and math.isnan(b)) or a == b
+                else:
+                    worst = max(worst, abs(a - b) / max(1.0, abs(b)))
+        slave.terminate()
+    finally:
+        slave.freeInstance()
+        shutil.rmtree(folder, ignore_errors=True)
+    assert worst <= 1e-9
+    assert np.any(out.level == 3)
+
+
+def test_cli_native_flag(tmp_path, native_fmu):
+    from typer.testing import CliRunner
+
+    from railadhesion.cli import app
+
+    out = tmp_path / "n.fmu"
+    res = CliRunner().invoke(app, ["monitor-fmu", str(out), "--native", "--threshold", "0.12"])
+    assert res.exit_code == 0, res.output
+    assert validate_fmu(str(out)) == []
+    assert "threshold 0.12" in read_model_description(out).description

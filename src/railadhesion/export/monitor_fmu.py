@@ -23,9 +23,12 @@ import tempfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
+import numpy as np
+
 from railadhesion.export.fmu import FmuVariable, build_fmu
 
-__all__ = ["build_monitor_fmu", "monitor_fmu_variables"]
+__all__ = ["build_monitor_fmu", "build_native_monitor_fmu", "monitor_fmu_variables",
+           "monitor_step_model"]
 
 _CONFIG_FILE = "railadhesion_fmu.json"
 _VEHICLE_FILE = "vehicle.toml"
@@ -162,3 +165,124 @@ def _documentation(description, variables, settings_text) -> str:
         f"<th>sentence (its values v1, v2)</th></tr>{reasons}</table>\n"
         f"<h2>Settings</h2>\n<pre>{esc(settings_text)}</pre>\n</body></html>\n"
     )
+
+
+# --------------------------------------------------------------------------------------------
+# Native (Python-free) FMU of the monitor
+
+
+def _native_records(config):
+    """(state, inputs) dtypes of the native FMU: the state holds the monitor's own records
+    (its input record, state, outputs and estimator bank) and the time since the start."""
+    from railadhesion.monitor import layout
+
+    a = (layout.MAX_AXLES,)
+    state_t = np.dtype([("time", "f8"), ("inp", layout.INPUT_DTYPE),
+                        ("st", layout.STATE_DTYPE), ("out", layout.OUTPUT_DTYPE),
+                        ("bank", "f8", (3, layout.MAX_AXLES, layout.NODES))], align=True)
+    inputs_t = np.dtype([("train_speed", "f8"), ("wheel_speed", "f8", a),
+                         ("brake_pressure", "f8", a), ("torque", "f8", a)], align=True)
+    return state_t, inputs_t
+
+
+def _native_step(state_t, config_t, inputs_t, n_axles):
+    """The step of the native FMU: one monitor sample at the time since the start."""
+    from numba import carray
+
+    from railadhesion.monitor.kernel import step_record
+
+    def step(state, settings, inputs, dt):
+        s = carray(state, 1, state_t)[0]
+        c = carray(settings, 1, config_t)[0]
+        x = carray(inputs, 1, inputs_t)[0]
+        s.time += dt
+        s.inp.time = s.time
+        s.inp.train_speed = x.train_speed
+        for i in range(n_axles):
+            s.inp.wheel_speed[i] = x.wheel_speed[i]
+            s.inp.brake_pressure[i] = x.brake_pressure[i]
+            s.inp.torque[i] = x.torque[i]
+        step_record(c, s.inp, s.st, s.out, s.bank)
+        return 0  # bad data show in the levels and reasons: the step never fails
+
+    return step
+
+
+_NATIVE_OUTPUTS = {"creep": "creep", "adhesion_used": "adhesion_used",
+                   "adhesion_available": "estimate", "adhesion_lower": "lower",
+                   "adhesion_upper": "upper", "level": "level", "reason": "reason",
+                   "level_since": "level_since"}
+
+
+def monitor_step_model(vehicle="coach_default", settings=None, *, pressure=True,
+                       torque=False):
+    """The monitor as a :class:`railadhesion.export.native.StepModel` (for
+    :func:`railadhesion.export.native.build_step_fmu`): the same compiled step
+    (:func:`railadhesion.monitor.kernel.step_record`) on its own records."""
+    from railadhesion.braking import Vehicle, load_vehicle
+    from railadhesion.export.native import RecordVariable, StepModel
+    from railadhesion.monitor import MonitorSettings
+    from railadhesion.monitor.estimator import build_config
+
+    if not isinstance(vehicle, Vehicle):
+        vehicle = load_vehicle(vehicle)
+    settings = settings if settings is not None else MonitorSettings()
+    if not (pressure or torque):
+        raise ValueError("the FMU needs brake-pressure or torque inputs (pressure or torque)")
+    config = build_config(vehicle, settings, pressure, torque)
+    state_t, inputs_t = _native_records(config)
+    n = vehicle.n_axles
+    state = np.zeros(1, state_t)
+    rv = []
+    for v in monitor_fmu_variables(n, pressure, torque):
+        name = v.name
+        if v.causality == "input":
+            if name == "train_speed":
+                rv.append(RecordVariable(v, "train_speed"))
+            else:
+                field, k = name.rsplit("_", 1)
+                rv.append(RecordVariable(v, field, (int(k) - 1,)))
+        elif name == "vehicle_level":
+            rv.append(RecordVariable(v, "out.vehicle_level"))
+        else:
+            field, k = name.rsplit("_", 1)
+            rv.append(RecordVariable(v, f"out.{_NATIVE_OUTPUTS[field]}", (int(k) - 1,)))
+    return StepModel(identifier="railadhesion_monitor",
+                     step=_native_step(state_t, config.dtype, inputs_t, n), state=state,
+                     settings=config, inputs=np.zeros(1, inputs_t), variables=rv)
+
+
+def build_native_monitor_fmu(out, vehicle="coach_default", settings=None, *, pressure=True,
+                             torque=False) -> Path:
+    """Write a native FMI 2.0 co-simulation FMU of the adhesion monitor: no Python at run time.
+
+    Same variables as :func:`build_monitor_fmu`; the vehicle, the settings and the compiled
+    step are in the binary (linux64; sources in ``sources/``, see ``docs/fmu.md``). Building
+    needs a C compiler. Differences from the Python FMU: the monitor's time is the time since
+    the start (the sum of the steps), and the C layer refuses a NaN or infinite input with
+    ``fmi2Error`` (a master signals a missing value by holding the last one or by a value the
+    monitor calls implausible, e.g. a negative wheel speed); every other bad input is reported
+    in the levels and reasons as by the per-sample call.
+
+    Raises
+    ------
+    railadhesion.export.native.NativeBuildError
+        No C compiler or FMI headers here, or the compiled step needs more than libm.
+    """
+    import railadhesion
+    from railadhesion.export.native import build_step_fmu
+    from railadhesion.monitor import MonitorSettings
+
+    settings = settings if settings is not None else MonitorSettings()
+    if not isinstance(settings, MonitorSettings):
+        raise ValueError(f"settings must be a MonitorSettings, got {type(settings).__name__}")
+    model = monitor_step_model(vehicle, settings, pressure=pressure, torque=torque)
+    variables = [r.variable for r in model.variables]
+    description = (f"railadhesion {railadhesion.__version__}: on-board adhesion monitor, "
+                   f"native (no Python at run time); threshold {settings.threshold:g}, sample "
+                   f"period {settings.sample_period:g} s (one sample per doStep).")
+    return build_step_fmu(model, out, model_name="railadhesion adhesion monitor (native)",
+                          description=description,
+                          documentation=_documentation(description, variables,
+                                                       json.dumps(settings.to_dict(), indent=2)),
+                          step_size=settings.sample_period)
