@@ -147,19 +147,6 @@ def build_config(vehicle, settings: MonitorSettings, pressure=True, torque=False
     return cfg
 
 
-def _entry(dispatcher, args):
-    """The compiled entry point of ``dispatcher`` for the types of ``args`` (skips numba's
-    type resolution, about 0.2 us a call); ``args`` must make a harmless call."""
-    dispatcher(*args)
-    try:
-        from numba import typeof
-
-        entry = dispatcher.overloads[tuple(typeof(a) for a in args)].entry_point
-    except Exception:  # pragma: no cover - numba internals changed: use the dispatcher
-        entry = None
-    return entry if callable(entry) else dispatcher
-
-
 class MonitorInputs:
     """The signals of the next sample, written in place (views of the input record).
 
@@ -366,11 +353,12 @@ class AdhesionMonitor:
 
     def _compiled_step(self):
         if self._step is None:
+            from railadhesion._jit import kernel_entry
             from railadhesion.monitor import kernel
 
             # a call with time NaN is rejected before it changes anything but the rejection
             # counter and the outputs: reset afterwards
-            self._step = _entry(kernel.step, self.records)
+            self._step = kernel_entry(kernel.step, self.records)
             self.reset()
         return self._step
 
