@@ -34,18 +34,23 @@ def test_model_description(monitor_fmu):
     assert "adhesion monitor" in md.description
 
 
-def test_outputs_equal_the_per_sample_call(monitor_fmu, low_run):
-    md = read_model_description(monitor_fmu)
+OUTPUTS = ["vehicle_level"] + [f"{q}_{k}" for k in range(1, 5) for q in (
+    "creep", "adhesion_used", "adhesion_available", "adhesion_lower", "adhesion_upper", "level",
+    "reason", "level_since")]
+INPUTS = ["train_speed"] + [f"wheel_speed_{k}" for k in range(1, 5)] + [
+    f"brake_pressure_{k}" for k in range(1, 5)]
+
+
+def _against_the_per_sample_call(fmu, run, samples=3600):
+    """Drive the FMU with ``run``'s signals and a per-sample monitor with the same inputs at
+    the FMU's own clock (the sum of its steps); the largest relative difference of the
+    outputs, and the monitor's last outputs."""
+    md = read_model_description(fmu)
     vr = {v.name: v.valueReference for v in md.modelVariables}
-    folder = extract(monitor_fmu)
+    folder = extract(fmu)
     slave = FMU2Slave(guid=md.guid, unzipDirectory=folder,
                       modelIdentifier=md.coSimulation.modelIdentifier, instanceName="m")
-    names = ["vehicle_level"] + [f"{q}_{k}" for k in range(1, 5) for q in (
-        "creep", "adhesion_used", "adhesion_available", "adhesion_lower", "adhesion_upper",
-        "level", "reason", "level_since")]
     ref = AdhesionMonitor("coach_default")
-    inputs = ["train_speed"] + [f"wheel_speed_{k}" for k in range(1, 5)] + [
-        f"brake_pressure_{k}" for k in range(1, 5)]
     worst = 0.0
     try:
         slave.instantiate()
@@ -53,16 +58,16 @@ def test_outputs_equal_the_per_sample_call(monitor_fmu, low_run):
         slave.enterInitializationMode()
         slave.exitInitializationMode()
         t = 0.0
-        for k in range(3600):  # 8.6 s: coasting, braking, low
-            values = [low_run["train_speed"][k], *low_run["wheel_speed"][k],
-                      *low_run["brake_pressure"][k]]
-            slave.setReal([vr[n] for n in inputs], values)
-            h = low_run["time"][k] - t
+        for k in range(samples):  # 8.6 s: coasting, braking, low
+            slave.setReal([vr[n] for n in INPUTS], [run["train_speed"][k],
+                                                    *run["wheel_speed"][k],
+                                                    *run["brake_pressure"][k]])
+            h = run["time"][k] - (run["time"][k - 1] if k else 0.0)
             slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-            t = low_run["time"][k]
-            out = ref.update(t, low_run["train_speed"][k], low_run["wheel_speed"][k],
-                             low_run["brake_pressure"][k])
-            got = slave.getReal([vr[n] for n in names])
+            t += h
+            out = ref.update(t, run["train_speed"][k], run["wheel_speed"][k],
+                             run["brake_pressure"][k])
+            got = slave.getReal([vr[n] for n in OUTPUTS])
             want = [float(ref.outputs["vehicle_level"][0])]
             for i in range(4):
                 want += [out.creep[i], out.adhesion_used[i], out.estimate[i], out.lower[i],
@@ -76,6 +81,11 @@ def test_outputs_equal_the_per_sample_call(monitor_fmu, low_run):
     finally:
         slave.freeInstance()
         shutil.rmtree(folder, ignore_errors=True)
+    return worst, out
+
+
+def test_outputs_equal_the_per_sample_call(monitor_fmu, low_run):
+    worst, out = _against_the_per_sample_call(monitor_fmu, low_run)
     assert worst <= 1e-12
     assert np.any(out.level == 3)  # the run reached low
 
@@ -126,47 +136,7 @@ def test_native_fmu_equals_the_per_sample_call(native_fmu, low_run):
         names = z.namelist()
     assert "binaries/linux64/railadhesion_monitor.so" in names
     assert not any(n.endswith(".py") for n in names)  # nothing for Python to run
-    md = read_model_description(native_fmu)
-    vr = {v.name: v.valueReference for v in md.modelVariables}
-    folder = extract(native_fmu)
-    slave = FMU2Slave(guid=md.guid, unzipDirectory=folder,
-                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="n")
-    outs = ["vehicle_level"] + [f"{q}_{k}" for k in range(1, 5) for q in (
-        "creep", "adhesion_used", "adhesion_available", "adhesion_lower", "adhesion_upper",
-        "level", "reason", "level_since")]
-    inputs = ["train_speed"] + [f"wheel_speed_{k}" for k in range(1, 5)] + [
-        f"brake_pressure_{k}" for k in range(1, 5)]
-    ref = AdhesionMonitor("coach_default")
-    worst = 0.0
-    try:
-        slave.instantiate()
-        slave.setupExperiment(startTime=0.0)
-        slave.enterInitializationMode()
-        slave.exitInitializationMode()
-        t = 0.0
-        for k in range(3600):
-            slave.setReal([vr[n] for n in inputs], [low_run["train_speed"][k],
-                                                   *low_run["wheel_speed"][k],
-                                                   *low_run["brake_pressure"][k]])
-            h = low_run["time"][k] - (low_run["time"][k - 1] if k else 0.0)
-            slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-            t += h  # the FMU's own clock: the sum of the steps
-            out = ref.update(t, low_run["train_speed"][k], low_run["wheel_speed"][k],
-                             low_run["brake_pressure"][k])
-            got = slave.getReal([vr[n] for n in outs])
-            want = [float(ref.outputs["vehicle_level"][0])]
-            for i in range(4):
-                want += [out.creep[i], out.adhesion_used[i], out.estimate[i], out.lower[i],
-                         out.upper[i], out.level[i], out.reason[i], out.level_since[i]]
-            for a, b in zip(got, want, strict=True):
-                if math.isnan(b) or math.isinf(b):
-                    assert (math.isnan(a) and math.isnan(b)) or a == b
-                else:
-                    worst = max(worst, abs(a - b) / max(1.0, abs(b)))
-        slave.terminate()
-    finally:
-        slave.freeInstance()
-        shutil.rmtree(folder, ignore_errors=True)
+    worst, out = _against_the_per_sample_call(native_fmu, low_run)
     assert worst <= 1e-9
     assert np.any(out.level == 3)
 

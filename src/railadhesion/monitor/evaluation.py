@@ -197,6 +197,29 @@ def _mean_demand(vehicle, condition, start, end, speed, creep):
     return (r * mu * float(np.mean(loads)) + j * d / r) / vehicle.brake_coefficient, mu
 
 
+def _columns(steps, n):
+    """The time series of a case: per sample, and per sample and axle."""
+    cols = {k: np.empty(steps) for k in ("time", "distance", "speed", "command")}
+    for k in ("level", "estimate", "lower", "upper", "used", "creep", "truth"):
+        cols[k] = np.empty((steps, n))
+    return cols
+
+
+def _record(cols, k, t, live, out, demand, truth):
+    """Sample k of a case: the simulator's state, the monitor's outputs and the truth."""
+    cols["time"][k] = t
+    cols["distance"][k] = live.distance
+    cols["speed"][k] = live.train_speed
+    cols["command"][k] = demand
+    cols["level"][k] = out.level
+    cols["estimate"][k] = out.estimate
+    cols["lower"][k] = out.lower
+    cols["upper"][k] = out.upper
+    cols["used"][k] = out.adhesion_used
+    cols["creep"][k] = out.creep
+    cols["truth"][k] = truth
+
+
 def run_case(case: MonitorCase, settings: MonitorSettings | None = None, *, vehicle=None,
              noise: SensorNoise | None = None, period: float = 2.4e-3, wsp=True) -> CaseResult:
     """Run one closed-loop case; the monitor is fed every ``period`` by its per-sample call."""
@@ -226,9 +249,7 @@ def run_case(case: MonitorCase, settings: MonitorSettings | None = None, *, vehi
     total = case.coast_time + case.dry_time + case.section_time + case.after_time
     steps = int(total / period)
     offsets = vehicle.axle_offsets()
-    cols = {k: np.empty(steps) for k in ("time", "distance", "speed", "command")}
-    for k in ("level", "estimate", "lower", "upper", "used", "creep", "truth"):
-        cols[k] = np.empty((steps, n))
+    cols = _columns(steps, n)
     cmd = sim.inputs.pressure_command
     valves = sim.inputs.valves
     truth = np.full(n, np.nan)
@@ -249,17 +270,7 @@ def run_case(case: MonitorCase, settings: MonitorSettings | None = None, *, vehi
         mon.update(t, v, w, p)
         if k % 40 == 0:
             truth = sim.adhesion_available()
-        cols["time"][k] = t
-        cols["distance"][k] = live.distance
-        cols["speed"][k] = live.train_speed
-        cols["command"][k] = demand
-        cols["level"][k] = out.level
-        cols["estimate"][k] = out.estimate
-        cols["lower"][k] = out.lower
-        cols["upper"][k] = out.upper
-        cols["used"][k] = out.adhesion_used
-        cols["creep"][k] = out.creep
-        cols["truth"][k] = truth
+        _record(cols, k, t, live, out, demand, truth)
         if live.stopped:
             for key in cols:
                 cols[key] = cols[key][:k + 1]
@@ -457,9 +468,7 @@ def run_traction_case(case: MonitorCase, settings: MonitorSettings | None = None
     total = case.coast_time + case.dry_time + case.section_time + case.after_time
     steps = int(total / period)
     offsets = vehicle.axle_offsets()
-    cols = {k: np.empty(steps) for k in ("time", "distance", "speed", "command")}
-    for k in ("level", "estimate", "lower", "upper", "used", "creep", "truth"):
-        cols[k] = np.empty((steps, n))
+    cols = _columns(steps, n)
     truth = np.full(n, np.nan)
     live = sim.live
     out = mon.live
@@ -475,15 +484,5 @@ def run_traction_case(case: MonitorCase, settings: MonitorSettings | None = None
         mon.update(t, v, w, None, tq)
         if k % 40 == 0:
             truth = sim.adhesion_available()
-        cols["time"][k] = t
-        cols["distance"][k] = live.distance
-        cols["speed"][k] = live.train_speed
-        cols["command"][k] = demand
-        cols["level"][k] = out.level
-        cols["estimate"][k] = out.estimate
-        cols["lower"][k] = out.lower
-        cols["upper"][k] = out.upper
-        cols["used"][k] = out.adhesion_used
-        cols["creep"][k] = out.creep
-        cols["truth"][k] = truth
+        _record(cols, k, t, live, out, demand, truth)
     return _case_result(case, settings, cols, offsets, (start, end), torque_mean, mu_mean)
