@@ -61,7 +61,7 @@ LEVELS = ("unknown", "normal", "caution", "low")
 # reason code -> (label, template); the templates take the two values of the reason
 # (``v1``, ``v2``) and the settings' threshold (``thr``).
 REASONS = {
-    0: ("starting", "no data yet"),
+    0: ("starting", "no estimate yet: no block with a force to speak of since the start"),
     1: ("below threshold",
         "available adhesion {v1:.3f}, at most {v2:.3f}: below the threshold {thr:g}"),
     2: ("above threshold",
