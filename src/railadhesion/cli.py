@@ -735,12 +735,14 @@ from railadhesion import (  # noqa: E402
     cli_braking,
     cli_export,
     cli_identification,
+    cli_monitor,
     cli_odometry,
     cli_sweeps,
     cli_wsp,
 )
 
-for _module in (cli_braking, cli_identification, cli_sweeps, cli_export, cli_wsp, cli_odometry):
+for _module in (cli_braking, cli_identification, cli_sweeps, cli_export, cli_wsp, cli_odometry,
+                cli_monitor):
     _module.register(app)
 
 if __name__ == "__main__":  # pragma: no cover

@@ -53,6 +53,7 @@ FMU_MODELS = ("wilac", "polach")
 #: optional factor). Water flow is in µl/s as everywhere in the package (spelt ``ul/s``).
 UNIT_DEFINITIONS: dict[str, dict[str, str]] = {
     "1": {},
+    "s": {"s": "1"},
     "m": {"m": "1"},
     "m/s": {"m": "1", "s": "-1"},
     "m/s2": {"m": "1", "s": "-2"},
@@ -60,6 +61,7 @@ UNIT_DEFINITIONS: dict[str, dict[str, str]] = {
     "rad/m": {"m": "-1", "rad": "1"},
     "N": {"kg": "1", "m": "1", "s": "-2"},
     "Pa": {"kg": "1", "m": "-1", "s": "-2"},
+    "N.m": {"kg": "1", "m": "2", "s": "-2"},
     "ul/s": {"m": "3", "s": "-1", "factor": "1e-09"},
 }
 
