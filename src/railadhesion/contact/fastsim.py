@@ -49,6 +49,7 @@ from railadhesion.numerics import flatten, jitable, kernel, read_only, run_chunk
 __all__ = [
     "FastsimResult",
     "fastsim",
+    "fastsim_bound",
     "fastsim_flexibilities",
     "fastsim_rectangular",
     "fastsim_strips",
@@ -509,6 +510,15 @@ def _check_count(value, name: str) -> int:
     return k
 
 
+@jitable(inline="always")
+def fastsim_bound(px, py, g):
+    """A trial traction (px, py) scaled back onto the traction bound g where |p| > g, keeping
+    its direction (Kalker 1982: the element slips): (px, py, slipping)."""
+    r = math.sqrt(px * px + py * py)
+    f = min(g / (r + _TINY_TRACTION), 1.0)
+    return px * f, py * f, r > g
+
+
 # Rows of the work array of :func:`fastsim_strips` (ny values each).
 _W_PX, _W_PY, _W_DPX, _W_DPY1, _W_INC, _W_GFAC, _W_SPX, _W_SPY, _W_QPY, _W_NSLIP = range(10)
 #: Rows of the work array :func:`fastsim_strips` needs.
@@ -562,15 +572,8 @@ def fastsim_strips(xi, eta, phi, fz, a, b, mu, l1, l2, l3, eta_j, sq, tx, gy, no
                 px[j] += dpx[j]
                 py[j] += inc[j]
         for j in range(ny):  # back onto the bound where |p| exceeds it (slip)
-            pxj = px[j]
-            pyj = py[j]
-            g = gfac[j] * t
-            r = math.sqrt(pxj * pxj + pyj * pyj)
-            slipping = r > g
+            pxj, pyj, slipping = fastsim_bound(px[j], py[j], gfac[j] * t)
             nslip[j] += 1.0 if slipping else 0.0
-            f = min(g / (r + _TINY_TRACTION), 1.0)
-            pxj *= f
-            pyj *= f
             px[j] = pxj
             py[j] = pyj
             spx[j] += pxj
@@ -644,15 +647,9 @@ def fastsim_rectangular(xi, eta, phi, fz, a, b, mu, l1, l2, l3, scale, xh, yh, m
         for j in range(ny):
             # step from the previous element; elements outside the contact reset to zero
             m = mask[i, j]
-            pxj = (px[j] + dpx[j]) * m
-            pyj = (py[j] + dpy) * m
-            g = gfac * shape[i, j]
-            r = math.sqrt(pxj * pxj + pyj * pyj)
-            slipping = r > g
+            pxj, pyj, slipping = fastsim_bound((px[j] + dpx[j]) * m, (py[j] + dpy) * m,
+                                               gfac * shape[i, j])  # fmt: skip
             nslip[j] += 1.0 if slipping else 0.0
-            f = min(g / (r + _TINY_TRACTION), 1.0)
-            pxj *= f
-            pyj *= f
             px[j] = pxj
             py[j] = pyj
             spx[j] += pxj
@@ -707,54 +704,46 @@ def _contact_flexibilities(xi, eta, phi, fz, a, b, mu, g, nu, l1, l2, l3, mode, 
 
 
 @kernel(nogil=True)
-def _strips_chunks(xi, eta, phi, fz, a, b, mu, g, nu, l1, l2, l3, mode, eta_j, sq, tx, gy,
-                   norm, out, px_out, py_out, slip_out, store, first, last):  # fmt: skip
-    """:func:`fastsim_strips` for the contacts of chunks first
-    to last - 1 (of FASTSIM_CHUNK contacts) into out (4, n): fx, fy, mz, slip fraction; the
-    tractions and slip flags into px_out, py_out, slip_out (n, ny, nx) if ``store``."""
-    work = np.empty((STRIPS_WORK_ROWS, eta_j.size))
+def _march_chunks(xi, eta, phi, fz, a, b, mu, g, nu, l1, l2, l3, mode, rect, p1, p2, p3, p4, q1,
+                  q2, s1, s2, out, px_out, py_out, slip_out, store, first, last):  # fmt: skip
+    """FASTSIM of the contacts of chunks first to last - 1 (of FASTSIM_CHUNK contacts) into out
+    (4, n): fx, fy, mz, slip fraction; the tractions and slip flags into px_out, py_out,
+    slip_out (n, ny, nx) if ``store``. The layout's factors: on the strips (``rect`` False,
+    :func:`fastsim_strips`) p1-p4 = eta_j, sq, tx, gy and s1 = norm; on CONTACT's grid
+    (:func:`fastsim_rectangular`) p1, p2 = xh, yh, q1, q2 = mask, shape, s1, s2 = scale,
+    n_in."""
+    work = np.empty((max(STRIPS_WORK_ROWS, RECT_WORK_ROWS), p2.size))
     for c in range(first * FASTSIM_CHUNK, min(last * FASTSIM_CHUNK, out.shape[1])):
         x, y, p, f1, f2, f3 = _contact_flexibilities(xi, eta, phi, fz, a, b, mu, g, nu, l1, l2,
                                                      l3, mode, c)  # fmt: skip
         k = c if store else 0
-        out[0, c], out[1, c], out[2, c], out[3, c] = fastsim_strips(
-            x, y, p, _at(fz, c), _at(a, c), _at(b, c), _at(mu, c), f1, f2, f3, eta_j, sq, tx,
-            gy, norm, work, px_out[k], py_out[k], slip_out[k], store)  # fmt: skip
+        if rect:
+            res = fastsim_rectangular(x, y, p, _at(fz, c), _at(a, c), _at(b, c), _at(mu, c), f1,
+                                      f2, f3, s1, p1, p2, q1, q2, s2, work, px_out[k],
+                                      py_out[k], slip_out[k], store)  # fmt: skip
+        else:
+            res = fastsim_strips(x, y, p, _at(fz, c), _at(a, c), _at(b, c), _at(mu, c), f1, f2,
+                                 f3, p1, p2, p3, p4, s1, work, px_out[k], py_out[k],
+                                 slip_out[k], store)  # fmt: skip
+        out[0, c], out[1, c], out[2, c], out[3, c] = res
     return 0
 
 
-@kernel(nogil=True)
-def _rect_chunks(xi, eta, phi, fz, a, b, mu, g, nu, l1, l2, l3, mode, scale, xh, yh, mask,
-                 shape, n_in, out, px_out, py_out, slip_out, store, first, last):  # fmt: skip
-    """:func:`fastsim_rectangular` for the contacts of chunks
-    first to last - 1; as :func:`_strips_chunks`."""
-    work = np.empty((RECT_WORK_ROWS, yh.size))
-    for c in range(first * FASTSIM_CHUNK, min(last * FASTSIM_CHUNK, out.shape[1])):
-        x, y, p, f1, f2, f3 = _contact_flexibilities(xi, eta, phi, fz, a, b, mu, g, nu, l1, l2,
-                                                     l3, mode, c)  # fmt: skip
-        k = c if store else 0
-        out[0, c], out[1, c], out[2, c], out[3, c] = fastsim_rectangular(
-            x, y, p, _at(fz, c), _at(a, c), _at(b, c), _at(mu, c), f1, f2, f3, scale, xh, yh,
-            mask, shape, n_in, work, px_out[k], py_out[k], slip_out[k], store)  # fmt: skip
-    return 0
-
-
-def _stores(store):
-    """The (px, py, slip) arrays to fill and True, or placeholders and False (``store``
-    None)."""
-    if store is None:
-        return np.empty((1, 1, 1)), np.empty((1, 1, 1)), np.empty((1, 1, 1), bool), False
-    return (*store, True)
-
-
-def _run(kernel, inputs, grid, store):
-    """Run a FASTSIM driver over the contacts; ``inputs`` the 12 per-contact arrays (length n
-    or 1) and the mode, ``grid`` the layout's factors. Returns (fx, fy, mz, slip fraction)."""
+def _run(inputs, rect, vectors, grids, scalars, store):
+    """Run the FASTSIM loop over the contacts; ``inputs`` the 12 per-contact arrays (length n
+    or 1) and the mode, then the layout's factors. Returns (fx, fy, mz, slip fraction)."""
     n = max(x.size for x in inputs[:12])
     out = np.empty((4, n))
-    run_chunks(kernel, (*inputs, *grid, out, *_stores(store)), -(-n // FASTSIM_CHUNK),
-               n >= FASTSIM_PARALLEL_MIN)  # fmt: skip
+    if store is None:
+        store = (np.empty((1, 1, 1)), np.empty((1, 1, 1)), np.empty((1, 1, 1), bool), False)
+    else:
+        store = (*store, True)
+    run_chunks(_march_chunks, (*inputs, rect, *vectors, *grids, *scalars, out, *store),
+               -(-n // FASTSIM_CHUNK), n >= FASTSIM_PARALLEL_MIN)  # fmt: skip
     return out
+
+
+_NO_GRID = np.zeros((1, 1))
 
 
 def march_strips(xi, eta, phi, fz, a, b, mu, g, nu, l1, l2, l3, mode, pattern, store=None):
@@ -764,16 +753,16 @@ def march_strips(xi, eta, phi, fz, a, b, mu, g, nu, l1, l2, l3, mode, pattern, s
     from :func:`_grid_pattern`; ``store`` None or (px, py, slip) arrays (n, ny, nx) for
     the tractions and slip flags. Returns (fx, fy, mz, slip_fraction) as a (4, n) array."""
     eta_j, sq, tx, gy, norm = pattern
-    return _run(_strips_chunks, (xi, eta, phi, fz, a, b, mu, g, nu, l1, l2, l3, mode),
-                (eta_j, sq, tx, gy, float(norm)), store)  # fmt: skip
+    return _run((xi, eta, phi, fz, a, b, mu, g, nu, l1, l2, l3, mode), False,
+                (eta_j, sq, tx, gy), (_NO_GRID, _NO_GRID), (float(norm), 0.0), store)
 
 
 def march_rect(xi, eta, phi, fz, a, b, mu, g, nu, l1, l2, l3, mode, scale, rect, store=None):
     """FASTSIM on CONTACT's rectangular grid for n contacts; as :func:`march_strips`, ``rect``
     from :func:`_rect_pattern`."""
     xh, yh, mask, shape, n_in = rect
-    return _run(_rect_chunks, (xi, eta, phi, fz, a, b, mu, g, nu, l1, l2, l3, mode),
-                (float(scale), xh, yh, mask, shape, float(n_in)), store)  # fmt: skip
+    return _run((xi, eta, phi, fz, a, b, mu, g, nu, l1, l2, l3, mode), True, (xh, yh, xh, yh),
+                (mask, shape), (float(scale), float(n_in)), store)
 
 
 @kernel
