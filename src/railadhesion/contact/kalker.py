@@ -163,8 +163,8 @@ def kalker_law(a_over_b, nu):
     snapping round-off so that table points are exact; the coefficients are linear in t
     between the rows, the parabola in 1/C across nu, and below g = 0.1 the corrected
     asymptotes. A plain function compiled where compiled code calls it (not inlined: it is
-    large and called from several places); from Python it runs as Python, or call the
-    compiled :data:`kalker_scalar`.
+    large and called from several places); from Python call the compiled
+    :data:`kalker_scalar`.
     """
     le = a_over_b <= 1.0
     g = a_over_b if le else 1.0 / a_over_b
@@ -323,8 +323,8 @@ def kalker_coefficients(a_over_b, poisson) -> KalkerCoefficients:
     in 1/C is not monotonic in nu near nu = 0.05 and makes C33 rise slightly (about 1 %)
     with a/b beyond a/b = 7 for 0.04 <= nu <= 0.16.
 
-    Implementation: :func:`kalker_law`, run as Python for one contact and compiled (numba,
-    a loop over the contacts) for arrays.
+    Implementation: :func:`kalker_law`, compiled (numba; for arrays in a loop over the
+    contacts).
 
     References
     ----------
@@ -342,8 +342,8 @@ def kalker_coefficients(a_over_b, poisson) -> KalkerCoefficients:
     """
     r = check_range(a_over_b, "a_over_b", AOB_MIN, AOB_MAX)
     nu = check_range(poisson, "poisson", 0.0, 0.5)
-    if r.ndim == 0 and nu.ndim == 0:  # one contact: the law run as Python (numba not needed)
-        return KalkerCoefficients(*(float(c) for c in kalker_law(float(r), float(nu))))
+    if r.ndim == 0 and nu.ndim == 0:  # one contact: one compiled call
+        return KalkerCoefficients(*kalker_scalar.dispatcher(float(r), float(nu)))
     shape = np.broadcast_shapes(r.shape, nu.shape)
     coef = np.empty((4, math.prod(shape)))
     _kalker_into(*(read_only(np.ascontiguousarray(np.broadcast_to(x, shape)).reshape(-1))
