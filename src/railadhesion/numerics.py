@@ -66,6 +66,7 @@ __all__ = [
     "kernel",
     "load_numba",
     "load_row",
+    "output_chunk",
     "read_only",
     "run_chunks",
 ]
@@ -390,6 +391,18 @@ def load_row(buf, row, x, lo, m):
         src = x[lo : lo + m]
         for k in range(m):
             dst[k] = src[k]
+
+
+@jitable
+def output_chunk(fx, fy, lo, m, ok):
+    """Views of chunk lo to lo + m of the outputs fx, fy, filled with NaN if not ``ok`` (an
+    input out of range: the caller raises the error naming it)."""
+    ox = fx[lo : lo + m]
+    oy = fy[lo : lo + m]
+    if not ok:
+        fill(ox, math.nan, m)
+        fill(oy, math.nan, m)
+    return ox, oy
 
 
 # Allowed ranges, as (low, low if closed else NaN, high, high if closed else NaN): x is in range

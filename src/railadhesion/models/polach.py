@@ -62,6 +62,7 @@ from railadhesion.numerics import (
     jitable,
     kernel,
     load_row,
+    output_chunk,
     run_chunks,
 )
 
@@ -227,13 +228,20 @@ def _contact_kernel():
     return dispatcher
 
 
-# Rows of the chunk buffer of the batch loop (rows of CHUNK values): the inputs, a/b, Kalker's
-# coefficients. One buffer, rows a constant CHUNK apart: the loop over a chunk reads one array
-# at known distances and writes two, which LLVM vectorises with few run-time aliasing checks
-# (a loop reading many arrays would need one check per pair and is not vectorised).
-(_X, _Y, _PSI, _Q, _V, _A, _B, _G, _NU, _MU0, _KA, _KS, _BA, _BB, _RATIO, _C11, _C22,
- _C23) = range(18)  # fmt: skip
-_ROWS = 18
+# Rows of the chunk buffer of the batch loops of Polach and WILAC (rows of CHUNK values): the
+# contact's inputs, a/b and Kalker's coefficients first (ROW_X to ROW_C23, shared by both
+# loops), then each model's own rows. One buffer, rows a constant CHUNK apart: the loop over a
+# chunk reads one array at known distances and writes few, which LLVM vectorises with few
+# run-time aliasing checks (a loop reading many arrays needs a check per pair and is not
+# vectorised).
+ROW_X, ROW_Y, ROW_PSI, ROW_Q, ROW_V, ROW_A, ROW_B, ROW_G, ROW_NU = range(9)
+ROW_RATIO, ROW_C11, ROW_C22, ROW_C23 = range(9, 13)
+CONTACT_ROWS = 13
+_MU0, _KA, _KS, _BA, _BB = range(CONTACT_ROWS, CONTACT_ROWS + 5)
+_ROWS = CONTACT_ROWS + 5
+# the rows of the driver's 14 inputs, in their order
+_INPUT_ROWS = (ROW_X, ROW_Y, ROW_PSI, ROW_Q, ROW_V, ROW_A, ROW_B, ROW_G, ROW_NU, _MU0, _KA, _KS,
+               _BA, _BB)  # fmt: skip
 #: From this many contacts the batch loop runs on ``numba.get_num_threads()`` threads
 #: (below, thread start-up and waiting for a descheduled thread cost more than the work).
 PARALLEL_MIN = 100_000
@@ -266,6 +274,27 @@ def polach_fixed_shape(a, b, nu, buf, c11_row, count):
     return True, ok
 
 
+@jitable
+def chunk_coefficients(buf, fixed, m):
+    """Kalker's coefficients of a chunk's contacts into rows ROW_C11 to ROW_C23 (unless
+    ``fixed``: then filled once per call by :func:`polach_fixed_shape`); False if an a/b is
+    outside Kalker's range."""
+    if fixed:
+        return True
+    for k in range(m):
+        buf[ROW_RATIO * CHUNK + k] = buf[ROW_A * CHUNK + k] / buf[ROW_B * CHUNK + k]
+    return kalker_rows(buf, ROW_RATIO, ROW_NU, ROW_C11, CHUNK, m)
+
+
+@jitable(inline="always")
+def chunk_contact_terms(buf, k):
+    """:func:`polach_contact_terms` of contact k of a chunk buffer."""
+    return polach_contact_terms(
+        buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k], buf[ROW_PSI * CHUNK + k],
+        buf[ROW_A * CHUNK + k], buf[ROW_B * CHUNK + k], buf[ROW_G * CHUNK + k],
+        buf[ROW_C11 * CHUNK + k], buf[ROW_C22 * CHUNK + k], buf[ROW_C23 * CHUNK + k])  # fmt: skip
+
+
 @kernel(nogil=True)
 def _polach_chunks(sx, sy, psi, q, v, a, b, g, nu, mu0, k_a, k_s, big_a, big_b, fx, fy, first,
                    last):  # fmt: skip
@@ -278,8 +307,8 @@ def _polach_chunks(sx, sy, psi, q, v, a, b, g, nu, mu0, k_a, k_s, big_a, big_b, 
     buf = np.empty(_ROWS * CHUNK)
     inputs = (sx, sy, psi, q, v, a, b, g, nu, mu0, k_a, k_s, big_a, big_b)
     for j in range(14):
-        fill_row(buf, j, inputs[j], count)
-    fixed, shape_ok = polach_fixed_shape(a, b, nu, buf, _C11, count)
+        fill_row(buf, _INPUT_ROWS[j], inputs[j], count)
+    fixed, shape_ok = polach_fixed_shape(a, b, nu, buf, ROW_C11, count)
     nbad = 0
     for c in range(first, last):
         lo = c * CHUNK
@@ -289,27 +318,17 @@ def _polach_chunks(sx, sy, psi, q, v, a, b, g, nu, mu0, k_a, k_s, big_a, big_b, 
             + count_outside(k_s, FRACTION, lo, m) + count_outside(big_a, NONNEGATIVE, lo, m)
             + count_outside(big_b, NONNEGATIVE, lo, m))  # fmt: skip
         for j in range(14):
-            load_row(buf, j, inputs[j], lo, m)
-        ok = bad == 0 and shape_ok
-        if not fixed:
-            for k in range(m):
-                buf[_RATIO * CHUNK + k] = buf[_A * CHUNK + k] / buf[_B * CHUNK + k]
-            ok = kalker_rows(buf, _RATIO, _NU, _C11, CHUNK, m) and ok
-        ox = fx[lo : lo + m]  # views: the loop writes the outputs directly
-        oy = fy[lo : lo + m]
+            load_row(buf, _INPUT_ROWS[j], inputs[j], lo, m)
+        ok = chunk_coefficients(buf, fixed, m) and bad == 0 and shape_ok
+        ox, oy = output_chunk(fx, fy, lo, m, ok)  # views: the loop writes the outputs directly
         if not ok:
             nbad += 1
-            fill(ox, math.nan, m)
-            fill(oy, math.nan, m)
             continue
         for k in range(m):  # the law, inlined: vectorised
-            t = polach_contact_terms(
-                buf[_X * CHUNK + k], buf[_Y * CHUNK + k], buf[_PSI * CHUNK + k],
-                buf[_A * CHUNK + k], buf[_B * CHUNK + k], buf[_G * CHUNK + k],
-                buf[_C11 * CHUNK + k], buf[_C22 * CHUNK + k], buf[_C23 * CHUNK + k])  # fmt: skip
+            t = chunk_contact_terms(buf, k)
             ox[k], oy[k] = polach_force(
-                buf[_X * CHUNK + k], buf[_Y * CHUNK + k], buf[_Q * CHUNK + k],
-                buf[_V * CHUNK + k], t[0], t[1], t[2], t[3], t[4], t[5], t[6],
+                buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k], buf[ROW_Q * CHUNK + k],
+                buf[ROW_V * CHUNK + k], t[0], t[1], t[2], t[3], t[4], t[5], t[6],
                 buf[_KA * CHUNK + k], buf[_KS * CHUNK + k], buf[_MU0 * CHUNK + k],
                 buf[_BA * CHUNK + k], buf[_BB * CHUNK + k])  # fmt: skip
     return nbad

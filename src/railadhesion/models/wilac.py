@@ -28,9 +28,23 @@ import numpy as np
 
 from railadhesion._labelled import labelled
 from railadhesion._validate import as_float_array, check_nonnegative, check_positive
-from railadhesion.contact.kalker import kalker_law, kalker_rows
+from railadhesion.contact.kalker import kalker_law
+from railadhesion.models import wilac_parameters as _parameters
 from railadhesion.models.polach import (
+    CONTACT_ROWS,
+    ROW_A,
+    ROW_B,
+    ROW_C11,
+    ROW_G,
+    ROW_NU,
+    ROW_PSI,
+    ROW_Q,
+    ROW_V,
+    ROW_X,
+    ROW_Y,
     check_polach_inputs,
+    chunk_coefficients,
+    chunk_contact_terms,
     polach_bad_input,
     polach_contact_terms,
     polach_count_bad,
@@ -58,6 +72,7 @@ from railadhesion.models.wilac_parameters import (  # noqa: F401 - re-exported
     wilac_regression,
     wilac_term,
     wilac_terms,
+    wilac_transition,
     wilac_transitions,
     wilac_weights,
 )
@@ -72,20 +87,12 @@ from railadhesion.numerics import (
     jitable,
     kernel,
     load_row,
+    output_chunk,
     run_chunks,
 )
 
 __all__ = [
-    "WILAC_CONDITIONS",
-    "POLACH_PARAMETER_NAMES",
-    "PHYSICAL_BOUNDS",
-    "PROVENANCE_FIELDS",
-    "WaterTransition",
-    "PAPER_TRANSITIONS",
-    "wilac_transitions",
-    "wilac_weights",
-    "WilacCondition",
-    "WilacParameters",
+    *_parameters.__all__,
     "wilac_blend",
     "wilac_forces",
     "wilac_law",
@@ -160,15 +167,18 @@ def wilac_checked(creep_x, creep_y, spin, normal_force, speed, a, b, water_flow,
 
 
 # Rows of the chunk buffer of the batch loop (rows of CHUNK values, see polach.py): the
-# inputs, a/b and Kalker's coefficients, the contact terms (shared by the conditions), the
-# weights, the regression factors, one condition's parameters and weights.
-_X, _Y, _PSI, _Q, _V, _A, _B, _G, _NU, _W, _RATIO, _C11, _C22, _C23 = range(14)
-_T0 = 14  # the 7 values of polach_contact_terms
-_WT0 = 21  # 4 weights
-_F0 = 25  # 6 factors and a row of ones
-_P0 = 32  # 5 parameters
-_WC = 37  # the weights of the condition being evaluated
-_ROWS = 38
+# contact's rows of polach.py (inputs, a/b, Kalker's coefficients), the water flow, the
+# contact terms (shared by the conditions), the weights, the regression factors and a row of
+# ones, one condition's parameters and weights.
+_W = CONTACT_ROWS
+_T0 = _W + 1  # the 7 values of polach_contact_terms
+_WT0 = _T0 + 7  # 4 weights
+_F0 = _WT0 + 4  # 6 factors and a row of ones
+_P0 = _F0 + 7  # 5 parameters
+_WC = _P0 + 5  # the weights of the condition being evaluated
+_ROWS = _WC + 1
+# the rows of the driver's 10 inputs, in their order
+_INPUT_ROWS = (ROW_X, ROW_Y, ROW_PSI, ROW_Q, ROW_V, ROW_A, ROW_B, ROW_G, ROW_NU, _W)
 #: From this many contacts the batch loop runs on several threads.
 PARALLEL_MIN_WILAC = 20_000
 
@@ -203,8 +213,8 @@ def _wilac_chunks(sx, sy, psi, q, v, a, b, g, nu, w, packed, fx, fy, first, last
     buf = np.empty(_ROWS * CHUNK)
     inputs = (sx, sy, psi, q, v, a, b, g, nu, w)
     for j in range(10):
-        fill_row(buf, j, inputs[j], count)
-    fixed, shape_ok = polach_fixed_shape(a, b, nu, buf, _C11, count)
+        fill_row(buf, _INPUT_ROWS[j], inputs[j], count)
+    fixed, shape_ok = polach_fixed_shape(a, b, nu, buf, ROW_C11, count)
     fill(buf[(_F0 + 6) * CHUNK :], 1.0, count)
     const_qv = q.size == 1 and v.size == 1
     pars = np.zeros(20)  # the parameters of single Q and v, once per call
@@ -217,18 +227,11 @@ def _wilac_chunks(sx, sy, psi, q, v, a, b, g, nu, w, packed, fx, fy, first, last
         bad = polach_count_bad(sx, sy, psi, q, v, a, b, g, nu, lo, m) + count_outside(
             w, NONNEGATIVE, lo, m)  # fmt: skip
         for j in range(10):
-            load_row(buf, j, inputs[j], lo, m)
-        ok = bad == 0 and shape_ok
-        if not fixed:
-            for k in range(m):
-                buf[_RATIO * CHUNK + k] = buf[_A * CHUNK + k] / buf[_B * CHUNK + k]
-            ok = kalker_rows(buf, _RATIO, _NU, _C11, CHUNK, m) and ok
-        ox = fx[lo : lo + m]  # views: the blend accumulates in the outputs directly
-        oy = fy[lo : lo + m]
+            load_row(buf, _INPUT_ROWS[j], inputs[j], lo, m)
+        ok = chunk_coefficients(buf, fixed, m) and bad == 0 and shape_ok
+        ox, oy = output_chunk(fx, fy, lo, m, ok)  # views: the blend accumulates in them
         if not ok:
             nbad += 1
-            fill(ox, math.nan, m)
-            fill(oy, math.nan, m)
             continue
         last_w = math.nan
         w0 = w1 = w2 = w3 = 0.0
@@ -244,17 +247,15 @@ def _wilac_chunks(sx, sy, psi, q, v, a, b, g, nu, w, packed, fx, fy, first, last
             buf[(_WT0 + 3) * CHUNK + k] = w3
         if not const_qv:
             for k in range(m):  # the regression factors (vectorised)
-                qn, vn = wilac_normalise(buf[_Q * CHUNK + k], buf[_V * CHUNK + k], packed)
+                qn, vn = wilac_normalise(buf[ROW_Q * CHUNK + k], buf[ROW_V * CHUNK + k], packed)
                 (buf[_F0 * CHUNK + k], buf[(_F0 + 1) * CHUNK + k], buf[(_F0 + 2) * CHUNK + k],
                  buf[(_F0 + 3) * CHUNK + k], buf[(_F0 + 4) * CHUNK + k],
                  buf[(_F0 + 5) * CHUNK + k]) = wilac_factors(qn, vn)  # fmt: skip
         for k in range(m):  # the contact terms, shared by the conditions (vectorised)
             (buf[_T0 * CHUNK + k], buf[(_T0 + 1) * CHUNK + k], buf[(_T0 + 2) * CHUNK + k],
              buf[(_T0 + 3) * CHUNK + k], buf[(_T0 + 4) * CHUNK + k],
-             buf[(_T0 + 5) * CHUNK + k], buf[(_T0 + 6) * CHUNK + k]) = polach_contact_terms(
-                buf[_X * CHUNK + k], buf[_Y * CHUNK + k], buf[_PSI * CHUNK + k],
-                buf[_A * CHUNK + k], buf[_B * CHUNK + k], buf[_G * CHUNK + k],
-                buf[_C11 * CHUNK + k], buf[_C22 * CHUNK + k], buf[_C23 * CHUNK + k])  # fmt: skip
+             buf[(_T0 + 5) * CHUNK + k], buf[(_T0 + 6) * CHUNK + k]) = chunk_contact_terms(
+                buf, k)  # fmt: skip
         fill(ox, 0.0, m)
         fill(oy, 0.0, m)
         for i in range(4):
@@ -287,8 +288,8 @@ def _wilac_chunks(sx, sy, psi, q, v, a, b, g, nu, w, packed, fx, fy, first, last
                     par[k] = wilac_clip(par[k], packed, j)
             for k in range(m):  # its forces, blended (vectorised)
                 fxi, fyi = polach_force(
-                    buf[_X * CHUNK + k], buf[_Y * CHUNK + k], buf[_Q * CHUNK + k],
-                    buf[_V * CHUNK + k], buf[_T0 * CHUNK + k], buf[(_T0 + 1) * CHUNK + k],
+                    buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k], buf[ROW_Q * CHUNK + k],
+                    buf[ROW_V * CHUNK + k], buf[_T0 * CHUNK + k], buf[(_T0 + 1) * CHUNK + k],
                     buf[(_T0 + 2) * CHUNK + k], buf[(_T0 + 3) * CHUNK + k],
                     buf[(_T0 + 4) * CHUNK + k], buf[(_T0 + 5) * CHUNK + k],
                     buf[(_T0 + 6) * CHUNK + k], buf[_P0 * CHUNK + k],

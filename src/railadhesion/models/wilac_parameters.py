@@ -229,10 +229,7 @@ def wilac_transitions(water_flow, transitions=PAPER_TRANSITIONS) -> np.ndarray:
     >>> [round(float(x), 4) for x in wilac_transitions(30.0)]
     [1.0, 0.5, 0.0]
     """
-    w = check_nonnegative(water_flow, "water_flow")
-    if transitions is not PAPER_TRANSITIONS:
-        transitions = _checked_transitions(_as_transition_key(transitions))
-    return _transitions(w, transitions)
+    return _water_flow_laws(water_flow, transitions, 3)
 
 
 @labelled(units="1", leading={"condition": WILAC_CONDITIONS})
@@ -256,13 +253,7 @@ def wilac_weights(water_flow, transitions=PAPER_TRANSITIONS) -> np.ndarray:
     -----
     Trummer et al. (seed 000), section 5.3, the equations for f_i: f_Dry = 1 − e_1,
     f_Damp2 = e_1 − e_2, f_Damp1 = e_2 − e_3, f_Wet = e_3, with e_i from
-    :func:`wilac_transitions`.
-
-    References
-    ----------
-    G. Trummer, L.E. Buckley-Johnstone, P. Voltr, A. Meierhofer, R. Lewis, K. Six.
-    Wheel-rail creep force model for predicting water induced low adhesion phenomena.
-    Tribology International 109 (2017) 409–415.
+    :func:`wilac_transitions` (reference there); evaluated by :func:`wilac_blend_weights`.
 
     Examples
     --------
@@ -271,15 +262,20 @@ def wilac_weights(water_flow, transitions=PAPER_TRANSITIONS) -> np.ndarray:
     >>> [round(float(f), 4) for f in wilac_weights(350.0)]
     [0.0, 0.0, 0.0, 1.0]
     """
-    w = check_nonnegative(water_flow, "water_flow")
-    if transitions is not PAPER_TRANSITIONS:
-        transitions = _checked_transitions(_as_transition_key(transitions))
-    return _transitions(w, transitions, 4)
+    return _water_flow_laws(water_flow, transitions, 4)
 
 
 @functools.lru_cache(maxsize=32)
 def _checked_transitions(transitions: tuple) -> tuple:
     return _check_transitions(transitions)
+
+
+def _water_flow_laws(water_flow, transitions, rows: int) -> np.ndarray:
+    """The transitions (``rows`` 3) or the weights (4) of the validated water flows."""
+    w = check_nonnegative(water_flow, "water_flow")
+    if transitions is not PAPER_TRANSITIONS:
+        transitions = _checked_transitions(_as_transition_key(transitions))
+    return _transitions(w, transitions, rows)
 
 
 def _as_regression(value, where: str) -> ParameterRegression:
