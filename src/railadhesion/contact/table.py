@@ -214,7 +214,7 @@ def _contract(typingctx, tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd2, w
 
     Why hand-written IR: the same sums in plain numba code (``tests/contact/
     test_table_kernel.py``, which holds this function to it) made the whole lookup about three
-    times slower (measured side by side: about 600 against 170-230 ns a contact, one thread).
+    times slower (measured side by side, one thread; docs/kernels.md).
     The only LLVM IR of the package; it uses numba's public extension API (``intrinsic``)."""
     f64 = types.float64
     if not (isinstance(tab, types.Array) and tab.dtype == f64 and tab.ndim == 1
@@ -613,15 +613,9 @@ def exact_table_forces(
     up to about 0.4 % near full sliding). Accuracy against the exact solver:
     ``docs/validation/exact_models.md``.
 
-    **Cost** (``benchmarks/bench_exact.py --table``, 2-core machine shared with other jobs,
-    load average 1.1): with one a/b for all contacts, about 0.05 us per contact at 2e5
-    and 1e6 contacts with spin, 2.2-2.6 times the package's vectorised
-    :func:`~railadhesion.models.polach.polach_forces` on the same contacts, with Coulomb or
-    falling friction and at nu = 0.25 alike (1.7-3.3 times over five runs, with the load);
-    with a/b varying per contact about 0.6 us. One contact given as Python floats takes a
-    scalar path (checks in plain Python, one compiled call): about 7 us a call (polach_forces
-    2.8 us in the same run; before this path, about 190 us).
-    Parallel from 1e5 contacts (``numba.get_num_threads()`` threads).
+    **Cost**: ``benchmarks/bench_exact.py --table`` (figures in ``docs/performance.md``). One
+    contact given as Python floats takes a scalar path (checks in plain Python, one compiled
+    call). Parallel from 1e5 contacts (``numba.get_num_threads()`` threads).
 
     **Falling friction.** The exact solution with a slip-velocity dependent coefficient has
     a coefficient that varies over the contact with the local slip velocity; the table

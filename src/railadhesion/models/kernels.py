@@ -12,7 +12,7 @@ compiled until a function is first called, and compiled code is cached on disk
 
 Stable API for numba code (the functions below are ``@njit`` and can be called from other
 ``@njit`` functions, e.g. an ODE right-hand side or a braking integrator; from Python they
-work too, at a dispatch cost of a few microseconds):
+work too, at the cost of numba's dispatch):
 
 ``kalker_scalar(a_over_b, nu) -> (c11, c22, c23, c33)``
     Kalker's coefficients (same table, interpolation and asymptotes as
@@ -24,7 +24,7 @@ k_A, k_S, mu0, A, B) -> (fx, fy)``
     :func:`railadhesion.models.polach.polach_forces` (spin, k_A/k_S, falling friction, the
     spin cap). Pass the coefficients of ``kalker_scalar(a/b, nu)`` as c11, c22, c23 (look them
     up once per contact shape), or ``c11 <= 0`` (e.g. 0.0) to have them looked up from a/b and
-    nu on every call (about 20 ns more).
+    nu on every call.
 
 ``wilac_scalar(creep_x, creep_y, spin, normal_force, speed, a, b, water_flow, G, nu, c11,
 c22, c23, packed) -> (fx, fy)``

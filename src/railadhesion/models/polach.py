@@ -647,7 +647,7 @@ class PolachContact:
     once); :meth:`forces` then evaluates :func:`polach_forces` for new creepages (and
     optionally a new speed or normal force) through the compiled scalar kernel
     (:func:`railadhesion.models.kernels.polach_scalar`, compiled for float64 arguments only:
-    ints and NumPy scalars are converted), well under a microsecond a call, and returns
+    ints and NumPy scalars are converted), and returns
     Python floats. The same numbers as :func:`polach_forces` with scalar arguments. Building
     one imports numba (the kernel is loaded from numba's cache, or compiled once).
 
