@@ -502,21 +502,20 @@ TASKS_PER_THREAD = 4
 _POOL: dict = {}
 
 
-def _pool(workers: int):
-    """The process's pool of kernel threads (at least ``workers`` threads). Created under a
-    lock, anew in a forked child (whose copy of the pool has no threads) or when more threads
-    are asked for; a pool being replaced finishes the work already handed to it."""
+def _pool():
+    """The process's pool of kernel threads, created on first use (under a lock) with
+    ``numba.config.NUMBA_NUM_THREADS - 1`` threads at most (``numba.set_num_threads`` cannot
+    ask for more), started as needed; anew in a forked child, whose copy has no threads. It
+    is never replaced while in use: callers asking for fewer threads submit fewer tasks."""
     from concurrent.futures import ThreadPoolExecutor
 
     with _LOCK:
-        pool = _POOL.get("pool")
-        if pool is None or _POOL["pid"] != os.getpid() or _POOL["size"] < workers:
-            if pool is not None and _POOL["pid"] == os.getpid():
-                pool.shutdown(wait=False)
-            pool = ThreadPoolExecutor(max_workers=workers,
-                                      thread_name_prefix="railadhesion-kernel")  # fmt: skip
-            _POOL.update(pool=pool, pid=os.getpid(), size=workers)
-        return pool
+        if _POOL.get("pid") != os.getpid():
+            workers = max(load_numba().config.NUMBA_NUM_THREADS - 1, 1)
+            _POOL["pool"] = ThreadPoolExecutor(max_workers=workers,
+                                               thread_name_prefix="railadhesion-kernel")
+            _POOL["pid"] = os.getpid()
+        return _POOL["pool"]
 
 
 def run_chunks(func, args, nchunk: int, parallel: bool) -> list:
@@ -543,7 +542,8 @@ def run_chunks(func, args, nchunk: int, parallel: bool) -> list:
                 return
             results[t] = func(*args, bounds[t], bounds[t + 1])
 
-    helpers = [_pool(nthreads - 1).submit(work) for _ in range(min(nthreads, ntask) - 1)]
+    pool = _pool()
+    helpers = [pool.submit(work) for _ in range(min(nthreads, ntask) - 1)]
     work()
     for helper in helpers:
         helper.result()
