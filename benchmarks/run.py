@@ -98,13 +98,14 @@ def plain_numpy_polach(sx, sy, psi, q, v, a, b, c11, c22, c23, mu0, k_a, k_s, bi
 
 def plain_with_kalker(contact, coef, pars):
     """:func:`plain_numpy_polach` with Kalker's coefficients given (``coef``) or, if ``None``,
-    looked up per contact (varying a/b)."""
-    from railadhesion.contact.kalker import kalker_coefficients
+    looked up per contact (varying a/b) with NumPy (the test oracle: the package's own lookup
+    is compiled now, and a baseline must not use it)."""
+    from oracles.kalker import kalker_coefficients  # NumPy, as a user's code would be
 
     sx, sy, psi, q, v, a, b = contact
     if coef is None:
         coef = kalker_coefficients(a / b, 0.28)
-    return plain_numpy_polach(sx, sy, psi, q, v, a, b, coef.c11, coef.c22, coef.c23, *pars)
+    return plain_numpy_polach(sx, sy, psi, q, v, a, b, coef[0], coef[1], coef[2], *pars)
 
 
 class Table:
