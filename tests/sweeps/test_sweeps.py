@@ -8,7 +8,7 @@ import pytest
 import xarray as xr
 
 import railadhesion as ra
-from railadhesion.plotting import contact_semi_axes
+from railadhesion.contact.geometry import contact_semi_axes
 from railadhesion.sweeps import (
     FunctionSweep,
     PolachSweep,

@@ -946,7 +946,7 @@ class BrakingSimulator:
                              st.reapply_slip_ratio, st.reapply_slip_min, st.hold_deceleration,
                              st.vent_deceleration, st.recovery_acceleration,
                              st.deceleration_filter, st.watchdog_time,
-                             st.watchdog_refill_time, st.sliding_reference_deceleration)
+                             st.watchdog_refill_time, 1.0)  # legacy kernel WSP: see run.py
 
     def _run_compiled(self, nmax, dt, progress, initial_speed):
         """The loop of simulate() in the compiled kernel, in blocks of rows."""

@@ -15,11 +15,21 @@ spread of mu within each (exact up to the slip spread within a bin of width max/
 slip range is the 1st to 99th percentile of the samples at that resolution. Samples are
 collected in one compiled pass over the log.
 
+The minimum is found by variable projection (Golub and Pereyra 1973): for fixed ``s0`` and
+``B`` the law is linear in ``c1 = mu_s A`` and ``c2 = mu_s (1 - A)``, solved exactly, so the
+search runs over (s0, B) only: a grid, then a pattern search after Hooke and Jeeves (1961),
+then scipy's ``least_squares`` polishes all four parameters.
+
 Uncertainty [our approximation]: the standard errors are the linearised ones
 (``s^2 (J^T W J)^-1``) with the residual variance of the samples, inflated by
 ``sqrt(n / n_eff)`` where ``n_eff`` counts one independent sample per correlation time of the
 filtered signals (``1/(2 f_c)``, f_c the wheel cut-off) and per axle: filtered samples 2.4 ms
 apart are not independent.
+
+References: G. H. Golub and V. Pereyra, "The differentiation of pseudo-inverses and nonlinear
+least squares problems whose variables separate", SIAM J. Numer. Anal. 10 (1973) 413-432.
+R. Hooke and T. A. Jeeves, "'Direct search' solution of numerical and statistical problems",
+J. ACM 8 (1961) 212-229.
 
 A fit is saved as a TOML parameter file (``format = "railadhesion-adhesion-law"``,
 ``version = 1``, docs/identification.md) and loaded by :func:`load_adhesion_law` as an
@@ -39,7 +49,7 @@ from numba import njit
 from scipy import optimize
 
 from railadhesion._validate import check_choice
-from railadhesion.identification.surface import _cell
+from railadhesion.identification.surface import cell_index
 
 __all__ = [
     "LAW_FORMAT",
@@ -129,7 +139,7 @@ def _band_stats(speed, x, mu, use, phase, edges):  # pragma: no cover - compiled
     band = np.empty(n, np.int64)
     for k in range(n):
         v = speed[k]
-        b = _cell(v, edges) if v < edges[nb] else -1  # bands are [low, high)
+        b = cell_index(v, edges) if v < edges[nb] else -1  # bands are [low, high)
         band[k] = b
         h0 = False
         h1 = False
@@ -279,8 +289,8 @@ def _linear_part(suu, suv, svv, sut, svt, stt, top):  # pragma: no cover - compi
 @njit(cache=True, nogil=True)
 def _grid_search(xb, yb, sw, s0_grid, b_grid, top):  # pragma: no cover - compiled
     """For each (s0, B) of the grid the linear parameters c1 = mu_s A and c2 = mu_s (1 - A) are
-    solved exactly (variable projection): half the cost and (mu_s, A) at every grid point,
-    shape (len(s0_grid), len(b_grid), 3)."""
+    solved exactly (variable projection, Golub and Pereyra 1973): half the cost and (mu_s, A)
+    at every grid point, shape (len(s0_grid), len(b_grid), 3)."""
     m = xb.size
     ns = s0_grid.size
     nb = b_grid.size
@@ -350,7 +360,8 @@ def _projected(xb, yb, sw, s0, b_rate, top):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True)
 def _pattern_search(xb, yb, sw, s0, b_rate, lo, hi, step, top, h_min):  # pragma: no cover
     """Local minimum of the projected cost over (log s0, log B) from a start: a pattern
-    search (8 directions; a successful direction is followed with doubled steps; the step is
+    search after Hooke and Jeeves (1961) (exploratory moves in 8 directions; a successful
+    direction is followed with doubled steps, our form of their pattern move; the step is
     halved when no direction improves, down to ``h_min``). B is kept >= 1e-9 (B = 0 and
     B = 1e-9 give the same curve to 1e-8). Returns (cost, mu_s, s0, A, B)."""
     b_min = 1e-9
@@ -417,9 +428,10 @@ def _global_start(xb, yb, sw, lo_b, hi_b, candidates: int = GLOBAL_CANDIDATES,
 
     For fixed s0 and B the law is linear in c1 = mu_s A and c2 = mu_s (1 - A) (c1, c2 >= 0,
     c1 + c2 <= mu_s's bound), so the search runs over (s0, B) only with the linear pair solved
-    exactly (variable projection): a ``grid`` x ``grid`` log grid over the whole box, then a
-    compiled pattern search from each of its ``candidates`` best local minima (down to steps
-    of ``h_min`` in log s0 and log B); the best point found."""
+    exactly (variable projection, Golub and Pereyra 1973): a ``grid`` x ``grid`` log grid
+    over the whole box, then a compiled pattern search (Hooke and Jeeves 1961) from each of
+    its ``candidates`` best local minima (down to steps of ``h_min`` in log s0 and log B); the
+    best point found."""
     s0_grid = np.geomspace(lo_b[1], hi_b[1], grid)
     b_grid = np.r_[0.0, np.geomspace(1e-3, hi_b[3], grid - 1)]
     starts = _grid_best(xb, yb, sw, s0_grid, b_grid, hi_b[0], candidates)
@@ -489,7 +501,7 @@ def fit_adhesion_curves(ident, *, slip: str = "absolute", speed_bands=None, phas
     Parameters
     ----------
     ident : BrakingIdentification
-        From :func:`~railadhesion.identification.braking.identify_adhesion` (its ``speed``,
+        From :func:`~railadhesion.identification.brake_tests.identify_adhesion` (its ``speed``,
         ``slip`` or ``relative_slip``, ``mu``, ``use`` and ``phase`` arrays).
     slip : {"absolute", "relative"}
         Fit against the absolute slip [m/s] or the relative slip [-].

@@ -149,7 +149,7 @@ def _profile_interval(xi, y, g, mu_hat, ka_hat, ssr_min, dof):
     """
     # floor: exact (noise-free) data still get a finite, tiny interval
     s2 = max(ssr_min / dof, (1e-6 * float(np.max(y))) ** 2, 1e-300)
-    from scipy import stats  # imported when needed (scipy.stats takes 0.5 s to import)
+    from scipy import stats  # imported when needed (scipy.stats is slow to import)
 
     limit = ssr_min + s2 * stats.chi2.ppf(_LEVEL, 1)
 

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from railadhesion.identification.braking import _worker_count, identify_adhesion
+from railadhesion.identification.brake_tests import identify_adhesion, worker_count
 from railadhesion.identification.curves import band_statistics, fit_adhesion_curves
 from railadhesion.identification.logs import BrakingLog, read_braking_log
 from railadhesion.identification.signals import VEHICLE_CUTOFF, WHEEL_CUTOFF
@@ -78,28 +78,13 @@ class IdentificationRun:
 
 
 def write_frame_csv(frame, path) -> Path:
-    """Write a DataFrame as CSV without its index, numbers in their shortest round-trip form
-    (pyarrow's writer; pandas' if pyarrow is missing)."""
+    """Write a DataFrame as CSV without its index (:func:`pyarrow.csv.write_csv`: numbers in
+    their shortest round-trip form, column names and strings quoted)."""
+    import pyarrow as pa
+    import pyarrow.csv as pcsv
+
     path = Path(path)
-    try:
-        import pyarrow as pa
-        import pyarrow.csv as pcsv
-    except ImportError:  # pragma: no cover - pyarrow is a dependency
-        frame.to_csv(path, index=False)
-        return path
-    table = pa.Table.from_pandas(frame, preserve_index=False)
-    body = pa.BufferOutputStream()
-    if len(frame):
-        try:  # plain values, as pandas writes them
-            pcsv.write_csv(table, body, write_options=pcsv.WriteOptions(
-                include_header=False, quoting_style="none"))
-        except pa.ArrowInvalid:  # a value holds a comma, quote or newline: quote strings
-            body = pa.BufferOutputStream()
-            pcsv.write_csv(table, body, write_options=pcsv.WriteOptions(
-                include_header=False, quoting_style="needed"))
-    with path.open("wb") as fh:
-        fh.write((",".join(str(c) for c in frame.columns) + "\n").encode())
-        fh.write(body.getvalue().to_pybytes())
+    pcsv.write_csv(pa.Table.from_pandas(frame, preserve_index=False), str(path))
     return path
 
 
@@ -134,7 +119,7 @@ def run_identification(
     figures : bool, default False
         Also draw the figures (``out/figures``; needs ``out``).
     threads : int, optional
-        Threads for the compiled stages (default: every core available).
+        Threads for the compiled stages (default: ``numba.get_num_threads()``).
     progress : callable, optional
         Called with the name of each stage of :data:`STAGES` after the first as it starts.
 
@@ -148,7 +133,7 @@ def run_identification(
         Unreadable log or vehicle, bad options, no braking in the log.
     """
     step = progress or (lambda _stage: None)
-    workers = _worker_count(threads)
+    workers = worker_count(threads)
     timings: dict[str, float] = {}
     clock = [time.perf_counter()]
 
@@ -189,6 +174,7 @@ def run_identification(
         if out is not None:
             paths["windows"] = write_frame_csv(ident.windows, out / "windows.csv")
         stats_abs.result()
+        step("fitted curves")
         law = fit_adhesion_curves(ident, speed_bands=bands)
         phase_curves = {}
         for phase in ("loss", "recovery"):
@@ -206,7 +192,6 @@ def run_identification(
         if pool is not None:
             pool.shutdown()
     lap("surfaces (waiting for them)")
-    step("fitted curves")
     if out is not None:
         save_surface(surface, out / "surface.nc")
         save_surface(surface_relative, out / "surface_relative.nc")

@@ -626,7 +626,7 @@ class Polach:
 
     def adhesion(self, creep_long, creep_lat, spin, normal_force, speed, a, b):
         """Adhesion coefficient sqrt(fx^2 + fy^2)/Q [-] (:func:`railadhesion.adhesion`)."""
-        from railadhesion import adhesion
+        from railadhesion.contact.traction import adhesion
 
         fx, fy = self.forces(creep_long, creep_lat, spin, normal_force, speed, a, b)
         return adhesion(fx, fy, normal_force)

@@ -104,7 +104,7 @@ PAPER_TRANSITIONS: tuple[WaterTransition, ...] = (
 )
 
 
-def _check_transitions(transitions, where: str = "transitions") -> tuple[WaterTransition, ...]:
+def check_transitions(transitions, where: str = "transitions") -> tuple[WaterTransition, ...]:
     """Validated tuple of three :class:`WaterTransition`; errors name ``where``."""
     try:
         items = list(transitions)
@@ -192,7 +192,7 @@ def _as_transition_key(transitions) -> tuple:
     try:
         return tuple((float(m), float(s)) for m, s in transitions)
     except (TypeError, ValueError):
-        _check_transitions(transitions)  # raises the specific error
+        check_transitions(transitions)  # raises the specific error
         raise
 
 
@@ -267,7 +267,7 @@ def wilac_weights(water_flow, transitions=PAPER_TRANSITIONS) -> np.ndarray:
 
 @functools.lru_cache(maxsize=32)
 def _checked_transitions(transitions: tuple) -> tuple:
-    return _check_transitions(transitions)
+    return check_transitions(transitions)
 
 
 def _water_flow_laws(water_flow, transitions, rows: int) -> np.ndarray:
@@ -342,7 +342,9 @@ class WilacCondition:
         return {name: getattr(self, name) for name in POLACH_PARAMETER_NAMES}
 
 
-def _check_provenance(provenance, where: str = "provenance") -> dict:
+def check_provenance(provenance, where: str = "provenance") -> dict:
+    """Validated provenance table (the fields of :data:`PROVENANCE_FIELDS`; ``created`` an ISO
+    date); errors name ``where``. ``None`` gives an empty dict."""
     if provenance is None:
         return {}
     if not isinstance(provenance, Mapping):
@@ -484,10 +486,10 @@ class WilacParameters:
             _check_pair(self.normal_force_range, "normal_force_range"),
         )
         object.__setattr__(self, "speed_range", _check_pair(self.speed_range, "speed_range"))
-        object.__setattr__(self, "transitions", _check_transitions(self.transitions))
+        object.__setattr__(self, "transitions", check_transitions(self.transitions))
         if not isinstance(self.name, str):
             raise ValueError(f"name: expected a string, got {self.name!r}")
-        object.__setattr__(self, "provenance", _check_provenance(self.provenance))
+        object.__setattr__(self, "provenance", check_provenance(self.provenance))
         # Every regression must be finite over the whole calibrated range (corners and a grid).
         q = np.linspace(*self.normal_force_range, 9)[:, None] / self.normal_force_ref
         v = np.linspace(*self.speed_range, 9)[None, :] / self.speed_ref

@@ -55,7 +55,8 @@ STUDY_OUTPUTS: dict[str, tuple[str, str]] = {
     "dry_stopping_distance": ("m", "stopping distance of the same stop on a dry rail (w = 0)"),
     "extension": ("m", "stopping-distance extension against the dry stop"),
     "extension_percent": ("%", "stopping-distance extension against the dry stop"),
-    "longest_lock": ("s", "longest continuous lock of any axle (creepage >= 0.95)"),
+    "longest_lock": ("s", "longest continuous lock of any axle (wheel below 10 % of the "
+                     "train speed, train above 0.5 m/s)"),
     "max_slip": ("1", "largest creepage of any axle"),
     "stopped": ("1", "1 if the train stopped before max_time, else 0"),
 }
@@ -258,7 +259,14 @@ def load_study_spec(path) -> StudySpec:
     from pathlib import Path
 
     from railadhesion.sweeps.plan import monte_carlo
-    from railadhesion.sweeps.spec import SpecError, _axis, _fail, _int, _keys, _num
+    from railadhesion.sweeps.spec import (
+        SpecError,
+        axis_values,
+        check_keys,
+        fail_field,
+        int_field,
+        number_field,
+    )
 
     path = Path(path)
     try:
@@ -268,88 +276,88 @@ def load_study_spec(path) -> StudySpec:
     except tomllib.TOMLDecodeError as exc:
         raise SpecError(f"{path}: not valid TOML: {exc}") from None
     try:
-        _keys(doc, "", ("format", "format_version", "title", "study", "design", "grid",
+        check_keys(doc, "", ("format", "format_version", "title", "study", "design", "grid",
                         "distributions", "fixed", "chunks"),
               ("format", "format_version", "design"))  # fmt: skip
         if doc["format"] != STUDY_FORMAT:
-            _fail("format", f"expected {STUDY_FORMAT!r}, got {doc['format']!r}")
+            fail_field("format", f"expected {STUDY_FORMAT!r}, got {doc['format']!r}")
         if doc["format_version"] != 1:
-            _fail("format_version", f"expected 1, got {doc['format_version']!r}")
+            fail_field("format_version", f"expected 1, got {doc['format_version']!r}")
         study = doc.get("study", {})
-        _keys(study, "study", ("vehicle", "dt", "max_time", "wsp_settings"))
+        check_keys(study, "study", ("vehicle", "dt", "max_time", "wsp_settings"))
         options = {}
         if "vehicle" in study:
             v = study["vehicle"]
             if not isinstance(v, str):
-                _fail("study.vehicle", f"expected a vehicle name or file, got {v!r}")
+                fail_field("study.vehicle", f"expected a vehicle name or file, got {v!r}")
             options["vehicle"] = str((path.parent / v).resolve()) if v.endswith(".toml") else v
         for key in ("dt", "max_time"):
             if key in study:
-                options[key] = _num(study[key], f"study.{key}")
+                options[key] = number_field(study[key], f"study.{key}")
                 if options[key] <= 0:
-                    _fail(f"study.{key}", f"expected a number > 0, got {study[key]!r}")
+                    fail_field(f"study.{key}", f"expected a number > 0, got {study[key]!r}")
         if "wsp_settings" in study:
             ws = study["wsp_settings"]
             if not isinstance(ws, dict):
-                _fail("study.wsp_settings", f"expected a table, got {ws!r}")
-            options["wsp_settings"] = {k: _num(v, f"study.wsp_settings.{k}")
+                fail_field("study.wsp_settings", f"expected a table, got {ws!r}")
+            options["wsp_settings"] = {k: number_field(v, f"study.wsp_settings.{k}")
                                        for k, v in ws.items()}  # fmt: skip
         try:
             model = BrakingStudy(**options)
         except (ValueError, TypeError) as exc:
-            _fail("study", str(exc))
+            fail_field("study", str(exc))
         design = doc["design"]
-        _keys(design, "design", ("kind", "n", "seed"), ("kind",))
+        check_keys(design, "design", ("kind", "n", "seed"), ("kind",))
         kind = design["kind"]
         if kind not in ("factorial", "monte_carlo"):
-            _fail("design.kind", f"expected 'factorial' or 'monte_carlo', got {kind!r}")
+            fail_field("design.kind", f"expected 'factorial' or 'monte_carlo', got {kind!r}")
         grid = {}
         for dim, value in doc.get("grid", {}).items():
             if dim not in STUDY_INPUTS:
-                _fail(f"grid.{dim}", f"not a study input; inputs: {', '.join(STUDY_INPUTS)}")
-            grid[dim] = _axis(dim, value, f"grid.{dim}", path.parent)
+                fail_field(f"grid.{dim}", f"not a study input; inputs: {', '.join(STUDY_INPUTS)}")
+            grid[dim] = axis_values(dim, value, f"grid.{dim}", path.parent)
         dists = doc.get("distributions", {})
         if kind == "monte_carlo":
             for key in ("n", "seed"):
                 if key not in design:
-                    _fail(f"design.{key}", "missing (required for a Monte Carlo design)")
-            n = _int(design["n"], "design.n")
-            seed = _int(design["seed"], "design.seed", low=0)
+                    fail_field(f"design.{key}", "missing (required for a Monte Carlo design)")
+            n = int_field(design["n"], "design.n")
+            seed = int_field(design["seed"], "design.seed", low=0)
             if not isinstance(dists, dict) or not dists:
-                _fail("distributions", "a Monte Carlo design needs at least one distribution")
+                fail_field("distributions", "a Monte Carlo design needs at least one distribution")
             checked = {}
             for name, spec in dists.items():
                 where = f"distributions.{name}"
                 if name not in STUDY_INPUTS:
-                    _fail(where, f"not a study input; inputs: {', '.join(STUDY_INPUTS)}")
+                    fail_field(where, f"not a study input; inputs: {', '.join(STUDY_INPUTS)}")
                 if not (isinstance(spec, list) and spec and spec[0] in _DISTRIBUTIONS
                         and len(spec) == 1 + _DISTRIBUTIONS[spec[0]]):  # fmt: skip
-                    _fail(where, "expected [\"uniform\", low, high], [\"normal\", mean, sd], "
+                    fail_field(where, "expected [\"uniform\", low, high], [\"normal\", mean, sd], "
                           "[\"lognormal\", mean_of_log, sd_of_log] or [\"choice\", [values]], "
                           f"got {spec!r}")  # fmt: skip
                 if spec[0] == "choice":
                     if not isinstance(spec[1], list) or not spec[1]:
-                        _fail(where, "choice needs a non-empty list of values")
-                    args = [[_num(x, f"{where}[1]") for x in spec[1]]]
+                        fail_field(where, "choice needs a non-empty list of values")
+                    args = [[number_field(x, f"{where}[1]") for x in spec[1]]]
                 else:
-                    args = [_num(x, f"{where}[{i + 1}]") for i, x in enumerate(spec[1:])]
+                    args = [number_field(x, f"{where}[{i + 1}]") for i, x in enumerate(spec[1:])]
                 checked[name] = (spec[0], *args)
             grid.update(monte_carlo(n, seed, **checked))
         elif dists:
-            _fail("distributions", "only for design.kind = 'monte_carlo'")
+            fail_field("distributions", "only for design.kind = 'monte_carlo'")
         elif "n" in design or "seed" in design:
-            _fail("design.n" if "n" in design else "design.seed",
+            fail_field("design.n" if "n" in design else "design.seed",
                   "only for design.kind = 'monte_carlo'")  # fmt: skip
         if not grid:
-            _fail("grid", "expected at least one swept input")
+            fail_field("grid", "expected at least one swept input")
         fixed = doc.get("fixed", {})
         if not isinstance(fixed, dict):
-            _fail("fixed", f"expected a table, got {fixed!r}")
-        fixed = {k: _num(v, f"fixed.{k}") for k, v in fixed.items()}
-        chunks = {k: _int(v, f"chunks.{k}") for k, v in doc.get("chunks", {}).items()}
+            fail_field("fixed", f"expected a table, got {fixed!r}")
+        fixed = {k: number_field(v, f"fixed.{k}") for k, v in fixed.items()}
+        chunks = {k: int_field(v, f"chunks.{k}") for k, v in doc.get("chunks", {}).items()}
         title = doc.get("title", "")
         if not isinstance(title, str):
-            _fail("title", f"expected a string, got {title!r}")
+            fail_field("title", f"expected a string, got {title!r}")
         spec = StudySpec(model, grid, fixed, chunks, title, str(path))
         try:
             spec.plan()
