@@ -143,15 +143,16 @@ def test_laws_compile_as_cfunc(law, signature):
     arguments (and the packed WILAC array), tuple returns, no exceptions, no allocation."""
     cfunc = numba.cfunc(signature, error_model="numpy")(law)
     ir = cfunc.inspect_llvm()
-    names = [re.search(r"@([^\s(]+)\(", f) for f in ir.split("\ndefine ")[1:]]
-    bodies = [f for f, name in zip(ir.split("\ndefine ")[1:], names, strict=True)
-              if law.__name__ in name.group(1) and not name.group(1).startswith("cfunc.")]
-    # the law's own code (not the C wrapper, which reports a failed call)
-    assert bodies
-    for body in bodies:
-        body = body[: body.index("\n}\n")]
-        assert "NRT_MemInfo_alloc" not in body  # no allocation
-        assert "numba_do_raise" not in body and "PyErr_" not in body  # no exceptions
+    parts = ir.split("\ndefine ")[1:]
+    names = [re.search(r"@([^\s(]+)\(", part).group(1) for part in parts]
+    assert any(law.__name__ in name for name in names)
+    for part, name in zip(parts, names, strict=True):
+        if name.startswith("cfunc."):
+            continue  # numba's C wrapper (it reports a failed call through Python)
+        body = part[: part.index("\n}\n")]
+        # no allocation (reference counts of the packed array are fine: none with numba.carray)
+        assert "NRT_MemInfo_alloc" not in body, name
+        assert "numba_do_raise" not in body and "@Py" not in body, name  # no exception path
 
 
 @numerics.jit(nogil=True)

@@ -694,14 +694,24 @@ def wilac_regression(packed, i, j, f0, f1, f2, f3, f4, f5):
     linear regression of seed 000, section 5.2 (:func:`wilac_term` summed over the terms,
     :func:`wilac_clip`); f0-f5 are the factors of :func:`wilac_factors`, indexed by the
     packed factor indices (6 for the factor 1)."""
-    fac = (f0, f1, f2, f3, f4, f5, 1.0)
     first, count = wilac_terms(packed, i, j)
     total = 0.0
     for t in range(count):
         p = first + 4 * t
-        total = total + wilac_term(packed[p], fac[int(packed[p + 1])], fac[int(packed[p + 2])],
-                                   fac[int(packed[p + 3])])  # fmt: skip
+        total = total + wilac_term(packed[p], _factor(packed[p + 1], f0, f1, f2, f3, f4, f5),
+                                   _factor(packed[p + 2], f0, f1, f2, f3, f4, f5),
+                                   _factor(packed[p + 3], f0, f1, f2, f3, f4, f5))  # fmt: skip
     return wilac_clip(total, packed, j)
+
+
+@jitable
+def _factor(index, f0, f1, f2, f3, f4, f5):
+    """Factor ``index`` (a packed factor index, a float: 0-5, 6 for the factor 1) of
+    :func:`wilac_factors`; selects, so that no indexing can raise (the native FMUs compile the
+    laws without numba's runtime)."""
+    low = f0 if index == 0.0 else (f1 if index == 1.0 else f2)
+    high = f3 if index == 3.0 else (f4 if index == 4.0 else (f5 if index == 5.0 else 1.0))
+    return low if index < 3.0 else high
 
 
 @kernel(nogil=True)
