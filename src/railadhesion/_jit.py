@@ -1,10 +1,13 @@
-"""The cache guard of the braking kernels (railadhesion.braking._kernels), which still use
-numba's in-tree cache; every other kernel is built with :func:`railadhesion.numerics.jit`,
-whose cache directory is keyed by the kernel sources and needs no guard. Remove this module
-when the braking kernels move to :func:`railadhesion.numerics.jit`.
+"""The package's only uses of numba internals, isolated here: the cache guard of the kernels
+that still use numba's in-tree cache (``braking._kernels``, ``monitor.kernel``; every other
+kernel is built with :func:`railadhesion.numerics.jit`, whose cache directory is keyed by the
+kernel sources and needs no guard) and :func:`kernel_entry` (with a fallback).
+``tests/test_jit.py`` checks both against the installed numba.
 """
 
 from __future__ import annotations
+
+__all__ = ["guard_cache", "kernel_entry", "purge_module_cache", "source_checksum"]
 
 # numba keys a cached kernel on its own source file only. A kernel that calls (and inlines)
 # njit helpers of another module keeps its cached machine code when that module changes; the
@@ -49,3 +52,18 @@ def guard_cache(fingerprint_dispatcher, module_file: str, current: int) -> list:
     if gone:
         fingerprint_dispatcher.recompile()
     return gone
+
+
+def kernel_entry(dispatcher, args):
+    """The compiled entry point of the numba ``dispatcher`` for the types of ``args``: calling
+    it skips the dispatcher's type resolution (a few hundred ns a call). ``args`` must make a
+    call without harm (it compiles the kernel, or loads it from the cache); falls back to the
+    dispatcher if numba's internals do not give the entry point."""
+    dispatcher(*args)
+    try:
+        from numba import typeof
+
+        entry = dispatcher.overloads[tuple(typeof(a) for a in args)].entry_point
+    except Exception:  # pragma: no cover - numba internals changed: use the dispatcher
+        entry = None
+    return entry if callable(entry) else dispatcher

@@ -21,6 +21,14 @@ from railadhesion.contact.fastsim import fastsim
 # the module (the package's attribute ``fastsim`` is the function)
 fastsim_module = importlib.import_module("railadhesion.contact.fastsim")
 
+#: The compiled kernels against their references over the whole input domain, implausible
+#: inputs included: the policy's warnings (docs/checks.md) are what tests/test_plausibility.py
+#: checks, not these tests.
+pytestmark = pytest.mark.filterwarnings(
+    "ignore::railadhesion.plausibility.PlausibilityWarning",
+    "ignore::railadhesion.plausibility.AlteredResultWarning",
+)
+
 FIELDS = ("fx", "fy", "mz", "slip_fraction")
 
 

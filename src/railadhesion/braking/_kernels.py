@@ -49,6 +49,7 @@ from railadhesion.braking._layout import (  # noqa: F401 (numba reads them as co
     AVAIL_ON_,
     BAD_COMMAND,
     BAD_DT,
+    BAD_TORQUE,
     BAD_VALVE,
     BOGIE_,
     BRAKE_,
@@ -162,6 +163,7 @@ from railadhesion.braking._layout import (  # noqa: F401 (numba reads them as co
     R_STATIC,
     R_STIFF,
     R_TMP,
+    R_TORQUE,
     R_TRANSFER,
     R_VACT,
     R_VALVE,
@@ -762,7 +764,8 @@ def _newton(buf, work, n, nl, v0, dt, external, r_pred):
             if work[R_CLAMP, i] != 0.0:
                 continue
             rn = radius * nl_i
-            g = j_dt * (work[R_W, i] - work[R_OMEGA, i]) - rn * mu + brake * work[R_PBAR, i]
+            g = (j_dt * (work[R_W, i] - work[R_OMEGA, i]) - rn * mu + brake * work[R_PBAR, i]
+                 - work[R_TORQUE, i])
             a = j_dt + rn * dmu * radius * iv
             b = -rn * (dmu * dsdv + dmv)
             c = -nl_i * dmu * radius * iv
@@ -784,7 +787,7 @@ def _newton(buf, work, n, nl, v0, dt, external, r_pred):
             if work[R_CLAMP, i] != 0.0:
                 work[R_TMP, i] = 0.0
                 static = (-j_dt * work[R_OMEGA, i] - radius * work[R_LOAD, i] * work[R_EMU, i]
-                          + brake * work[R_PBAR, i])
+                          + brake * work[R_PBAR, i] - work[R_TORQUE, i])
                 if static < 0.0:  # brake friction cannot hold the wheel: it turns
                     work[R_CLAMP, i] = 0.0
                     changed = True
@@ -831,11 +834,11 @@ def _solve_wheels(buf, work, n, nl, v, dt, tol):
     for i in range(n):
         rn = radius * work[R_LOAD, i]
         locked = (-inertia * work[R_OMEGA, i] / dt - rn * work[R_EMU, i]
-                  + brake * work[R_PBAR, i]) >= 0.0
+                  + brake * work[R_PBAR, i] - work[R_TORQUE, i]) >= 0.0
         work[R_CLAMP, i] = 1.0 if locked else 0.0
         work[R_ACT, i] = 0.0 if locked else 1.0
         work[R_LO, i] = 0.0
-        hi = work[R_OMEGA, i] + dt * rn * 2.0 / inertia + 1e-9
+        hi = work[R_OMEGA, i] + dt * (rn * 2.0 + max(work[R_TORQUE, i], 0.0)) / inertia + 1e-9
         work[R_HI, i] = hi
         work[R_W, i] = min(max(work[R_W, i], 0.0), hi)
     for _ in range(100):
@@ -849,8 +852,8 @@ def _solve_wheels(buf, work, n, nl, v, dt, tol):
         for i in range(n):
             rn = radius * work[R_LOAD, i]
             w = work[R_W, i]
-            g = inertia * (w - work[R_OMEGA, i]) / dt - rn * work[R_EMU, i] + brake * work[
-                R_PBAR, i]
+            g = (inertia * (w - work[R_OMEGA, i]) / dt - rn * work[R_EMU, i]
+                 + brake * work[R_PBAR, i] - work[R_TORQUE, i])
             dg = inertia / dt + rn * work[R_EDMU, i] * radius / vr
             step = g / dg
             converged = dg > 0.0 and abs(step) * radius < tol
@@ -992,7 +995,7 @@ def _advance(buf, work, rows, dt):
     wb = 0.0
     wc = 0.0
     for i in range(n):
-        wb += brake * work[R_PBAR, i] * work[R_W, i] * dt
+        wb += (brake * work[R_PBAR, i] - work[R_TORQUE, i]) * work[R_W, i] * dt
         wc += work[R_EMU, i] * work[R_LOAD, i] * (v - work[R_W, i] * radius) * dt
     buf[WB_] += wb
     buf[WC_] += wc
@@ -1077,10 +1080,12 @@ def _set_valves(buf, work, n):
 @njit(cache=True, error_model="numpy")
 def step(buf, work, rows, dt):
     """The stepping API: advance by dt (split into equal sub-steps <= max_step) with the inputs
-    in work[R_CMD] (commanded pressure per axle) and work[R_VIN] (valve state per axle).
+    in work[R_CMD] (commanded pressure per axle), work[R_VIN] (valve state per axle) and
+    work[R_TORQUE] (traction torque per axle [N m], positive driving the wheel forward).
 
     Returns OK, STOPPED (the train is at rest: nothing happens), NONFINITE, BAD_DT,
-    BAD_COMMAND or BAD_VALVE (buf[ERR_AXLE_] and buf[ERR_VALUE_] say which input), or
+    BAD_COMMAND, BAD_VALVE or BAD_TORQUE (buf[ERR_AXLE_] and buf[ERR_VALUE_] say which
+    input), or
     ROWS_FULL (nothing done: the caller provides a new rows block and calls again).
     """
     if not (dt > 0.0 and dt < math.inf):
@@ -1099,6 +1104,11 @@ def step(buf, work, rows, dt):
             buf[ERR_AXLE_] = i
             buf[ERR_VALUE_] = s
             return BAD_VALVE
+        q = work[R_TORQUE, i]
+        if not (q > -math.inf and q < math.inf):
+            buf[ERR_AXLE_] = i
+            buf[ERR_VALUE_] = q
+            return BAD_TORQUE
     nsub = max(1, int(math.ceil(dt / buf[MAX_STEP_] - 1e-9)))
     if buf[RECORD_] != 0.0 and buf[NROW_] + nsub > rows.shape[0]:
         return ROWS_FULL

@@ -2,8 +2,10 @@
 
 Equations (seed 002 §4, with the vehicle of :mod:`railadhesion.braking.vehicle`):
 
-* wheelset i: ``J dω_i/dt = R T_i − c p_i`` (eq. 6), brake torque only while the wheel turns
-  (a stopped wheel is held by static brake friction while ``R T_i ≤ c p_i``);
+* wheelset i: ``J dω_i/dt = R T_i − c p_i + τ_i`` (eq. 6 with a traction torque τ_i, the
+  input ``inputs.torque``, positive driving the wheel forward; 0 unless set), brake torque
+  only while the wheel turns (a stopped wheel is held by static brake friction while
+  ``R T_i + τ_i ≤ c p_i``);
 * train: ``M_tot dv/dt = −Σ T_i − F_res(v) − M_tot g sin(atan(gradient))``;
 * creep force ``T_i = μ_i(ξ_i, v) N_i`` with ``ξ_i = (v − ω_i R)/v`` and the axle load
   ``N_i`` of eqs. 11-12 at the current deceleration (taken from the previous step);
@@ -156,19 +158,23 @@ class StepInputs:
     ``pressure_command`` (n,) float [Pa]: commanded brake-cylinder pressure per axle, in
     [0, inf); ``valves`` (n,) float: WSP valve state per axle, 0 apply, 1 hold, 2 vent (with
     ``BrakeCylinders(valves="bogie")`` the axles of a bogie follow the most severe state of
-    the bogie). Both are views of the simulator's memory: write into them (``inputs.valves[2]
-    = 2``, ``inputs.pressure_command[:] = p``, or a data-acquisition driver's ``out=``); values
-    persist until overwritten and are checked at each step.
+    the bogie); ``torque`` (n,) float [N m]: traction torque per axle, positive driving the
+    wheel forward (``J dω/dt = R T − c p + τ``), any finite value, default 0. All are views of
+    the simulator's memory: write into them (``inputs.valves[2] = 2``,
+    ``inputs.pressure_command[:] = p``, ``inputs.torque[:] = 4e3``, or a data-acquisition
+    driver's ``out=``); values persist until overwritten and are checked at each step.
     """
 
-    __slots__ = ("pressure_command", "valves")
+    __slots__ = ("pressure_command", "valves", "torque")
 
     def __init__(self, work, n):
         self.pressure_command = work[L.R_CMD, :n]
         self.valves = work[L.R_VIN, :n]
+        self.torque = work[L.R_TORQUE, :n]
 
     def __repr__(self) -> str:
-        return f"StepInputs(pressure_command={self.pressure_command}, valves={self.valves})"
+        return (f"StepInputs(pressure_command={self.pressure_command}, valves={self.valves}, "
+                f"torque={self.torque})")
 
 
 _FIXED = frozenset(("vehicle", "adhesion", "cylinders", "gradient", "refresh_period",
@@ -584,6 +590,9 @@ class BrakingSimulator:
         if status == L.BAD_VALVE:
             raise ValueError(f"valves must be 0 (apply), 1 (hold) or 2 (vent); axle {axle + 1} "
                              f"has {value!r}")
+        if status == L.BAD_TORQUE:
+            raise ValueError(f"torque must be a finite number [N m]; axle {axle + 1} has "
+                             f"{value!r}")
         if status == L.NONFINITE:
             self._fail(axle, f" (creep {value:.6g})")
         raise RuntimeError(f"unexpected status {status} of the braking kernel")  # pragma: no cover
@@ -598,23 +607,27 @@ class BrakingSimulator:
         inputs : mapping, optional
             ``pressure_command`` [Pa]: commanded brake-cylinder pressure, a number or one per
             axle (default: the previous command, initially 0); ``valves``: WSP valve states
-            per axle (or per bogie), 0 apply, 1 hold, 2 vent (default: all apply).
+            per axle (or per bogie), 0 apply, 1 hold, 2 vent (default: all apply);
+            ``torque`` [N m]: traction torque, a number or one per axle (default: the previous
+            one, initially 0).
         """
         if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
             raise ValueError(f"dt must be in (0, inf) s, got {dt!r}")
-        cmd = valves = None
+        cmd = valves = torque = None
         if inputs:
             if not isinstance(inputs, Mapping):
-                raise ValueError(
-                    "inputs must be a mapping with 'pressure_command' and/or 'valves'")
-            unknown = set(inputs) - {"pressure_command", "valves"}
+                raise ValueError("inputs must be a mapping with 'pressure_command', 'valves' "
+                                 "and/or 'torque'")
+            unknown = set(inputs) - {"pressure_command", "valves", "torque"}
             if unknown:
                 raise ValueError(f"unknown input(s) {sorted(unknown)}; allowed: "
-                                 "pressure_command, valves")
+                                 "pressure_command, valves, torque")
             cmd = inputs.get("pressure_command")
             valves = inputs.get("valves")
+            torque = inputs.get("torque")
         elif inputs is not None and not isinstance(inputs, Mapping):
-            raise ValueError("inputs must be a mapping with 'pressure_command' and/or 'valves'")
+            raise ValueError("inputs must be a mapping with 'pressure_command', 'valves' and/or "
+                             "'torque'")
         n = self._n
         u = self._inputs
         # values are checked by the step itself (errors name the axle)
@@ -624,6 +637,12 @@ class BrakingSimulator:
             except (ValueError, TypeError):
                 raise ValueError(f"pressure_command must be a number or {n} numbers in "
                                  f"[0, inf) Pa, got {cmd!r}") from None
+        if torque is not None:
+            try:
+                u.torque[:] = torque
+            except (ValueError, TypeError):
+                raise ValueError(f"torque must be a number or {n} finite numbers [N m], got "
+                                 f"{torque!r}") from None
         if valves is None:
             u.valves.fill(APPLY)
         else:
@@ -656,6 +675,10 @@ class BrakingSimulator:
             if s not in (0.0, 1.0, 2.0):
                 buf[L.ERR_AXLE_], buf[L.ERR_VALUE_] = i, s
                 return L.BAD_VALVE
+            q = work[L.R_TORQUE, i]
+            if not (-math.inf < q < math.inf):
+                buf[L.ERR_AXLE_], buf[L.ERR_VALUE_] = i, q
+                return L.BAD_TORQUE
         nsub = max(1, int(math.ceil(dt / buf[L.MAX_STEP_] - 1e-9)))
         if buf[L.RECORD_] != 0.0 and buf[L.NROW_] + nsub > rows.shape[0]:
             return L.ROWS_FULL
@@ -722,8 +745,9 @@ class BrakingSimulator:
             omega, mu = work[L.R_W, :n].copy(), work[L.R_EMU, :n].copy()
         wb = 0.0
         wc = 0.0
+        torque = work[L.R_TORQUE, :n]
         for i in range(n):  # summed in axle order, as the compiled kernel does
-            wb += brake * pbar[i] * omega[i] * dt
+            wb += (brake * pbar[i] - torque[i]) * omega[i] * dt
             wc += mu[i] * work[L.R_LOAD, i] * (v - omega[i] * radius) * dt
         buf[L.WB_] += wb
         buf[L.WC_] += wc
@@ -782,6 +806,7 @@ class BrakingSimulator:
         pbar = work[L.R_PBAR, :n].tolist()
         loads = work[L.R_LOAD, :n].tolist()
         dom = work[L.R_DOMEGA, :n].tolist()
+        torque = work[L.R_TORQUE, :n].tolist()
         v = v0 + r_pred * buf[L.DV_PREV_]
         clamp = [w0 == 0.0 for w0 in omega0]
         w = [0.0 if clamp[i] else (omega0[i] + r_pred * dom[i]
@@ -811,7 +836,7 @@ class BrakingSimulator:
                 if clamp[i]:
                     continue
                 rn = radius * loads[i]
-                g[i] = j_dt * (w[i] - omega0[i]) - rn * mu[i] + brake * pbar[i]
+                g[i] = j_dt * (w[i] - omega0[i]) - rn * mu[i] + brake * pbar[i] - torque[i]
                 a_i = j_dt + rn * dmu[i] * radius * iv
                 b[i] = -rn * (dmu[i] * dsdv + dmv[i])
                 c = -loads[i] * dmu[i] * radius * iv
@@ -829,7 +854,8 @@ class BrakingSimulator:
             for i in range(n):
                 if clamp[i]:
                     dw[i] = 0.0
-                    static = -j_dt * omega0[i] - radius * loads[i] * mu[i] + brake * pbar[i]
+                    static = (-j_dt * omega0[i] - radius * loads[i] * mu[i] + brake * pbar[i]
+                              - torque[i])
                     if static < 0.0:
                         clamp[i] = False
                         changed = True
@@ -899,17 +925,18 @@ class BrakingSimulator:
         omega0 = work[L.R_OMEGA, :n]
         vr = max(v, 1e-6)
         rn = radius * work[L.R_LOAD, :n]
+        traction = work[L.R_TORQUE, :n]
         torque = c * work[L.R_PBAR, :n]
         mu1, _ = self._evaluate(np.ones(n), v)
-        locked = (-inertia * omega0 / dt - rn * mu1 + torque) >= 0
+        locked = (-inertia * omega0 / dt - rn * mu1 + torque - traction) >= 0
         lo = np.zeros(n)
-        hi = omega0 + dt * rn * 2.0 / inertia + 1e-9
+        hi = omega0 + dt * (rn * 2.0 + np.maximum(traction, 0.0)) / inertia + 1e-9
         w = np.minimum(np.maximum(guess, lo), hi)
         active = ~locked
         for _ in range(100):
             xi = (v - w * radius) / vr
             mu, dmu = self._evaluate(xi, v)
-            g = inertia * (w - omega0) / dt - rn * mu + torque
+            g = inertia * (w - omega0) / dt - rn * mu + torque - traction
             dg = inertia / dt + rn * dmu * radius / vr
             with np.errstate(divide="ignore", invalid="ignore"):
                 step = g / dg

@@ -46,6 +46,7 @@ from railadhesion._validate import (
 )
 from railadhesion.contact.friction import falling_friction_factor
 from railadhesion.numerics import jit
+from railadhesion.plausibility import input_checker
 
 __all__ = [
     "ExactResult",
@@ -794,6 +795,11 @@ def _discrete_shape(aob: float, nu: float, nx: int, ny: int, scale: float) -> np
     return shp
 
 
+#: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
+_PLAUSIBLE = input_checker(("creep_long", "creep_lat", "spin", "normal_force", "a", "b",
+                            "shear_modulus", "poisson", "speed"))
+
+
 def exact_rolling(
     creep_long,
     creep_lat,
@@ -1029,6 +1035,7 @@ def exact_rolling(
             "state": state.reshape(*shape, ny, nx),
             "mu_local": mu_all.reshape(*shape, ny, nx),
         }
+    _PLAUSIBLE((xi, eta, phi, fz, a_, b_, g_mod, nu, speed))  # implausible inputs warn
     return ExactResult(
         shaped(out_f[:, 0]),
         shaped(out_f[:, 1]),

@@ -45,6 +45,7 @@ from railadhesion._validate import (
 )
 from railadhesion.contact.kalker import AOB_MAX, AOB_MIN, axis_ratio, kalker_law
 from railadhesion.numerics import flatten, jitable, kernel, read_only, run_chunks
+from railadhesion.plausibility import input_checker
 
 __all__ = [
     "FastsimResult",
@@ -202,6 +203,11 @@ def limit_creepage(xi, eta, phi, a):
     size = max(max(abs(xi), abs(eta)), abs(phi) * a)
     scale = _CREEP_MAX / size if size > _CREEP_MAX else 1.0
     return xi * scale, eta * scale, phi * scale
+
+
+#: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
+_PLAUSIBLE = input_checker(("creep_long", "creep_lat", "spin", "normal_force", "a", "b", "mu",
+                            "shear_modulus", "poisson"))
 
 
 @labelled(units=FASTSIM_UNITS)
@@ -381,6 +387,7 @@ def fastsim(
         if values is not None:
             out = _fastsim_scalar(*values, nx, ny, bound, flexibility)
             if out is not None:
+                _PLAUSIBLE(values)  # implausible inputs warn (docs/checks.md)
                 return out
     xi = check_finite(creep_long, "creep_long")
     eta = check_finite(creep_lat, "creep_lat")
@@ -407,6 +414,7 @@ def fastsim(
 
     if not flx_given:
         axis_ratio(a_, b_)  # Kalker's coefficients are looked up: a/b in their range
+    _PLAUSIBLE((xi, eta, phi, fz, a_, b_, mu_, g_mod, nu))  # implausible inputs warn
     shape, n, flat = flatten([xi, eta, phi, fz, a_, b_, mu_, g_mod, nu, *flx_given])
     mode = _FLEX_GIVEN if flx_given else _FLEXIBILITIES.index(flexibility)
     flex = flat[9:] if flx_given else (_ONE, _ONE, _ONE)

@@ -15,6 +15,7 @@ Outputs (``out``): ``summary.json``, ``surface.nc``, ``surface_relative.nc``,
 from __future__ import annotations
 
 import json
+import math
 import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
@@ -28,6 +29,14 @@ from railadhesion.identification.curves import band_statistics, fit_adhesion_cur
 from railadhesion.identification.logs import BrakingLog, read_braking_log
 from railadhesion.identification.signals import VEHICLE_CUTOFF, WHEEL_CUTOFF
 from railadhesion.identification.surface import adhesion_surface, save_surface
+from railadhesion.plausibility import (
+    PlausibilityWarning,
+    UnitWarning,
+    UntrustedResultWarning,
+    sniff_ratio,
+    sniff_speed_ratio,
+    warn,
+)
 
 __all__ = ["STAGES", "IdentificationRun", "run_identification", "write_frame_csv"]
 
@@ -62,6 +71,12 @@ class IdentificationRun:
         Stage -> wall time [s].
     threads : int
         Threads used.
+    warnings : tuple of str
+        Why the identification should not be trusted (``docs/checks.md``): columns of the log
+        in another unit, a brake coefficient far from the vehicle's, curves of the laws that
+        the quality gate flags. Empty if none; also in ``summary.json`` and the law files.
+    trusted : bool
+        ``not warnings``.
     """
 
     log: BrakingLog
@@ -75,6 +90,12 @@ class IdentificationRun:
     paths: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
     threads: int = 1
+    warnings: tuple = ()
+
+    @property
+    def trusted(self) -> bool:
+        """True when nothing was found against the identification (:attr:`warnings`)."""
+        return not self.warnings
 
 
 def write_frame_csv(frame, path) -> Path:
@@ -153,6 +174,11 @@ def run_identification(
                               vehicle_cutoff=vehicle_cutoff, wheel_cutoff=wheel_cutoff,
                               progress=step, threads=workers)
     lap("identify (filters, eq. 14, loads, mu, windows)")
+    findings = [*getattr(log, "warnings", ()), *_brake_coefficient_check(ident, vehicle)]
+    if not any("train_speed" in w for w in findings):  # against the vehicle's own radius
+        found = sniff_speed_ratio(log.train_speed, log.wheel_speed, vehicle.wheel_radius,
+                                  where=f"{log.source or 'log'}: train_speed")  # fmt: skip
+        findings += [found] if found else []
     bands = [float(x) for x in speed_bands]
     step("surface")
     paths: dict[str, Path] = {}
@@ -175,16 +201,23 @@ def run_identification(
             paths["windows"] = write_frame_csv(ident.windows, out / "windows.csv")
         stats_abs.result()
         step("fitted curves")
-        law = fit_adhesion_curves(ident, speed_bands=bands)
+        law = fit_adhesion_curves(ident, speed_bands=bands, warn_untrusted=False)
         phase_curves = {}
         for phase in ("loss", "recovery"):
             try:
-                phase_curves[phase] = fit_adhesion_curves(ident, speed_bands=bands,
-                                                          phase=phase, per_band=False).overall
+                phase_curves[phase] = fit_adhesion_curves(
+                    ident, speed_bands=bands, phase=phase, per_band=False, warn_untrusted=False,
+                ).overall  # fmt: skip
             except ValueError as exc:  # too few samples in that phase
                 phase_curves[phase] = str(exc)
         stats_rel.result()
-        law_rel = fit_adhesion_curves(ident, slip="relative", speed_bands=bands)
+        law_rel = fit_adhesion_curves(ident, slip="relative", speed_bands=bands,
+                                      warn_untrusted=False)  # fmt: skip
+        findings += [f"law (absolute slip) {w}" for w in law.warnings]
+        findings += [f"law (relative slip) {w}" for w in law_rel.warnings]
+        if findings:  # the law files carry every finding of the run in their provenance
+            for one in (law, law_rel):
+                one.provenance.update({"run_trusted": False, "run_warnings": list(findings)})
         lap("fitted curves (4 bands + all, both slips; loss, recovery)")
         surface = surface_abs.result()
         surface_relative = surface_rel.result()
@@ -209,15 +242,43 @@ def run_identification(
         lap("figures")
     step("summary")
     summary = _summary(ident, law, law_rel, phase_curves)
+    summary.update({"trusted": not findings, "warnings": list(findings)})
     if out is not None:
         paths["summary"] = out / "summary.json"
         paths["summary"].write_text(json.dumps(summary, indent=2), encoding="utf-8")
     lap("summary")
+    if findings:
+        warn(f"identification not trusted ({len(findings)} finding(s)): " + "; ".join(findings),
+             UntrustedResultWarning)  # fmt: skip
     return IdentificationRun(
         log=log, ident=ident, surface=surface, surface_relative=surface_relative, law=law,
         law_relative=law_rel, phase_curves=phase_curves, summary=summary, paths=paths,
-        timings=timings, threads=workers,
+        timings=timings, threads=workers, warnings=tuple(findings),
     )
+
+
+#: Factor between the identified brake coefficient and the vehicle's when the log's
+#: pressures are in another unit than bar (eq. 14 divides by the pressures).
+_PRESSURE_SLIPS = {"Pa": 1e-5, "kPa": 1e-2, "psi": 1.0 / 14.503774, "MPa": 10.0}
+
+
+def _brake_coefficient_check(ident, vehicle) -> list[str]:
+    """The identified c against the vehicle's (eq. 14 is c = brake torque / pressure): a
+    factor of 1e-5 means pressures in Pa under the bar column names, 1e-2 kPa, 0.069 psi.
+    Returns the finding (a :class:`~railadhesion.plausibility.UnitWarning` issued) or []."""
+    c_vehicle = float(getattr(vehicle, "brake_coefficient", math.nan))
+    c = float(ident.brake.mean)
+    if not (c_vehicle > 0 and math.isfinite(c)):
+        return []
+    ok, unit = sniff_ratio(c / c_vehicle, "brake coefficient", _PRESSURE_SLIPS)
+    if ok:
+        return []
+    text = (f"brake coefficient: the identified c = {c:.3g} N m/Pa is {c / c_vehicle:.3g} x the "
+            f"vehicle's {c_vehicle:.3g} N m/Pa")  # fmt: skip
+    if unit is not None:
+        return [warn(text + f": brake_pressure_i in {unit}? (the braking-log format records "
+                     "bar)", UnitWarning)]  # fmt: skip
+    return [warn(text + ": check the pressures' unit and the vehicle file", PlausibilityWarning)]
 
 
 class _Done:

@@ -33,6 +33,18 @@ c22, c23, packed) -> (fx, fy)``
     1-d float64 array of :func:`pack_wilac` (``pack_wilac(params)``, once per parameter set);
     c11 as above.
 
+``fletcher_scalar(creep, slope, inverse_mu) -> (adhesion, d_creep, d_slope, d_inverse_mu)``
+    Fletcher's (2013) 2D curve with k_s = 1 (eqs. (8)-(12) in closed form, the law of
+    :func:`railadhesion.models.twod.fletcher`) as the adhesion coefficient of a creep
+    magnitude, parametrised by its initial slope and the inverse of its saturation level
+    (``inverse_mu = 0``: the straight line of the limit mu -> inf), with its partial
+    derivatives (used by the on-board monitor's estimator).
+
+``polach_curve_scalar(creep, slope, inverse_mu, ratio) -> (adhesion, d_creep, d_slope)``
+    Polach's (2005) curve for pure longitudinal creepage and constant friction (A = 1, the
+    law of :func:`railadhesion.models.polach.polach_forces`) parametrised the same way, with
+    ``ratio = k_S / k_A``.
+
 ``polach_checked(...)``, same arguments as ``polach_scalar`` -> (fx, fy, bad)
     With validation: ``bad`` is -1, or the position (0-16) of the first argument out of the
     range of :func:`~railadhesion.models.polach.polach_forces` (forces then NaN).
@@ -67,6 +79,8 @@ from __future__ import annotations
 from railadhesion.contact import kalker as _kalker
 from railadhesion.models import polach as _polach
 from railadhesion.models import wilac as _wilac
+from railadhesion.models.polach import polach_curve
+from railadhesion.models.twod import fletcher_curve
 from railadhesion.models.wilac_parameters import (
     PACKED_HEADER,
     pack_wilac,
@@ -78,8 +92,10 @@ from railadhesion.numerics import jit
 
 __all__ = [
     "HEADER_SIZE",
+    "fletcher_scalar",
     "kalker_scalar",
     "pack_wilac",
+    "polach_curve_scalar",
     "polach_checked",
     "polach_scalar",
     "wilac_checked",
@@ -101,6 +117,10 @@ polach_checked = _polach.polach_checked.dispatcher
 wilac_scalar = _wilac.wilac_scalar.dispatcher
 #: :func:`wilac_scalar` with validation: ``(fx, fy, ok)``
 wilac_checked = _wilac.wilac_checked.dispatcher
+#: ``fletcher_scalar(creep, slope, inverse_mu) -> (adhesion, d_creep, d_slope, d_inverse_mu)``
+fletcher_scalar = jit(fletcher_curve)
+#: ``polach_curve_scalar(creep, slope, inverse_mu, ratio) -> (adhesion, d_creep, d_slope)``
+polach_curve_scalar = jit(polach_curve)
 
 
 # The two functions below serve the braking kernels (railadhesion.braking._kernels) until they

@@ -65,11 +65,13 @@ from railadhesion.numerics import (
     output_chunk,
     run_chunks,
 )
+from railadhesion.plausibility import input_checker
 
 __all__ = [
     "Polach",
     "PolachContact",
     "polach_contact_terms",
+    "polach_curve",
     "polach_force",
     "polach_forces",
     "polach_law",
@@ -147,6 +149,35 @@ def polach_law(creep_x, creep_y, spin, normal_force, speed, a, b, G, nu, c11, c2
     t = polach_contact_terms(creep_x, creep_y, spin, a, b, G, c11, c22, c23)
     return polach_force(creep_x, creep_y, normal_force, speed, t[0], t[1], t[2], t[3], t[4],
                         t[5], t[6], k_A, k_S, mu0, A, B)  # fmt: skip
+
+
+@jitable
+def polach_curve(creep, slope, inverse_mu, ratio):
+    """Polach's (2005) adhesion-creep curve without falling friction, and two derivatives.
+
+    ``creep`` >= 0 the creep magnitude [-], ``slope`` > 0 the initial slope d(F/Q)/d creep,
+    ``inverse_mu`` >= 0 the inverse of the friction coefficient mu (the curve's asymptote; 0
+    gives the straight line), ``ratio`` = k_S / k_A > 0. Returns ``(F/Q, d/d creep,
+    d/d slope)``.
+
+    Polach (Wear 258 (2005) 992-1000; ``docs`` MODELS §3) for pure longitudinal creepage,
+    A = 1 (no falling friction): ``F/Q = (2 mu/pi) (k_A eps/(1 + (k_A eps)**2) +
+    arctan(k_S eps))`` with ``eps = K creep / mu`` (K = (pi/4) G a b C11 / Q), whose initial
+    slope is ``slope = (2/pi)(k_A + k_S) K``. With ``x = k_A eps = pi slope creep q /
+    (2 (1 + ratio))``: ``F/Q = (2/pi) z (1/(1 + x**2) + ratio atan(ratio x)/(ratio x))``,
+    ``z = x / q``, finite at q = 0 (the line ``slope * creep``); d/d creep =
+    ``slope F'(x)/(1 + ratio)`` and d/d slope = ``creep F'(x)/(1 + ratio)`` with
+    ``F'(x) = (1 - x**2)/(1 + x**2)**2 + ratio/(1 + (ratio x)**2)``. Written for the on-board
+    monitor's estimator; compiled: :func:`railadhesion.models.kernels.polach_curve_scalar`.
+    """
+    z = math.pi * slope * creep / (2.0 * (1.0 + ratio))
+    x = z * inverse_mu
+    y = ratio * x
+    g = math.atan(y) / y if y > 1e-6 else 1.0 - y * y / 3.0
+    xx = x * x
+    f = 2.0 / math.pi * z * (1.0 / (1.0 + xx) + ratio * g)
+    fp = (1.0 - xx) / ((1.0 + xx) * (1.0 + xx)) + ratio / (1.0 + y * y)
+    return f, slope * fp / (1.0 + ratio), creep * fp / (1.0 + ratio)
 
 
 # --- compiled entry points (numba, built on first use) ---------------------------------------
@@ -509,7 +540,9 @@ def polach_forces(
     )  # fmt: skip
     scalars = as_scalars(args)
     if scalars is None:
-        return _polach_array(*args)
+        out = _polach_array(*args)
+        _PLAUSIBLE(args)  # implausible inputs warn (docs/checks.md); errors were raised above
+        return out
     sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu = scalars
     fx, fy, bad = polach_checked.dispatcher(
         sx, sy, psi, q, v, a, b, g, nu, 0.0, 0.0, 0.0, k_a, k_s, mu0, big_a, big_b
@@ -517,6 +550,7 @@ def polach_forces(
     if bad >= 0:
         check_polach_inputs(*scalars)  # raises the error naming the argument
         raise AssertionError("polach kernel flagged an input the checks accept")
+    _PLAUSIBLE(scalars)  # implausible inputs warn (docs/checks.md)
     return np.float64(fx), np.float64(fy)
 
 
@@ -528,6 +562,8 @@ _ARG_NAMES = (
     "creep_long", "creep_lat", "spin", "normal_force", "speed", "a", "b",
     "mu0", "k_A", "k_S", "A", "B", "shear_modulus", "poisson",
 )  # fmt: skip
+#: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
+_PLAUSIBLE = input_checker(_ARG_NAMES)
 
 
 def _polach_array(*args):
@@ -697,6 +733,7 @@ class PolachContact:
         if scalars is None:
             raise ValueError("PolachContact holds one contact: every argument must be a scalar")
         check_polach_inputs(*scalars)  # validates every argument, errors name it
+        _PLAUSIBLE(scalars)  # implausible inputs warn (docs/checks.md), once per contact
         (_, _, _, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu) = (float(x) for x in scalars)
         self.normal_force, self.speed, self.a, self.b = q, v, a, b
         self.mu0, self.k_A, self.k_S, self.A, self.B = mu0, k_a, k_s, big_a, big_b

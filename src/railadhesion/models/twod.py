@@ -53,11 +53,13 @@ from railadhesion._validate import (
     check_positive,
 )
 from railadhesion.numerics import flatten, jitable, kernel
+from railadhesion.plausibility import input_checker
 
 __all__ = [
     "TwoDTraction",
     "carter",
     "carter_law",
+    "fletcher_curve",
     "fletcher_law",
     "elastic_foundation",
     "fletcher",
@@ -144,6 +146,31 @@ def fletcher_law(creep, normal_load, half_width, radius, mu, k_a, k_s):
     return stick + slip, stick, slip, c  # eq. (12)
 
 
+@jitable
+def fletcher_curve(creep, slope, inverse_mu):
+    """Fletcher's (2013) 2D creep curve with k_s = 1 and its partial derivatives.
+
+    ``creep`` >= 0 is the creep magnitude xi [-], ``slope`` > 0 the initial slope
+    d(Q/P)/d xi = 2 k_a R / a [-], ``inverse_mu`` >= 0 the inverse 1/mu of the friction
+    coefficient (the saturation level of the curve); 0 gives the limit mu -> inf, the straight
+    line ``slope * creep``. Returns ``(Q/P, d/d creep, d/d slope, d/d inverse_mu)``.
+
+    Fletcher's eqs. (8)-(12) (Proc. IMechE Part J 227(6) (2013) 529-537) reduce to
+    ``Q/P = mu (1 - (c/a)**3)`` with ``c/a = max(1 - x/mu, 0)`` and ``x = 2 k_a xi R/(3 a)
+    = slope * xi / 3`` (:func:`railadhesion.models.twod.fletcher`, its Notes). Written with
+    u = 1 - x q (q = 1/mu): ``Q/P = x (3 - 3 x q + x**2 q**2)`` while u > 0 (finite at q = 0),
+    ``1/q`` at and beyond full slip (u <= 0); d/d xi = slope u**2, d/d slope = xi u**2,
+    d/d q = -x**2 (3 - 2 x q) before full slip, 0, 0, -1/q**2 beyond.
+    """
+    x = slope * creep / 3.0
+    u = 1.0 - x * inverse_mu
+    if u > 0.0:
+        uu = u * u
+        return (x * (3.0 - 3.0 * x * inverse_mu + x * x * inverse_mu * inverse_mu),
+                slope * uu, creep * uu, -x * x * (3.0 - 2.0 * x * inverse_mu))
+    return 1.0 / inverse_mu, 0.0, 0.0, -1.0 / (inverse_mu * inverse_mu)
+
+
 @kernel(nogil=True)
 def _twod_into(fletcher, xi, load, a, r, m, ka, ks, out):
     """:func:`fletcher_law` (``fletcher``) or :func:`carter_law` of arrays of length n or 1
@@ -174,7 +201,12 @@ def _evaluate(fletcher, creep, normal_load, half_width, radius, mu, k_a, k_s) ->
     shape, n, flat = flatten(inputs)
     out = np.empty((4, n))
     _twod_into(fletcher, *flat, out)
+    _PLAUSIBLE((inputs[0], inputs[2], inputs[3]))  # implausible inputs warn (docs/checks.md)
     return TwoDTraction(*(x.reshape(shape)[()] for x in out))
+
+
+#: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
+_PLAUSIBLE = input_checker(("creep", "half_width", "radius"))
 
 
 @labelled(units=TWOD_UNITS)
@@ -470,6 +502,7 @@ class FletcherCondition:
             creep, self.normal_load, self.half_width, self.radius, self.mu, self.k_a, self.k_s
         )
 
+    @labelled(units="1")
     def adhesion(self, creep):
         """Adhesion coefficient |Q|/P [-] of Fletcher's fitted model at creep xi [-] (fraction).
 
@@ -481,6 +514,7 @@ class FletcherCondition:
         res = self.traction(creep)
         return np.abs(res.traction) / self.normal_load
 
+    @labelled(units="1")
     def elastic_foundation_adhesion(self, creep):
         """Adhesion coefficient |Q|/P [-] of the unmodified model (k_a = k_s = 1), Fig. 4/5's
         "original model", at creep xi [-]."""

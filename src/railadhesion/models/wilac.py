@@ -90,6 +90,7 @@ from railadhesion.numerics import (
     output_chunk,
     run_chunks,
 )
+from railadhesion.plausibility import check_calibrated, input_checker
 
 __all__ = [
     *_parameters.__all__,
@@ -398,6 +399,7 @@ def wilac_forces(
         if not ok:
             check_wilac_inputs(*scalars)
             raise AssertionError("WILAC kernel flagged an input the checks accept")
+        _check_plausible(scalars, params)  # implausible inputs, clamped Q, v warn
         return np.float64(fx), np.float64(fy)
     arrays = [as_float_array(x, name) for x, name in zip(args, _WILAC_ARGS, strict=True)]
     shape, n, flat = flatten(arrays)
@@ -409,6 +411,7 @@ def wilac_forces(
     if sum(nbad):
         check_wilac_inputs(*arrays)
         raise AssertionError("WILAC kernel flagged an input the checks accept")
+    _check_plausible(arrays, params)  # implausible inputs, clamped Q, v warn (docs/checks.md)
     if not shape:
         return np.float64(fx[0]), np.float64(fy[0])
     return fx.reshape(shape), fy.reshape(shape)
@@ -418,6 +421,21 @@ _WILAC_ARGS = (
     "creep_long", "creep_lat", "spin", "normal_force", "speed", "a", "b", "water_flow",
     "shear_modulus", "poisson",
 )  # fmt: skip
+_PLAUSIBLE = input_checker(_WILAC_ARGS)
+
+
+def _check_plausible(values, params: WilacParameters) -> None:
+    """Warn for implausible inputs (:func:`railadhesion.plausibility.input_checker`) and for a
+    normal force or speed outside the set's calibrated ranges, where the parameters are held
+    at the boundary values (:func:`railadhesion.plausibility.check_calibrated`)."""
+    _PLAUSIBLE(values)
+    q, v = values[3], values[4]
+    (qlo, qhi), (vlo, vhi) = params.normal_force_range, params.speed_range
+    if type(q) is float and type(v) is float and qlo <= q <= qhi and vlo <= v <= vhi:
+        return
+    what = f"the WILAC set {params.name or '(unnamed)'!r}"
+    check_calibrated(q, "normal_force", qlo, qhi, unit="N", what=what)
+    check_calibrated(v, "speed", vlo, vhi, unit="m/s", what=what)
 
 
 def check_wilac_inputs(sx, sy, psi, q, v, a, b, w, g, nu):
@@ -475,8 +493,10 @@ class Wilac:
             shear_modulus=self.shear_modulus, poisson=self.poisson,
         )
 
+    @labelled(units="1")
     def adhesion(self, creep_long, creep_lat, spin, normal_force, speed, a, b, water_flow):
-        """Adhesion coefficient |T|/Q [-] of :func:`wilac_forces`."""
+        """Adhesion coefficient |T|/Q [-] of :func:`wilac_forces` (pandas and xarray inputs
+        give results labelled with units "1")."""
         fx, fy = self.forces(creep_long, creep_lat, spin, normal_force, speed, a, b, water_flow)
         return np.hypot(fx, fy) / np.asarray(normal_force, dtype=float)
 

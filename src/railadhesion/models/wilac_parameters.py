@@ -27,6 +27,7 @@ from railadhesion._validate import check_choice, check_nonnegative, check_positi
 from railadhesion.models.parameters import PARAMETER_RANGES
 from railadhesion.models.regression import ParameterRegression
 from railadhesion.numerics import exp, flatten, jitable, kernel, read_only
+from railadhesion.plausibility import check_calibrated
 
 __all__ = [
     "WILAC_CONDITIONS",
@@ -539,12 +540,26 @@ class WilacParameters:
         >>> cond = WilacCondition(k_A=1.0, k_S=0.4, mu0=0.55, A=0.4, B=0.6)
         >>> p = WilacParameters({c: cond for c in WILAC_CONDITIONS}, 1e5, 40.0,
         ...                     (4e3, 1e5), (1.0, 40.0))
-        >>> round(float(p.polach_parameters("wet", 5e4, 0.0)["mu0"]), 4)
+        >>> round(float(p.polach_parameters("wet", 5e4, 20.0)["mu0"]), 4)
         0.55
+
+        Below the calibrated speed range (a train near standstill) the parameters are those
+        of the lowest calibrated speed, with an
+        :class:`~railadhesion.plausibility.AlteredResultWarning` saying so:
+
+        >>> import warnings
+        >>> with warnings.catch_warnings(record=True) as caught:
+        ...     warnings.simplefilter("always")
+        ...     mu0 = p.polach_parameters("wet", 5e4, 0.0)["mu0"]
+        >>> type(caught[0].message).__name__, round(float(mu0), 4)
+        ('AlteredResultWarning', 0.55)
         """
         check_choice(condition, "condition", WILAC_CONDITIONS)
         q = check_positive(normal_force, "normal_force")
         v = check_nonnegative(speed, "speed")
+        what = f"the WILAC set {self.name or '(unnamed)'!r}"
+        check_calibrated(q, "normal_force", *self.normal_force_range, unit="N", what=what)
+        check_calibrated(v, "speed", *self.speed_range, unit="m/s", what=what)
         shape, n, (qf, vf) = flatten([q, v])
         out = np.empty((5, n))
         _parameters_into(qf, vf, pack_wilac(self), WILAC_CONDITIONS.index(condition), out)

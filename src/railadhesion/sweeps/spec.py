@@ -24,11 +24,17 @@ Format (``format = "railadhesion-sweep"``, ``format_version = 1``)::
 
 Every field is validated; errors name the file and the field
 (``map.toml: grid.speed.num: expected an integer >= 1, got 'ten'``). Unknown fields are
-errors. Relative parameter-file paths are taken relative to the spec file.
+errors. Relative parameter-file paths are taken relative to the spec file. Careless values
+give a warning naming the file and the field (``docs/checks.md``): a creepage above 1 (given
+in percent?), a speed above 100 m/s (km/h?), a normal force outside 500 N to 500 kN (kN?), a
+water flow above 1000 µl/s; so do loads and speeds outside a WILAC set's calibrated ranges,
+where it holds its parameters. They are kept in :attr:`SweepSpec.warnings` and in the map's
+``attrs["warnings"]``.
 """
 
 from __future__ import annotations
 
+import json
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -68,6 +74,8 @@ class SweepSpec:
     chunk_points: int = DEFAULT_CHUNK_POINTS
     title: str = ""
     source: str = ""
+    #: Careless values found when loading (each also issued as a warning).
+    warnings: tuple = ()
 
     def plan(self) -> SweepPlan:
         return plan_sweep(self.model, self.grid, fixed=self.fixed, chunks=self.chunks,
@@ -80,6 +88,8 @@ class SweepSpec:
         attrs = {"spec_file": self.source}
         if self.title:
             attrs["title"] = self.title
+        if self.warnings:  # the map records what its spec was warned for
+            attrs["warnings"] = json.dumps(list(self.warnings))
         return run_sweep(self.plan(), out=out, attrs=attrs, **kwargs)
 
 
@@ -243,7 +253,42 @@ def parse_sweep_spec(doc: dict, *, base: Path = Path("."), source: str = "") -> 
         spec.plan()  # the plan's checks name grid.<dim>, fixed.<input>, chunks.<dim>
     except ValueError as exc:
         raise SpecError(str(exc)) from None
+    spec.warnings = _plausible_inputs(Path(source).name if source else "spec", model, grid,
+                                      fixed)  # fmt: skip
     return spec
+
+
+def _plausible_inputs(name: str, model, grid: dict, fixed: dict) -> tuple[str, ...]:
+    """Warnings for careless numeric inputs of a spec (module notes), naming the field; for a
+    WILAC map also the loads and speeds outside each parameter set's calibrated ranges, where
+    the model holds its parameters (an AlteredResultWarning)."""
+    from railadhesion.plausibility import ARGUMENT_QUANTITY, check_calibrated, check_plausible
+    from railadhesion.sweeps.models import WilacSweep
+
+    found = []
+    if isinstance(model, WilacSweep):
+        labels = grid.get("parameter_set", [fixed.get("parameter_set",
+                                                      model.labels["parameter_set"])])
+        for label in labels:
+            params = model.resolve("parameter_set", str(label))
+            what = f"the WILAC set {params.name or label!r}"
+            for key, (lo, hi), unit in (("normal_force", params.normal_force_range, "N"),
+                                        ("speed", params.speed_range, "m/s")):  # fmt: skip
+                where, values = (f"grid.{key}", grid[key]) if key in grid else (
+                    f"fixed.{key}", fixed.get(key))  # fmt: skip
+                if values is not None and not isinstance(values, dict):
+                    found.append(check_calibrated(np.asarray(values, dtype=float),
+                                                  f"{name}: {where}", lo, hi, unit=unit,
+                                                  what=what))  # fmt: skip
+    for where, values in [*((f"grid.{k}", v) for k, v in grid.items()),
+                          *((f"fixed.{k}", v) for k, v in fixed.items())]:  # fmt: skip
+        columns = values if isinstance(values, dict) else {where.split(".", 1)[1]: values}
+        for key, column in columns.items():
+            if key in ARGUMENT_QUANTITY and not isinstance(column, str):
+                label = where if not isinstance(values, dict) else f"{where}.{key}"
+                found.append(check_plausible(np.asarray(column, dtype=float), key,
+                                             where=f"{name}: {label}"))  # fmt: skip
+    return tuple(f for f in found if f)
 
 
 def load_sweep_spec(path) -> SweepSpec:

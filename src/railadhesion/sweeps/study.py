@@ -16,6 +16,13 @@ protection on, 0: off).
 Outputs per stop: stopping distance and time, the same stop on a dry rail (``water_flow = 0``)
 and the extension against it (m and %), the longest lock and the total locked time of any
 axle [s], the maximum creepage, and whether the train stopped before ``max_time``.
+
+A stop that cannot be trusted (the train did not stop within ``max_time``, a NaN distance, or
+a braking result flagged ``trusted = False``) is a failed point: its outputs are NaN and
+``error`` holds the reason, so that ``failed stops: N`` counts it (``docs/checks.md``).
+Spec files are checked for careless values (``load_study_spec``): a brake pressure below
+0.05 bar or above 20 bar (bar for Pa?), or above the cylinders' ``max_pressure``, an initial
+speed above 100 m/s (km/h?), a water flow above 1000 µl/s.
 """
 
 from __future__ import annotations
@@ -63,14 +70,15 @@ STUDY_OUTPUTS: dict[str, tuple[str, str]] = {
 
 
 @functools.lru_cache(maxsize=256)
-def _stop(vehicle, wsp_settings: tuple, dt: float, max_time: float, initial_speed: float,
-          water_flow: float, wet_length: float, payload: float, brake_pressure: float,
-          wsp: bool):  # fmt: skip
+def _stop(vehicle, wsp_settings: tuple, dt: float, max_time: float, max_pressure: float | None,
+          initial_speed: float, water_flow: float, wet_length: float, payload: float,
+          brake_pressure: float, wsp: bool):  # fmt: skip
     """One simulated stop (summary dict); memoised per process: the dry reference of a
     scenario is shared by all its flow rates. Pure: same arguments, same result."""
     from dataclasses import replace
 
     from railadhesion.braking import (
+        BrakeCylinders,
         WaterFlowProfile,
         WheelSlideProtection,
         WilacAdhesion,
@@ -84,15 +92,25 @@ def _stop(vehicle, wsp_settings: tuple, dt: float, max_time: float, initial_spee
     else:
         profile = WaterFlowProfile.sections([(0.0, wet_length, water_flow)], base=0.0)
     controller = WheelSlideProtection(WSPSettings(**dict(wsp_settings))) if wsp else None
+    cylinders = BrakeCylinders() if max_pressure is None else BrakeCylinders(
+        max_pressure=max_pressure)  # fmt: skip
     res = simulate(veh, WilacAdhesion(profile), initial_speed, brake_pressure, wsp=controller,
-                   dt=dt, max_time=max_time)  # fmt: skip
+                   dt=dt, max_time=max_time, cylinders=cylinders)  # fmt: skip
     s = res.summary
+    untrusted = [str(w) for w in getattr(res, "warnings", ())] if not getattr(
+        res, "trusted", True) else []  # fmt: skip
+    if not res.success:
+        untrusted.append(f"the train did not stop within max_time = {max_time:g} s "
+                         f"({res.message})")  # fmt: skip
+    if not math.isfinite(s["stopping_distance_m"]):
+        untrusted.append(f"the stopping distance is {s['stopping_distance_m']} (NaN results)")
     return {
         "stopping_distance": s["stopping_distance_m"],
         "stopping_time": s["stopping_time_s"],
         "longest_lock": s["longest_lock_s"],
         "max_slip": s["max_slip"],
         "stopped": float(res.success),
+        "untrusted": tuple(untrusted),
     }
 
 
@@ -110,12 +128,19 @@ class BrakingStudy(SweepModel):
         Simulation step [s].
     max_time : float, optional
         Longest simulated stop [s].
+    max_pressure : float or None, optional
+        Pressure limit of the brake cylinders [Pa]; default 6e5, as in the example scenarios,
+        so that the default emergency demand ``brake_pressure = 5.5e5`` is applied as asked
+        (``None``: the default of :class:`railadhesion.braking.BrakeCylinders`, 3.8 bar, which
+        would clip it). A ``brake_pressure`` above it is clipped by the cylinders, and
+        :func:`load_study_spec` warns.
     """
 
     vehicle: object = "coach_default"
     wsp_settings: dict = field(default_factory=dict)
     dt: float = 1e-3
     max_time: float = 600.0
+    max_pressure: float | None = 6e5
     name = "braking_study"
     pointwise = True
 
@@ -124,9 +149,18 @@ class BrakingStudy(SweepModel):
         object.__setattr__(self, "labels", {})
         object.__setattr__(self, "wsp_settings", dict(self.wsp_settings))
         self._vehicle()  # validates
-        from railadhesion.braking import WSPSettings
+        from railadhesion.braking import BrakeCylinders, WSPSettings
 
         WSPSettings(**self.wsp_settings)
+        if self.max_pressure is not None:
+            BrakeCylinders(max_pressure=self.max_pressure)  # validates
+
+    @property
+    def cylinder_max_pressure(self) -> float:
+        """The cylinders' pressure limit [Pa] the stops use."""
+        from railadhesion.braking import BrakeCylinders
+
+        return BrakeCylinders().max_pressure if self.max_pressure is None else self.max_pressure
 
     @property
     def input_attrs(self):
@@ -150,10 +184,13 @@ class BrakingStudy(SweepModel):
         if x["wsp"] not in (0.0, 1.0):
             raise ValueError(f"wsp must be 0 or 1, got {x['wsp']}")
         common = (self._vehicle(), tuple(sorted(self.wsp_settings.items())), self.dt,
-                  self.max_time, x["initial_speed"])  # fmt: skip
+                  self.max_time, self.max_pressure, x["initial_speed"])  # fmt: skip
         rest = (x["payload"], x["brake_pressure"], bool(x["wsp"]))
         wet = _stop(*common, x["water_flow"], x["wet_length"], *rest)
         dry = _stop(*common, 0.0, math.inf, *rest)
+        for label, stop in (("", wet), ("the dry reference stop: ", dry)):
+            if stop["untrusted"]:  # a failed point, its reason in the sweep's error record
+                raise ValueError(label + stop["untrusted"][0])
         d, d0 = wet["stopping_distance"], dry["stopping_distance"]
         out = {**wet, "dry_stopping_distance": d0, "extension": d - d0,
                "extension_percent": 100.0 * (d - d0) / d0}  # fmt: skip
@@ -168,7 +205,8 @@ class BrakingStudy(SweepModel):
         return {"model": "braking stops: railadhesion.braking.simulate with WILAC adhesion "
                          "(Trummer et al. 2017) and the default WILAC set",
                 "vehicle": fields_, "wsp_settings": self.wsp_settings, "dt": self.dt,
-                "max_time": self.max_time}  # fmt: skip
+                "max_time": self.max_time,
+                "max_pressure": self.cylinder_max_pressure}  # fmt: skip
 
 
 def plot_extension_distribution(ds, by: str = "water_flow", *, bins: int = 8, ax=None):
@@ -229,7 +267,8 @@ _DISTRIBUTIONS = {"uniform": 2, "normal": 2, "lognormal": 2, "choice": 1}
 
 @dataclass
 class StudySpec:
-    """A validated study spec (``railadhesion study SPEC.toml --out DIR``)."""
+    """A validated study spec (``railadhesion study SPEC.toml --out DIR``); ``warnings`` holds
+    the careless values found when loading it (each also issued as a warning)."""
 
     model: BrakingStudy
     grid: dict
@@ -237,6 +276,7 @@ class StudySpec:
     chunks: dict
     title: str = ""
     source: str = ""
+    warnings: tuple = ()
 
     def plan(self):
         from railadhesion.sweeps.plan import plan_sweep
@@ -245,14 +285,47 @@ class StudySpec:
                           chunk_points=4)  # fmt: skip
 
 
+def _plausible_study(name: str, model: BrakingStudy, grid: dict, fixed: dict) -> tuple:
+    """Warnings for careless values of a study spec (module notes), naming the field."""
+    from railadhesion.plausibility import AlteredResultWarning, check_plausible, warn
+
+    def values(key):  # (field, values) of a study input: swept, drawn, fixed or default
+        if key in grid:
+            return f"grid.{key}", np.asarray(grid[key], dtype=float)
+        for dim, columns in grid.items():
+            if isinstance(columns, dict) and key in columns:
+                return f"distributions.{key} (along {dim})", np.asarray(columns[key], float)
+        if key in fixed:
+            return f"fixed.{key}", np.asarray(fixed[key], dtype=float)
+        return f"{key} (default)", np.asarray(STUDY_INPUTS[key][2], dtype=float)
+
+    found = []
+    for key in ("initial_speed", "water_flow", "brake_pressure"):
+        where, x = values(key)
+        if x.size:
+            found.append(check_plausible(x, key, where=f"{name}: {where}"))
+    where, x = values("brake_pressure")
+    limit = model.cylinder_max_pressure
+    if x.size and float(np.max(x)) > limit:
+        given = "study.max_pressure" if model.max_pressure is not None else (
+            "the cylinders' default; set study.max_pressure")  # fmt: skip
+        found.append(warn(
+            f"{name}: {where} reaches {float(np.max(x)):g} Pa, above the brake cylinders' "
+            f"max_pressure = {limit:g} Pa ({given}): the cylinders will hold {limit:g} Pa, not "
+            "the demand (docs/checks.md)", AlteredResultWarning,
+        ))  # fmt: skip
+    return tuple(f for f in found if f)
+
+
 def load_study_spec(path) -> StudySpec:
     """Read and validate a study spec; errors name the file and the field.
 
     Format (``format = "railadhesion-study"``, ``format_version = 1``): ``[study]`` vehicle,
-    dt, max_time, wsp_settings; ``[design]`` kind = "factorial" or "monte_carlo" (with n and
-    seed); ``[grid]`` swept inputs (lists or ranges, as in sweep specs); ``[distributions]``
-    (Monte Carlo) input = ["uniform", low, high] | ["normal", mean, sd] |
-    ["lognormal", mean_of_log, sd_of_log] | ["choice", [values]]; ``[fixed]`` other inputs.
+    dt, max_time, max_pressure (the cylinders' limit [Pa]), wsp_settings; ``[design]`` kind =
+    "factorial" or "monte_carlo" (with n and seed); ``[grid]`` swept inputs (lists or ranges,
+    as in sweep specs); ``[distributions]`` (Monte Carlo) input = ["uniform", low, high] |
+    ["normal", mean, sd] | ["lognormal", mean_of_log, sd_of_log] | ["choice", [values]];
+    ``[fixed]`` other inputs.
     See ``examples/braking_study.toml``.
     """
     import tomllib
@@ -284,14 +357,14 @@ def load_study_spec(path) -> StudySpec:
         if doc["format_version"] != 1:
             fail_field("format_version", f"expected 1, got {doc['format_version']!r}")
         study = doc.get("study", {})
-        check_keys(study, "study", ("vehicle", "dt", "max_time", "wsp_settings"))
+        check_keys(study, "study", ("vehicle", "dt", "max_time", "max_pressure", "wsp_settings"))
         options = {}
         if "vehicle" in study:
             v = study["vehicle"]
             if not isinstance(v, str):
                 fail_field("study.vehicle", f"expected a vehicle name or file, got {v!r}")
             options["vehicle"] = str((path.parent / v).resolve()) if v.endswith(".toml") else v
-        for key in ("dt", "max_time"):
+        for key in ("dt", "max_time", "max_pressure"):
             if key in study:
                 options[key] = number_field(study[key], f"study.{key}")
                 if options[key] <= 0:
@@ -363,6 +436,7 @@ def load_study_spec(path) -> StudySpec:
             spec.plan()
         except ValueError as exc:
             raise SpecError(str(exc)) from None
+        spec.warnings = _plausible_study(path.name, model, grid, fixed)
         return spec
     except SpecError as exc:
         raise SpecError(f"{path.name}: {exc}") from None
@@ -379,6 +453,10 @@ def run_study(spec: StudySpec, out_dir, **kwargs):
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     attrs = {"spec_file": spec.source, "title": spec.title or "braking study"}
+    if spec.warnings:  # the study records what its spec was warned for
+        import json
+
+        attrs["warnings"] = json.dumps(list(spec.warnings))
     result = run_sweep(spec.plan(), out=out_dir / "study.zarr", attrs=attrs, **kwargs)
     ds = result.dataset.load()
     ds.to_dataframe().reset_index().to_csv(out_dir / "study.csv", index=False)
