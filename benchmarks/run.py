@@ -11,9 +11,9 @@ their ratio:
 * "plain NumPy": a straightforward NumPy Polach (Polach 2005, section 2) with Kalker's
   coefficients computed once (constant a/b) or per contact (varying a/b), the alternative a
   user would write;
-* "NumPy reference": the package's own readable NumPy implementation that the compiled
-  kernels are tested against (``_polach_reference``, ``_wilac_reference``, the NumPy FASTSIM
-  march, the Python scalar path).
+* "NumPy reference": the readable NumPy implementations that the compiled laws are tested
+  against, the independent oracles of ``tests/oracles`` (Polach, WILAC, the FASTSIM march,
+  Polach for one contact with the ``math`` module).
 
 Timings are medians of several repeats (wall clock); the machine may be shared, so compare
 ratios within one run rather than absolute figures across runs. Memory: the peak of the
@@ -101,13 +101,14 @@ def plain_numpy_polach(sx, sy, psi, q, v, a, b, c11, c22, c23, mu0, k_a, k_s, bi
 
 def plain_with_kalker(contact, coef, pars):
     """:func:`plain_numpy_polach` with Kalker's coefficients given (``coef``) or, if ``None``,
-    looked up per contact (varying a/b)."""
-    from railadhesion.contact.kalker import kalker_coefficients
+    looked up per contact (varying a/b) with NumPy (the test oracle: the package's own lookup
+    is compiled now, and a baseline must not use it)."""
+    from oracles.kalker import kalker_coefficients  # NumPy, as a user's code would be
 
     sx, sy, psi, q, v, a, b = contact
     if coef is None:
         coef = kalker_coefficients(a / b, 0.28)
-    return plain_numpy_polach(sx, sy, psi, q, v, a, b, coef.c11, coef.c22, coef.c23, *pars)
+    return plain_numpy_polach(sx, sy, psi, q, v, a, b, coef[0], coef[1], coef[2], *pars)
 
 
 class Table:
@@ -180,20 +181,20 @@ def main(argv=None) -> None:
     run = Run(command="benchmarks/run.py " + " ".join(argv if argv is not None else
                                                       sys.argv[1:]))
     sys.path.insert(0, str(SRC))
+    sys.path.insert(0, str(HERE.parent / "tests"))  # the NumPy oracles
 
     import numba
 
+    from oracles.fastsim import fastsim as fastsim_oracle
+    from oracles.polach import polach_forces as _polach_reference
+    from oracles.polach import polach_scalar as _polach_scalar
+    from oracles.wilac import wilac_forces as _wilac_reference
     from railadhesion.contact.fastsim import fastsim
     from railadhesion.contact.kalker import kalker_coefficients
     from railadhesion.models import kernels
     from railadhesion.models.parameters import polach_parameters
-    from railadhesion.models.polach import (
-        PolachContact,
-        _polach_reference,
-        _polach_scalar,
-        polach_forces,
-    )
-    from railadhesion.models.wilac import _wilac_reference, default_wilac_parameters, wilac_forces
+    from railadhesion.models.polach import PolachContact, polach_forces
+    from railadhesion.models.wilac import default_wilac_parameters, wilac_forces
 
     print(f"railadhesion kernel benchmarks on {platform.processor() or platform.machine()}, "
           f"{os.cpu_count()} CPUs, Python {platform.python_version()}, NumPy {np.__version__}, "
@@ -296,14 +297,12 @@ def main(argv=None) -> None:
 
     params = default_wilac_parameters()
     packed = kernels.pack_wilac(params)
-    from railadhesion.models.wilac import _wilac_scalar
-
-    t_ref = scalar_latency(lambda: _wilac_scalar(0.01, 0.0, 0.1, 100e3, 20.0, 6e-3, 5e-3, 25.0,
-                                                 params, 8.2e10, 0.28), 5000)  # fmt: skip
+    t_ref = scalar_latency(lambda: _wilac_reference(0.01, 0.0, 0.1, 100e3, 20.0, 6e-3, 5e-3,
+                                                    25.0, params), 2000)  # fmt: skip
     t = scalar_latency(lambda: wilac_forces(0.01, 0.0, 0.1, 100e3, 20.0, 6e-3, 5e-3, 25.0,
                                             params), 5000)  # fmt: skip
     table.add("WILAC, one call, wilac_forces, w = 25 µl/s", micro(t),
-              f"Python reference {micro(t_ref)}", f"{t_ref / t:.1f}x")  # fmt: skip
+              f"NumPy reference {micro(t_ref)}", f"{t_ref / t:.1f}x")  # fmt: skip
     t = scalar_latency(lambda: kernels.wilac_scalar(0.01, 0.0, 0.1, 100e3, 20.0, 6e-3, 5e-3,
                                                     25.0, 8.2e10, 0.28, c11, c22, c23, packed))
     table.add("WILAC, one call of kernels.wilac_scalar from Python", micro(t),
@@ -314,16 +313,17 @@ def main(argv=None) -> None:
     fs = (xi[:m] * 0.01, eta[:m] * 0.3, phi[:m], q[:m], a_v[:m], b_v[:m], 0.3)
     for grid in (20, 40):
         t = median_time(lambda grid=grid: fastsim(*fs, nx=grid, ny=grid), 3)
-        t_ref = median_time(lambda grid=grid: fastsim(*fs, nx=grid, ny=grid,
-                                                      return_tractions=True), 3)  # fmt: skip
+        t_ref = median_time(lambda grid=grid: fastsim_oracle(*fs, nx=grid, ny=grid,
+                                                             return_tractions=True), 3)  # fmt: skip
         table.add(f"FASTSIM {grid}x{grid}, batched ({m} contacts), per contact", micro(t / m),
                   f"NumPy march {micro(t_ref / m)}", f"{t_ref / t:.1f}x",
                   f"{threads} threads; the NumPy march also stores the tractions")  # fmt: skip
         t = scalar_latency(lambda grid=grid: fastsim(0.001, 0.0, 0.0, 80e3, 6e-3, 5e-3, 0.3,
                                                      nx=grid, ny=grid), 2000)  # fmt: skip
-        t_ref = scalar_latency(lambda grid=grid: fastsim(0.001, 0.0, 0.0, 80e3, 6e-3, 5e-3, 0.3,
-                                                         nx=grid, ny=grid,
-                                                         return_tractions=True), 200)  # fmt: skip
+        t_ref = scalar_latency(lambda grid=grid: fastsim_oracle(0.001, 0.0, 0.0, 80e3, 6e-3, 5e-3,
+                                                                0.3, nx=grid, ny=grid,
+                                                                return_tractions=True),
+                               200)  # fmt: skip
         table.add(f"FASTSIM {grid}x{grid}, one contact", micro(t), f"NumPy march {micro(t_ref)}",
                   f"{t_ref / t:.1f}x")  # fmt: skip
     from railadhesion.contact.hertz import hertz_3d

@@ -6,9 +6,14 @@ never depends on luck. Run `CI=true python3 -m pytest` to reproduce CI exactly.
 """
 
 import os
+import sys
+from pathlib import Path
 
 from hypothesis import settings
 
 settings.register_profile("ci", derandomize=True, database=None, print_blob=True)
 if os.environ.get("CI"):
     settings.load_profile("ci")
+
+# the independent oracles of the compiled laws (tests/oracles) import as ``oracles``
+sys.path.insert(0, str(Path(__file__).parent))

@@ -148,22 +148,21 @@ def test_adhesion_available_tracking_matches_a_full_search():
 
 def test_wilac_parameters_equal_the_library_regressions():
     from railadhesion.braking._kernels import wilac_table
-    from railadhesion.models.kernels import _condition_parameters, _factors, pack_wilac
-    from railadhesion.models.wilac import default_wilac_parameters
+    from railadhesion.models.kernels import pack_wilac
+    from railadhesion.models.wilac import WILAC_CONDITIONS, default_wilac_parameters
 
-    packed = pack_wilac(default_wilac_parameters())
+    wilac = default_wilac_parameters()
+    packed = pack_wilac(wilac)
     program = L.wilac_program(packed)
     loads = np.array([36e3, 36e3, 21e3, 52e3])  # a bogie pair (reused), then distinct
     water = np.array([0.0, 12.0, 25.0, 60.0])
     weights, params = np.empty((4, 4)), np.empty((4, 4, 5))
     wilac_table(packed, program, loads, 31.0, water, weights, params, np.empty(7),
                 np.empty(int(program[0])))
-    fac, ref = np.empty(7), np.empty(20)
     for a in range(4):
-        _factors(loads[a], 31.0, packed, fac)
-        for i in range(4):
-            _condition_parameters(packed, i, fac, ref)
-        np.testing.assert_allclose(params[a].ravel(), ref, rtol=1e-13, atol=1e-15)
+        ref = [list(wilac.polach_parameters(c, loads[a], 31.0).values()) for c in WILAC_CONDITIONS]
+        np.testing.assert_allclose(params[a], np.ravel(ref).reshape(4, 5), rtol=1e-13,
+                                   atol=1e-15)  # fmt: skip
 
 
 def test_new_parameters_before_the_first_step_rebuild_the_simulator():

@@ -1,18 +1,25 @@
-"""The compiled FASTSIM marches against the NumPy reference march.
+"""The compiled FASTSIM marches against the independent NumPy oracle (``tests/oracles``).
 
-``return_tractions=True`` runs the NumPy march (the readable reference); otherwise the compiled
-one runs (batched, or the one-contact path for scalar input on the strips). They must agree to
-about 1e-12 relative (forces near zero: to 1e-12 of mu Fz).
+Every path of :func:`fastsim` runs the compiled laws (batched, serial or on several threads;
+the one-contact path for scalar input on the strips; the tractions with
+``return_tractions=True``). They must agree with the oracle's march to about 1e-12 relative
+(forces near zero: to 1e-12 of mu Fz), the tractions and slip flags included.
 """
 
 from __future__ import annotations
+
+import importlib
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from oracles.fastsim import fastsim as fastsim_oracle
 from railadhesion.contact.fastsim import fastsim
+
+# the module (the package's attribute ``fastsim`` is the function)
+fastsim_module = importlib.import_module("railadhesion.contact.fastsim")
 
 #: The compiled kernels against their references over the whole input domain, implausible
 #: inputs included: the policy's warnings (docs/checks.md) are what tests/test_plausibility.py
@@ -25,7 +32,14 @@ pytestmark = pytest.mark.filterwarnings(
 FIELDS = ("fx", "fy", "mz", "slip_fraction")
 
 
-def _agree(ours, ref, mu_fz, a):
+def _agree(ours, ref, mu_fz, a, tractions=False):
+    if tractions:
+        np.testing.assert_array_equal(ours.slip, ref.slip)
+        for name in ("x", "y", "px", "py"):
+            x, r = getattr(ours, name), getattr(ref, name)
+            assert x.shape == r.shape
+            scale = np.max(np.abs(r)) if name in ("x", "y") else mu_fz / (np.pi * a * a)
+            np.testing.assert_allclose(x, r, rtol=1e-12, atol=1e-11 * scale, err_msg=name)
     for name in FIELDS:
         x, r = np.asarray(getattr(ours, name)), np.asarray(getattr(ref, name))
         assert x.shape == r.shape
@@ -37,9 +51,7 @@ def _agree(ours, ref, mu_fz, a):
 @pytest.mark.parametrize("flexibility", ["original", "blended"])
 @pytest.mark.parametrize("bound", ["parabolic", "elliptic"])
 def test_batched_kernel_equals_numpy_march(grid, flexibility, bound, monkeypatch):
-    from railadhesion.contact import _fastsim_kernels
-
-    monkeypatch.setattr(_fastsim_kernels, "_PARALLEL_MIN", 50)  # run the parallel kernel too
+    monkeypatch.setattr(fastsim_module, "FASTSIM_PARALLEL_MIN", 50)  # several threads too
     rng = np.random.default_rng(11)
     n = 80
     xi = rng.uniform(-3e-3, 3e-3, n)
@@ -47,9 +59,11 @@ def test_batched_kernel_equals_numpy_march(grid, flexibility, bound, monkeypatch
     args = (xi, rng.uniform(-3e-3, 3e-3, n), rng.uniform(-2, 2, n), rng.uniform(0, 1e5, n),
             rng.uniform(2e-3, 9e-3, n), rng.uniform(2e-3, 9e-3, n), 0.3)  # fmt: skip
     kw = dict(grid=grid, flexibility=flexibility, bound=bound, nx=17, ny=13)
-    _agree(fastsim(*args, **kw), fastsim(*args, **kw, return_tractions=True), 0.3 * 1e5, 9e-3)
-    few = tuple(x[:5] if np.ndim(x) else x for x in args)  # the serial kernel
-    _agree(fastsim(*few, **kw), fastsim(*few, **kw, return_tractions=True), 0.3 * 1e5, 9e-3)
+    _agree(fastsim(*args, **kw), fastsim_oracle(*args, **kw), 0.3 * 1e5, 9e-3)
+    _agree(fastsim(*args, **kw, return_tractions=True),
+           fastsim_oracle(*args, **kw, return_tractions=True), 0.3 * 1e5, 9e-3, True)
+    few = tuple(x[:5] if np.ndim(x) else x for x in args)  # one thread
+    _agree(fastsim(*few, **kw), fastsim_oracle(*few, **kw), 0.3 * 1e5, 9e-3)
 
 
 @given(
@@ -67,9 +81,11 @@ def test_one_contact_path_equals_numpy_march(xi, eta, phi, fz, ratio, flexibilit
     a = 6e-3
     kw = dict(flexibility=flexibility, bound=bound, nx=nx, ny=ny)
     ours = fastsim(xi, eta, phi, fz, a, a / ratio, 0.3, **kw)
-    ref = fastsim(xi, eta, phi, fz, a, a / ratio, 0.3, **kw, return_tractions=True)
+    ref = fastsim_oracle(xi, eta, phi, fz, a, a / ratio, 0.3, **kw, return_tractions=True)
     assert isinstance(ours.fx, np.float64)
     _agree(ours, ref, 0.3 * max(fz, 1.0), a)
+    full = fastsim(xi, eta, phi, fz, a, a / ratio, 0.3, **kw, return_tractions=True)
+    _agree(full, ref, 0.3 * max(fz, 1.0), a, True)
 
 
 def test_one_contact_path_raises_like_the_array_path():

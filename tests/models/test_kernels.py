@@ -1,9 +1,8 @@
-"""The compiled kernels (railadhesion.models.kernels) against the NumPy reference.
+"""The compiled laws (Polach, WILAC, Kalker) and their drivers against the NumPy oracles.
 
-The NumPy implementations (``_polach_reference``, ``_wilac_reference``,
-``kalker_coefficients``) are the readable reference; the kernels must give the same numbers to
-about 1e-12 relative everywhere, edge cases included (zero creep, pure spin, huge creep, the
-spin cap, subnormal loads).
+The independent NumPy oracles (``tests/oracles``) are the readable implementations; the
+compiled code must give the same numbers to about 1e-12 relative everywhere, edge cases
+included (zero creep, pure spin, huge creep, the spin cap, subnormal loads).
 """
 
 from __future__ import annotations
@@ -17,17 +16,22 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from railadhesion.contact.kalker import kalker_coefficients
-from railadhesion.models import kernels
-from railadhesion.models.polach import _polach_reference, _polach_scalar, polach_forces
+from oracles.kalker import kalker_coefficients as kalker_oracle
+from oracles.polach import polach_forces as _polach_reference
+from oracles.polach import polach_scalar as _polach_scalar
+from oracles.wilac import wilac_forces as _wilac_reference
+from railadhesion.contact import kalker
+from railadhesion.contact.kalker import kalker_coefficients, kalker_law
+from railadhesion.models import kernels, polach, wilac
+from railadhesion.models.polach import polach_forces
 from railadhesion.models.wilac import (
     WILAC_CONDITIONS,
     WilacCondition,
     WilacParameters,
-    _wilac_reference,
     default_wilac_parameters,
     wilac_forces,
 )
+from railadhesion.numerics import CHUNK
 
 #: The compiled kernels against their references over the whole input domain, implausible
 #: inputs included: the policy's warnings (docs/checks.md) are what tests/test_plausibility.py
@@ -100,7 +104,7 @@ def test_polach_kernel_edge_cases(monkeypatch):
     assert ours[0][5] == 0.0  # friction gone
     rng = np.random.default_rng(3)
     n = 20_000
-    monkeypatch.setattr(kernels, "_PARALLEL_MIN", 5000)  # run the parallel kernel too
+    monkeypatch.setattr(polach, "PARALLEL_MIN", 5000)  # run the parallel kernel too
     big = [rng.uniform(-0.3, 0.3, n), rng.uniform(-0.01, 0.01, n), rng.uniform(-2, 2, n),
            rng.uniform(2e4, 1.2e5, n), rng.uniform(0, 40, n), rng.uniform(3e-3, 8e-3, n),
            rng.uniform(3e-3, 8e-3, n), 0.55, 1.0, 0.4, 0.4, 0.6, 8.2e10, 0.28]  # fmt: skip
@@ -124,13 +128,16 @@ def test_polach_empty_arrays():
 @given(r=st.one_of(st.floats(1e-150, 1e150), st.sampled_from([0.1, 0.5, 1.0, 1.9, 10.0, 0.099])),
        nu=st.one_of(st.floats(0.0, 0.5), st.sampled_from([0.0, 0.25, 0.5])))  # fmt: skip
 @SETTINGS
-def test_kalker_kernel_equals_reference(r, nu):
-    ref = kalker_coefficients(r, nu)
+def test_kalker_law_equals_numpy_oracle(r, nu):
+    """The compiled law, the law run as Python (the scalar path of kalker_coefficients) and
+    its loop over arrays give the oracle's numbers."""
+    ref = kalker_oracle(r, nu)
     ours = kernels.kalker_scalar(r, nu)
-    np.testing.assert_allclose(ours, tuple(ref), rtol=RTOL)
-    np.testing.assert_allclose(ours[:3], kernels._kalker3(r, nu), rtol=0, atol=0)
-    many = kernels.kalker_many(np.array([r, 1.0]), np.array([nu]))
-    np.testing.assert_allclose(many[:, 0], ours, rtol=0, atol=0)
+    np.testing.assert_allclose(ours, ref, rtol=RTOL)
+    np.testing.assert_allclose(kalker_law(r, nu), ours, rtol=RTOL)
+    np.testing.assert_allclose(tuple(kalker_coefficients(r, nu)), ours, rtol=RTOL)
+    many = kalker_coefficients(np.array([r, 1.0]), np.array([nu]))
+    np.testing.assert_array_equal([c[0] for c in many], ours)
 
 
 # --- WILAC --------------------------------------------------------------------------------
@@ -151,7 +158,7 @@ def _params():
 def test_wilac_kernel_equals_numpy_reference(params, monkeypatch):
     rng = np.random.default_rng(7)
     n = 9000
-    monkeypatch.setattr(kernels, "_PARALLEL_MIN_WILAC", 5000)  # run the parallel kernel
+    monkeypatch.setattr(wilac, "PARALLEL_MIN_WILAC", 5000)  # run the parallel kernel
     args = [rng.uniform(-0.6, 0.6, n), rng.uniform(-0.01, 0.01, n), rng.uniform(-2, 2, n),
             rng.uniform(1e3, 1.5e5, n), rng.uniform(0, 50, n), rng.uniform(1e-3, 9e-3, n),
             rng.uniform(1e-3, 9e-3, n), rng.uniform(0, 120, n)]  # fmt: skip
@@ -292,14 +299,14 @@ def test_wilac_kernel_reuses_parameters_only_while_q_and_v_repeat():
     _close(wilac_forces(*args), _wilac_reference(*args), 1.5 * 1e5)
 
 
-# --- the batch kernels' paths (chunks of kernels._BATCH contacts) ----------------------------
+# --- the batch kernels' paths (chunks of CHUNK contacts) ----------------------------
 
 
 def _both_kernels(monkeypatch, call):
     """``call()`` with the serial kernel, then with the parallel one; both results."""
     serial = call()
-    monkeypatch.setattr(kernels, "_PARALLEL_MIN", 1)
-    monkeypatch.setattr(kernels, "_PARALLEL_MIN_WILAC", 1)
+    monkeypatch.setattr(polach, "PARALLEL_MIN", 1)
+    monkeypatch.setattr(wilac, "PARALLEL_MIN_WILAC", 1)
     return serial, call()
 
 
@@ -308,14 +315,14 @@ def test_polach_batch_kalker_lookup_paths(monkeypatch):
     than the chunk remembers, the asymptotic range g < 0.1 and a/b > 700 (K_psi from exp
     below -700) in arrays: the reference's numbers; serial and parallel kernels identical."""
     rng = np.random.default_rng(5)
-    n = 3 * kernels._BATCH + 17
+    n = 3 * CHUNK + 17
     scale = rng.uniform(0.8, 1.25, n)
     a = 6e-3 * scale
     b = 5e-3 * scale  # a/b = 1.2 up to an ulp: a few distinct values
-    assert 1 < np.unique(a / b).size <= kernels._MEMO
+    assert 1 < np.unique(a / b).size <= kalker._MEMO
     ratios = np.array([1e-3, 0.05, 0.099, 0.1, 0.5, 1.0, 1.9, 10.0, 10.1, 40.0, 800.0, 1e5])
-    chunk = slice(kernels._BATCH, 2 * kernels._BATCH)  # the second chunk: many distinct a/b
-    a[chunk] = 4e-3 * np.resize(ratios, kernels._BATCH)
+    chunk = slice(CHUNK, 2 * CHUNK)  # the second chunk: many distinct a/b
+    a[chunk] = 4e-3 * np.resize(ratios, CHUNK)
     b[chunk] = 4e-3
     args = [rng.uniform(-0.3, 0.3, n), rng.uniform(-0.01, 0.01, n), rng.uniform(-2, 2, n),
             rng.uniform(2e4, 1.2e5, n), rng.uniform(0, 40, n), a, b]  # fmt: skip
@@ -328,14 +335,14 @@ def test_polach_batch_kalker_lookup_paths(monkeypatch):
 
 
 def test_batch_validation_names_the_argument_in_any_chunk():
-    n = 2 * kernels._BATCH + 3
+    n = 2 * CHUNK + 3
     sx = np.linspace(-0.1, 0.1, n)
     q = np.full(n, 1e5)
     q[n - 2] = -1.0  # in the last chunk
     with pytest.raises(ValueError, match=r"^normal_force must be in \(0, inf\)"):
         polach_forces(sx, 0.0, 0.0, q, 10.0, 6e-3, 5e-3, mu0=0.3)
     k_a = np.full(n, 0.5)
-    k_a[kernels._BATCH] = np.nan
+    k_a[CHUNK] = np.nan
     with pytest.raises(ValueError, match=r"^k_A must be in \(0.0, 1.0\]"):
         polach_forces(sx, 0.0, 0.0, 1e5, 10.0, 6e-3, 5e-3, mu0=0.3, k_A=k_a)
     a = np.full(n, 6e-3)
@@ -355,7 +362,7 @@ def test_wilac_batch_paths(params, monkeypatch):
     zero weight skipped), water flows switching conditions on and off within a chunk: the
     reference's numbers; serial and parallel kernels identical."""
     rng = np.random.default_rng(9)
-    n = 2 * kernels._BATCH + 5
+    n = 2 * CHUNK + 5
     sx = rng.uniform(-0.6, 0.6, n)
     sy = rng.uniform(-0.01, 0.01, n)
     psi = rng.uniform(-2, 2, n)
@@ -376,18 +383,6 @@ def test_wilac_batch_paths(params, monkeypatch):
         monkeypatch.undo()
         _close(serial, ref, 1.5 * 1.5e5)
         np.testing.assert_array_equal(serial, parallel)
-
-
-def test_serial_and_parallel_twins_have_separate_caches():
-    """numba's disk cache is keyed by the function's qualified name, line and signature, not
-    by ``parallel``: the twins must carry different names or one would load the other's
-    cached code (the parallel FASTSIM kernel then ran serially)."""
-    from railadhesion.contact import _fastsim_kernels as fk
-
-    for par, ser in ((fk._strips_par, fk._strips_ser), (fk._rect_par, fk._rect_ser)):
-        assert par.targetoptions.get("parallel") and not ser.targetoptions.get("parallel")
-        assert par.py_func.__qualname__ != ser.py_func.__qualname__
-        assert par.py_func.__code__ is ser.py_func.__code__
 
 
 def test_polach_contact_numbers_and_mutation():
@@ -418,9 +413,11 @@ def test_read_only_and_writeable_inputs_share_one_compiled_kernel():
     wilac_forces(frozen, 0.0, 0.1, 1e5, 10.0, a, 5e-3, x + 1.0, default_wilac_parameters())
     np.testing.assert_array_equal(fx1, fx2)
     assert x.flags.writeable and a.flags.writeable  # the caller's arrays are untouched
-    for sig in kernels._batch_chunks.signatures:
-        inputs = [t for i, t in enumerate(sig) if i not in (16, 17) and hasattr(t, "mutable")]
-        assert not any(t.mutable for t in inputs), sig
+    for dispatcher, outputs in ((polach._polach_chunks.dispatcher, (14, 15)),
+                                (wilac._wilac_chunks.dispatcher, (11, 12))):
+        for sig in dispatcher.signatures:
+            inputs = [t for i, t in enumerate(sig) if i not in outputs and hasattr(t, "mutable")]
+            assert not any(t.mutable for t in inputs), sig
 
 
 def test_polach_contact_recomputes_everything_when_an_input_changes():

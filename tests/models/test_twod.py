@@ -475,3 +475,35 @@ def test_condition_geometry_agrees_with_hertz_module():
         )
         assert float(line.half_width) == pytest.approx(cond.half_width, rel=1e-12)
         assert float(line.load_per_length) == pytest.approx(cond.normal_load, rel=1e-12)
+
+
+# --- the compiled laws against the NumPy oracle -------------------------------------------
+
+
+@given(
+    creep=st.one_of(st.just(0.0), st.floats(-0.05, 0.05), st.sampled_from([-0.0, 1e-300, 1e10])),
+    load=st.one_of(st.just(0.0), st.floats(1.0, 1e6)),
+    a=st.floats(1e-5, 1e-2), r=st.floats(1e-3, 1.0),
+    mu=st.one_of(st.just(0.0), st.floats(1e-3, 1.0)),
+    k_a=st.floats(0.01, 2.0), k_s=st.floats(0.01, 1.0),
+)  # fmt: skip
+@settings(max_examples=80, deadline=None)
+@pytest.mark.filterwarnings("ignore::railadhesion.plausibility.PlausibilityWarning")
+def test_compiled_twod_laws_equal_the_numpy_oracle(creep, load, a, r, mu, k_a, k_s):
+    """Carter's and Fletcher's laws (compiled) against the oracle, scalars and arrays,
+    zero creep, zero friction (then zero traction) and full slip included."""
+    from oracles import twod as oracle
+
+    for ours, ref in ((carter(creep, load, a, r, mu), oracle.carter(creep, load, a, r, mu)),
+                      (fletcher(creep, load, a, r, mu, k_a, k_s),
+                       oracle.fletcher(creep, load, a, r, mu, k_a, k_s))):  # fmt: skip
+        scale = max(mu * load, 1e-300)
+        for got, want in zip(ours, ref, strict=True):
+            assert np.shape(got) == np.shape(want)
+            np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-13 * max(scale, a))
+    creeps = np.array([creep, -creep, 0.0, 0.01])
+    got = fletcher(creeps[:, None], load, a, r, np.array([mu, 0.3]), k_a, k_s)
+    want = oracle.fletcher(creeps[:, None], load, a, r, np.array([mu, 0.3]), k_a, k_s)
+    for g, w in zip(got, want, strict=True):
+        assert g.shape == (4, 2)
+        np.testing.assert_allclose(g, w, rtol=1e-12, atol=1e-13 * max(load, a))

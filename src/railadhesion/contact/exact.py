@@ -36,7 +36,6 @@ import math
 from dataclasses import dataclass
 from functools import lru_cache
 
-import numba
 import numpy as np
 
 from railadhesion._validate import (
@@ -45,6 +44,8 @@ from railadhesion._validate import (
     check_positive,
     check_range,
 )
+from railadhesion.contact.friction import falling_friction_factor
+from railadhesion.numerics import jit
 from railadhesion.plausibility import input_checker
 
 __all__ = [
@@ -71,7 +72,7 @@ _EXTERIOR, _STICK, _SLIP = 0, 1, 2
 # ---------------------------------------------------------------------------------------------
 
 
-@numba.njit(cache=True, inline="always")
+@jit(error_model="python", inline="always")
 def _ylnxr(x, y):
     """``y ln(x + r)``, ``r = sqrt(x^2 + y^2)``; 0 for y = 0; no cancellation for x < 0."""
     if y == 0.0:
@@ -82,13 +83,13 @@ def _ylnxr(x, y):
     return y * math.log(y * y / (r - x))
 
 
-@numba.njit(cache=True, inline="always")
+@jit(error_model="python", inline="always")
 def _prim_xx(x, y, nu):
     """Primitive of ``(1-nu)/r + nu x^2/r^3`` in x and y: ``y ln(x+r) + (1-nu) x ln(y+r)``."""
     return _ylnxr(x, y) + (1.0 - nu) * _ylnxr(y, x)
 
 
-@numba.njit(cache=True)
+@jit(error_model="python")
 def _influence_point(x, y, hx, hy, nu):
     """(Axx, Axy, Ayy) * pi * G at offset (x, y) of a (2hx x 2hy) element with unit traction."""
     xp, xm, yp, ym = x + hx, x - hx, y + hy, y - hy
@@ -102,7 +103,7 @@ def _influence_point(x, y, hx, hy, nu):
     return axx, axy, ayy
 
 
-@numba.njit(cache=True)
+@jit(error_model="python")
 def _influence_array(x, y, hx, hy, nu, out_xx, out_xy, out_yy):
     for k in range(x.size):
         out_xx[k], out_xy[k], out_yy[k] = _influence_point(x[k], y[k], hx, hy, nu[k])
@@ -272,7 +273,7 @@ def solve_normal(gap, dx, dy, normal_force, *, shear_modulus=8.2e10, poisson=0.2
     return NormalSolution(p.reshape(ny, nx), float(delta), iterations)
 
 
-@numba.njit(cache=True)
+@jit(error_model="python")
 def _rolling_kernel(mx, my, dx, dy, nu):
     """Kernel of the steady-rolling slip, times G: ``s_I = w_I + sum_J K(I - J) p_J / G``.
 
@@ -305,7 +306,7 @@ def _rolling_kernel(mx, my, dx, dy, nu):
     return kxx, kxy, kyy
 
 
-@numba.njit(cache=True)
+@jit(error_model="python")
 def _gs_diagonal(ratio, nu):
     """Diagonal (x, y) used in the Gauss-Seidel update, for dx = 1 and dy = ``ratio``.
 
@@ -328,7 +329,7 @@ def _gs_diagonal(ratio, nu):
 # ---------------------------------------------------------------------------------------------
 
 
-@numba.njit(cache=True)
+@jit(error_model="python")
 def _local_slip(ssx, ssy, kx, ky, g):
     """Traction on the bound |p| = g with p = -g s/|s|, s = ss + diag(kx, ky) p.
 
@@ -358,7 +359,7 @@ def _local_slip(ssx, ssy, kx, ky, g):
     return g * ex, g * ey
 
 
-@numba.njit(cache=True, fastmath=True)
+@jit(error_model="python", fastmath=True)
 def _apply_update(sx, sy, lo, hi, kxx, kxy, kyy, iy, ix, mx, my, dpx, dpy):
     """s_J += K(J - I) dp for every element J of the contact rows."""
     for jy in range(my):
@@ -377,7 +378,7 @@ def _apply_update(sx, sy, lo, hi, kxx, kxy, kyy, iy, ix, mx, my, dpx, dpy):
             oy[t] += rxy[t] * dpx + ryy[t] * dpy
 
 
-@numba.njit(cache=True)
+@jit(error_model="python")
 def _full_slip_field(px, py, wx, wy, lo, hi, kxx, kxy, kyy, mx, my, sx, sy):
     """s = w + K p on the contact rows, computed from scratch."""
     for jy in range(my):
@@ -390,7 +391,7 @@ def _full_slip_field(px, py, wx, wy, lo, hi, kxx, kxy, kyy, mx, my, sx, sy):
                 _apply_update(sx, sy, lo, hi, kxx, kxy, kyy, iy, ix, mx, my, px[iy, ix], py[iy, ix])
 
 
-@numba.njit(cache=True)
+@jit(error_model="python")
 def _gauss_seidel(g, wx, wy, kxx, kxy, kyy, dgx, dgy, tol, max_iter, px, py, sx, sy, state):
     """Block Gauss-Seidel for the steady rolling problem on one grid.
 
@@ -488,13 +489,7 @@ def _gauss_seidel(g, wx, wy, kxx, kxy, kyy, dgx, dgy, tol, max_iter, px, py, sx,
     return sweeps, err / pref
 
 
-@numba.njit(cache=True)
-def _friction_factor(slip_velocity, ratio, decay):
-    """mu(w)/mu0 = (1 - A) exp(-B w) + A (Polach 2005, eq. 11; CONTACT's exponential law)."""
-    return (1.0 - ratio) * math.exp(-decay * slip_velocity) + ratio
-
-
-@numba.njit(cache=True)
+@jit(error_model="python")
 def _solve_falling_friction(
     g0, wx, wy, kxx, kxy, kyy, dgx, dgy, tol, max_iter, px, py, sx, sy, state, mu_fac,
     speed, ratio, decay, tol_outer, max_outer,
@@ -523,7 +518,7 @@ def _solve_falling_friction(
         outer += 1
         for j in range(my):
             for i in range(mx):
-                mu_fac[j, i] = _friction_factor(vel[j, i], ratio, decay)
+                mu_fac[j, i] = falling_friction_factor(vel[j, i], ratio, decay)
                 g[j, i] = g0[j, i] * mu_fac[j, i]
         it, err = _gauss_seidel(g, wx, wy, kxx, kxy, kyy, dgx, dgy, tol, max_iter, px, py, sx, sy,
                                 state)  # fmt: skip
@@ -555,14 +550,14 @@ def _solve_falling_friction(
     for j in range(my):
         for i in range(mx):
             if g0[j, i] > 0.0:
-                mu_fac[j, i] = _friction_factor(speed * math.hypot(sx[j, i], sy[j, i]), ratio,
-                                                decay)  # fmt: skip
+                w = speed * math.hypot(sx[j, i], sy[j, i])
+                mu_fac[j, i] = falling_friction_factor(w, ratio, decay)
             else:
                 mu_fac[j, i] = 0.0
     return sweeps, err, outer, change
 
 
-@numba.njit(cache=True)
+@jit(error_model="python")
 def _solve_hertz_batch(
     xi, eta, phi, fz, a, b, mu, gmod, nu, speed, fratio, decay, mx, my, scale, spin_offset, tol,
     max_iter, tol_outer, max_outer, out_f, out_iter, out_err, out_outer, px_all, py_all, sx_all,
@@ -747,7 +742,7 @@ def _check_grid(value, name: str) -> int:
     return n
 
 
-def _check_friction_law(speed, friction_ratio, friction_decay):
+def check_friction_law(speed, friction_ratio, friction_decay):
     """Validated (A, B, V) of the falling friction law; V = 0 stands for 'not given'."""
     ratio = check_range(friction_ratio, "friction_ratio", 0.0, 1.0)
     decay = check_nonnegative(friction_decay, "friction_decay")
@@ -945,7 +940,7 @@ def exact_rolling(
     mu_ = check_nonnegative(mu, "mu")
     g_mod = check_positive(shear_modulus, "shear_modulus")
     nu = check_range(poisson, "poisson", 0.0, 0.5)
-    ratio, decay, v = _check_friction_law(speed, friction_ratio, friction_decay)
+    ratio, decay, v = check_friction_law(speed, friction_ratio, friction_decay)
     tol_friction = float(check_range(tol_friction, "tol_friction", 1e-12, 1e-1))
     max_friction_iter = _check_grid(max_friction_iter, "max_friction_iter")
     nx = _check_grid(nx, "nx")
@@ -1113,7 +1108,7 @@ def solve_tangential(
     mu_ = float(check_nonnegative(mu, "mu"))
     g = float(check_positive(shear_modulus, "shear_modulus"))
     nu = float(check_range(poisson, "poisson", 0.0, 0.5))
-    ratio, decay, v = (float(q) for q in _check_friction_law(speed, friction_ratio, friction_decay))
+    ratio, decay, v = (float(q) for q in check_friction_law(speed, friction_ratio, friction_decay))
     tol_friction = float(check_range(tol_friction, "tol_friction", 1e-12, 1e-1))
     max_friction_iter = _check_grid(max_friction_iter, "max_friction_iter")
     x0 = -0.5 * (nx - 1) * dx_ if x0 is None else float(check_finite(x0, "x0"))

@@ -12,12 +12,14 @@ its own length; the default, converging fast) and CONTACT's rectangular grid (re
 numbers of Vollebregt's CONTACT program, e.g. its ``fastsim`` example).
 
 This module solves many contacts at once: every input broadcasts to a *contact shape*. The
-march runs in compiled code (numba, :mod:`railadhesion.contact._fastsim_kernels`): the strips
-advance side by side in the inner loop, and large batches of contacts run in parallel; one
-contact given as scalars takes a short path with ``math`` around the compiled march. The
-NumPy march (contacts and grid rows vectorised, a Python loop along x) is kept as the readable
-reference; it runs when ``return_tractions=True`` and the tests hold the compiled march to it
-at 1e-12.
+laws (the flexibilities, :func:`fastsim_flexibilities`; the marches on the strips and on
+CONTACT's grid, :func:`fastsim_strips`, :func:`fastsim_rectangular`) are compiled (numba,
+on first use) and looped over the contacts (:func:`march_strips`, :func:`march_rect`,
+:func:`strips_one`, at the end of this module): the strips advance side
+by side in the inner loop, and large batches of contacts run on several threads; one contact
+given as scalars takes a short path (checks in plain Python, one compiled call). A NumPy
+march (contacts and grid rows vectorised) is the tests' independent oracle
+(``tests/oracles/fastsim.py``).
 
 Sign convention (``docs/CONVENTIONS.md``): the returned forces are exerted by the rail on the
 wheel and oppose the creepage (Kalker's, as CONTACT); at small creepage
@@ -41,19 +43,25 @@ from railadhesion._validate import (
     check_positive,
     check_range,
 )
-from railadhesion.contact.kalker import (
-    _AOB_MAX,
-    _AOB_MIN,
-    _coefficients_scalar,
-    axis_ratio,
-    kalker_coefficients,
-)
+from railadhesion.contact.kalker import AOB_MAX, AOB_MIN, axis_ratio, kalker_law
+from railadhesion.numerics import flatten, jitable, kernel, read_only, run_chunks
 from railadhesion.plausibility import input_checker
 
-__all__ = ["FastsimResult", "fastsim"]
+__all__ = [
+    "FastsimResult",
+    "fastsim",
+    "fastsim_bound",
+    "fastsim_flexibilities",
+    "fastsim_rectangular",
+    "fastsim_strips",
+    "limit_creepage",
+]
 
 _BOUNDS = ("parabolic", "elliptic")
 _FLEXIBILITIES = ("original", "blended")
+#: Flexibility mode of the compiled marches: explicit (L1, L2, L3) given per contact.
+_FLEX_GIVEN = 2
+_ONE = read_only(np.ones(1))
 _GRIDS = ("strips", "rectangular")
 #: CONTACT evaluates the spin part of the rigid slip a sixth of a step upstream of the element
 #: centre, at x + dq/6 (input FACPHI, default 1/6: CONTACT ``m_sinput.f90``; used in
@@ -61,9 +69,6 @@ _GRIDS = ("strips", "rectangular")
 _FACPHI = 1.0 / 6.0
 #: CONTACT evaluates the blending weight with spin in rad/mm; 1 rad/m = 1e-3 rad/mm.
 _SPIN_TO_PER_MM = 1e-3
-#: Target number of array elements (contacts x strips) processed together: keeps the march's
-#: working arrays in cache for large batches.
-_CHUNK_ELEMENTS = 16384
 #: [Pa]; keeps g/|p| finite where p = 0 in the march (tractions that small are irrelevant).
 _TINY_TRACTION = 1e-30
 #: Largest creepage magnitude max(|xi|, |eta|, |phi| a) marched as given. Larger creepages
@@ -160,39 +165,44 @@ def _rect_pattern(nx: int, ny: int, scale: float, bound: str):
     return xh, yh, inside.astype(float), shape, int(inside.sum())
 
 
-def _flexibilities(a, b, xi, eta, phi, normal_force, mu, g_mod, nu, blended):
-    """Kalker's three flexibilities L1, L2, L3 [m^3/N], optionally blended (CONTACT 2023)."""
-    a_over_b = axis_ratio(a, b)
-    coef = kalker_coefficients(a_over_b, nu)
-    c11, c22, c23 = coef.c11, coef.c22, coef.c23
+@jitable
+def fastsim_flexibilities(a, b, xi, eta, phi, fz, mu, g_mod, c11, c22, c23, blended):
+    """Kalker's three flexibilities (L1, L2, L3) [m^3/N] of one contact, blended towards one
+    value as the creepage grows if ``blended`` (Vollebregt & Voltr 2023, CONTACT
+    ``simpflex``); the formulas are in :func:`fastsim`, Notes. C11, C22, C23 are Kalker's
+    coefficients of a/b (:func:`railadhesion.contact.kalker.kalker_law`)."""
     l1 = 8.0 * a / (3.0 * g_mod * c11)
     l2 = 8.0 * a / (3.0 * g_mod * c22)
-    l3 = np.pi * a * np.sqrt(a_over_b) / (4.0 * g_mod * c23)
+    l3 = math.pi * a * math.sqrt(a / b) / (4.0 * g_mod * c23)
     if not blended:
         return l1, l2, l3
-    # Vollebregt & Voltr (2023): blend the three flexibilities towards one combined value as the
-    # creepage grows, so that the force at full sliding opposes the creepage.
-    spin_term = (phi * (3.0 * np.pi * a / 32.0)) ** 2  # (phi f4/f3)^2, f4/f3 = 3 pi a / 32
+    spin_term = (phi * (3.0 * math.pi * a / 32.0)) ** 2  # (phi f4/f3)^2, f4/f3 = 3 pi a / 32
     num = xi * xi + eta * eta + spin_term
     den = xi * xi / l1 + eta * eta / l2 + spin_term / l3
-    l_crss = np.divide(num, den, out=np.array(l1, dtype=float, copy=True), where=den > 0.0)
+    l_crss = num / den if den > 0.0 else l1
     c2 = a * b
-    c3 = c2 * np.sqrt(c2)
-    mu_fz = mu * normal_force
+    c3 = c2 * math.sqrt(c2)
+    mu_fz = mu * fz
     ch_xi = mu_fz / (c2 * g_mod * c11)
     ch_eta = mu_fz / (c2 * g_mod * c22)
     ch_phi = mu_fz / (c3 * g_mod * c23) * _SPIN_TO_PER_MM
     phi_mm = phi * _SPIN_TO_PER_MM
     ch2 = ch_xi * ch_xi + ch_eta * ch_eta + ch_phi * ch_phi
     crp2 = xi * xi + eta * eta + phi_mm * phi_mm
-    # ch2 = 0 only when mu Fz = 0: then the bound is zero anyway and any weight will do.
-    f_crp = np.sqrt(np.divide(crp2, ch2, out=np.zeros_like(crp2), where=ch2 > 0.0))
-    w = np.clip(f_crp / 3.0, 0.0, 1.0)
-    return (
-        (1.0 - w) * l1 + w * l_crss,
-        (1.0 - w) * l2 + w * l_crss,
-        (1.0 - w) * l3 + w * l_crss,
-    )
+    # ch2 = 0 only when mu Fz = 0: then the bound is zero anyway and any weight will do
+    f_crp = math.sqrt(crp2 / ch2) if ch2 > 0.0 else 0.0
+    w = min(max(f_crp / 3.0, 0.0), 1.0)
+    return ((1.0 - w) * l1 + w * l_crss, (1.0 - w) * l2 + w * l_crss,
+            (1.0 - w) * l3 + w * l_crss)  # fmt: skip
+
+
+@jitable
+def limit_creepage(xi, eta, phi, a):
+    """The creepages scaled down, all three by one factor, to magnitude :data:`_CREEP_MAX`
+    where max(|xi|, |eta|, |phi| a) exceeds it (see there)."""
+    size = max(max(abs(xi), abs(eta)), abs(phi) * a)
+    scale = _CREEP_MAX / size if size > _CREEP_MAX else 1.0
+    return xi * scale, eta * scale, phi * scale
 
 
 #: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
@@ -402,31 +412,44 @@ def fastsim(
                 f"ellipse with scale={scale!r}: increase nx, ny or decrease scale (>= 1)"
             )
 
-    args = np.broadcast_arrays(xi, eta, phi, fz, a_, b_, mu_, g_mod, nu, *flx_given)
-    shape = args[0].shape
-    xi, eta, phi, fz, a_, b_, mu_, g_mod, nu, *flx_given = (np.ravel(v) for v in args)
-    xi, eta, phi = _limit_creepage(xi, eta, phi, a_)
-    if flx_given:
-        l1, l2, l3 = flx_given
+    if not flx_given:
+        axis_ratio(a_, b_)  # Kalker's coefficients are looked up: a/b in their range
+    _PLAUSIBLE((xi, eta, phi, fz, a_, b_, mu_, g_mod, nu))  # implausible inputs warn
+    shape, n, flat = flatten([xi, eta, phi, fz, a_, b_, mu_, g_mod, nu, *flx_given])
+    mode = _FLEX_GIVEN if flx_given else _FLEXIBILITIES.index(flexibility)
+    flex = flat[9:] if flx_given else (_ONE, _ONE, _ONE)
+    store = None
+    if return_tractions:
+        store = (np.empty((n, ny, nx)), np.empty((n, ny, nx)), np.empty((n, ny, nx), bool))
+    if grid == "strips":
+        pattern = _grid_pattern(nx, ny, bound)
+        out = march_strips(*flat[:9], *flex, mode, pattern, store)
     else:
-        l1, l2, l3 = _flexibilities(
-            a_, b_, xi, eta, phi, fz, mu_, g_mod, nu, flexibility == "blended"
-        )
+        out = march_rect(*flat[:9], *flex, mode, scale, rect, store)
 
-    _PLAUSIBLE(args[:9])  # implausible inputs warn (docs/checks.md); errors were raised above
-    if not return_tractions:  # the compiled march (same numbers as the NumPy one below)
-        from railadhesion.contact import _fastsim_kernels as kern
+    def shaped(v):
+        v = v.reshape(shape)
+        return v[()] if v.ndim == 0 else v
 
-        flat = [np.ascontiguousarray(x, dtype=float) for x in
-                (xi, eta, phi, fz, a_, b_, mu_, *np.broadcast_arrays(l1, l2, l3, xi)[:3])]
+    extra = {}
+    if return_tractions:
+        a_ = np.broadcast_to(a_, shape).reshape(-1)
+        b_ = np.broadcast_to(b_, shape).reshape(-1)
         if grid == "strips":
-            out = kern.march_strips(*flat, _grid_pattern(nx, ny, bound))
+            eta_j, sq = pattern[0], pattern[1]
+            s_centre = (np.arange(nx) + 0.5) / nx  # fraction of the strip length from the lead
+            a_strip = a_[:, None] * sq[None, :]  # (n, ny)
+            x = a_strip[:, :, None] * (1.0 - 2.0 * s_centre)[None, None, :]
+            y = np.broadcast_to((b_[:, None] * eta_j[None, :])[:, :, None], x.shape)
         else:
-            out = kern.march_rect(*flat, scale, rect)
-        return FastsimResult(*(_shaped(v, shape) for v in out))
-    return _fastsim_reference(xi, eta, phi, fz, a_, b_, mu_, l1, l2, l3, shape, nx, ny, bound,
-                              grid, scale, rect if grid == "rectangular" else None,
-                              return_tractions)  # fmt: skip
+            xh, yh = rect[0], rect[1]
+            x = np.broadcast_to(a_[:, None, None] * xh[None, None, :], (n, ny, nx))
+            y = np.broadcast_to(b_[:, None, None] * yh[None, :, None], (n, ny, nx))
+        grid_shape = (*shape, ny, nx)
+        extra = {"x": np.array(x).reshape(grid_shape), "y": np.array(y).reshape(grid_shape)}
+        extra.update(zip(("px", "py", "slip"), (v.reshape(grid_shape) for v in store),
+                         strict=True))  # fmt: skip
+    return FastsimResult(*(shaped(v) for v in out), **extra)
 
 
 def _float_scalars(values) -> list | None:
@@ -442,126 +465,21 @@ def _float_scalars(values) -> list | None:
 
 
 def _fastsim_scalar(xi, eta, phi, fz, a, b, mu, g_mod, nu, nx, ny, bound, flexibility):
-    """:func:`fastsim` for one contact on the strips, with ``math`` instead of NumPy around
-    the compiled march (a few microseconds of Python). ``None`` if any input is invalid or
-    out of range: the caller's array path then raises the error naming it."""
+    """:func:`fastsim` for one contact on the strips: checks in plain Python, one compiled
+    call. ``None`` if any input is invalid or out of range: the caller's array path then
+    raises the error naming it."""
     fin = math.isfinite
     if not (fin(xi) and fin(eta) and fin(phi) and fin(fz) and fin(a) and fin(b) and fin(mu)
             and fin(g_mod) and fz >= 0 and a > 0 and b > 0 and mu >= 0 and g_mod > 0
             and 0.0 <= nu <= 0.5 and nx >= 1 and ny >= 1 and bound in _BOUNDS
             and flexibility in _FLEXIBILITIES):  # fmt: skip
         return None
-    a_over_b = a / b
-    if not _AOB_MIN <= a_over_b <= _AOB_MAX:
+    if not AOB_MIN <= a / b <= AOB_MAX:
         return None
-    size = max(abs(xi), abs(eta), abs(phi) * a)
-    if size > _CREEP_MAX:
-        scale = _CREEP_MAX / size
-        xi, eta, phi = xi * scale, eta * scale, phi * scale
-    c11, c22, c23, _ = _coefficients_scalar(a_over_b, nu)
-    l1 = 8.0 * a / (3.0 * g_mod * c11)
-    l2 = 8.0 * a / (3.0 * g_mod * c22)
-    l3 = math.pi * a * math.sqrt(a_over_b) / (4.0 * g_mod * c23)
-    if flexibility == "blended":  # the operations of _flexibilities, in floats
-        spin_term = (phi * (3.0 * math.pi * a / 32.0)) ** 2
-        num = xi * xi + eta * eta + spin_term
-        den = xi * xi / l1 + eta * eta / l2 + spin_term / l3
-        l_crss = num / den if den > 0.0 else l1
-        c2 = a * b
-        c3 = c2 * math.sqrt(c2)
-        mu_fz = mu * fz
-        ch_xi = mu_fz / (c2 * g_mod * c11)
-        ch_eta = mu_fz / (c2 * g_mod * c22)
-        ch_phi = mu_fz / (c3 * g_mod * c23) * _SPIN_TO_PER_MM
-        phi_mm = phi * _SPIN_TO_PER_MM
-        ch2 = ch_xi * ch_xi + ch_eta * ch_eta + ch_phi * ch_phi
-        crp2 = xi * xi + eta * eta + phi_mm * phi_mm
-        f_crp = math.sqrt(crp2 / ch2) if ch2 > 0.0 else 0.0
-        w = min(max(f_crp / 3.0, 0.0), 1.0)
-        l1, l2, l3 = ((1.0 - w) * l1 + w * l_crss, (1.0 - w) * l2 + w * l_crss,
-                      (1.0 - w) * l3 + w * l_crss)  # fmt: skip
-    from railadhesion.contact import _fastsim_kernels as kern
-
-    eta_j, sq, tx, gy, norm = _grid_pattern(nx, ny, bound)
-    out = kern.strips_one(xi, eta, phi, fz, a, b, mu, l1, l2, l3, eta_j, sq, tx, gy, norm)
+    out = strips_one(xi, eta, phi, fz, a, b, mu, g_mod, nu,
+                             _FLEXIBILITIES.index(flexibility),
+                             _grid_pattern(nx, ny, bound))  # fmt: skip
     return FastsimResult(*(np.float64(v) for v in out))
-
-
-def _shaped(v, shape):
-    v = v.reshape(shape)
-    return v[()] if v.ndim == 0 else v
-
-
-def _fastsim_reference(xi, eta, phi, fz, a_, b_, mu_, l1, l2, l3, shape, nx, ny, bound, grid,
-                       scale, rect, return_tractions):  # fmt: skip
-    """NumPy reference of :func:`fastsim` (validated, raveled inputs): the readable march, used
-    for ``return_tractions=True``; the compiled march is tested against it."""
-    n = xi.size
-    l1, l2, l3 = (np.broadcast_to(x, (n,)) for x in (l1, l2, l3))
-    fx = np.empty(n)
-    fy = np.empty(n)
-    mz = np.empty(n)
-    slip_fraction = np.empty(n)
-    if return_tractions:
-        px_all = np.empty((n, ny, nx))
-        py_all = np.empty((n, ny, nx))
-        slip_all = np.empty((n, ny, nx), dtype=bool)
-    else:
-        px_all = py_all = slip_all = None
-
-    if grid == "strips":
-        eta_j, sq, tx, gy, norm = _grid_pattern(nx, ny, bound)
-    step = max(1, _CHUNK_ELEMENTS // ny)
-    for lo in range(0, n, step):
-        sl = slice(lo, min(lo + step, n))
-        store = None if px_all is None else (px_all[sl], py_all[sl], slip_all[sl])
-        if grid == "strips":
-            out = _march(
-                xi[sl], eta[sl], phi[sl], fz[sl], a_[sl], b_[sl], mu_[sl],
-                l1[sl], l2[sl], l3[sl], nx, eta_j, sq, tx, gy, norm, store,
-            )  # fmt: skip
-        else:
-            out = _march_rect(
-                xi[sl], eta[sl], phi[sl], fz[sl], a_[sl], b_[sl], mu_[sl],
-                l1[sl], l2[sl], l3[sl], scale, rect, store,
-            )  # fmt: skip
-        fx[sl], fy[sl], mz[sl], slip_fraction[sl] = out
-
-    def shaped(v):
-        v = v.reshape(shape)
-        return v[()] if v.ndim == 0 else v
-
-    extra = {}
-    if return_tractions:
-        if grid == "strips":
-            s_centre = (np.arange(nx) + 0.5) / nx  # fraction of the strip length from the lead
-            a_strip = a_[:, None] * sq[None, :]  # (n, ny)
-            x = a_strip[:, :, None] * (1.0 - 2.0 * s_centre)[None, None, :]
-            y = np.broadcast_to((b_[:, None] * eta_j[None, :])[:, :, None], x.shape)
-        else:
-            xh, yh = rect[0], rect[1]
-            x = np.broadcast_to(a_[:, None, None] * xh[None, None, :], (n, ny, nx))
-            y = np.broadcast_to(b_[:, None, None] * yh[None, :, None], (n, ny, nx))
-        grid_shape = (*shape, ny, nx)
-        extra = {
-            "x": np.array(x).reshape(grid_shape),
-            "y": np.array(y).reshape(grid_shape),
-            "px": px_all.reshape(grid_shape),
-            "py": py_all.reshape(grid_shape),
-            "slip": slip_all.reshape(grid_shape),
-        }
-    return FastsimResult(shaped(fx), shaped(fy), shaped(mz), shaped(slip_fraction), **extra)
-
-
-def _limit_creepage(xi, eta, phi, a):
-    """Creepages scaled down to magnitude :data:`_CREEP_MAX` where they exceed it (see there)."""
-    with np.errstate(over="ignore"):
-        size = np.maximum(np.maximum(np.abs(xi), np.abs(eta)), np.abs(phi) * a)
-    over = size > _CREEP_MAX
-    if not over.any():
-        return xi, eta, phi
-    scale = np.where(over, _CREEP_MAX / np.where(over, size, 1.0), 1.0)
-    return xi * scale, eta * scale, phi * scale
 
 
 def _check_flexibility(flexibility) -> list:
@@ -600,141 +518,274 @@ def _check_count(value, name: str) -> int:
     return k
 
 
-def _clip_to_bound(px, py, g, slip, r, tmp):
-    """Scale the tractions (px, py) back onto the bound ``g`` where ``|p| > g``, in place.
+@jitable(inline="always")
+def fastsim_bound(px, py, g):
+    """A trial traction (px, py) scaled back onto the traction bound g where |p| > g, keeping
+    its direction (Kalker 1982: the element slips): (px, py, slipping)."""
+    r = math.sqrt(px * px + py * py)
+    f = min(g / (r + _TINY_TRACTION), 1.0)
+    return px * f, py * f, r > g
 
-    The step shared by both grid layouts: ``slip`` receives the flags ``|p| > g``; the factor
-    is ``min(1, g/|p|)``, so the traction keeps its direction. ``r`` and ``tmp`` are work
-    arrays of the same shape (overwritten).
+
+# Rows of the work array of :func:`fastsim_strips` (ny values each).
+_W_PX, _W_PY, _W_DPX, _W_DPY1, _W_INC, _W_GFAC, _W_SPX, _W_SPY, _W_QPY, _W_NSLIP = range(10)
+#: Rows of the work array :func:`fastsim_strips` needs.
+STRIPS_WORK_ROWS = 10
+
+
+@jitable(inline="never")
+def fastsim_strips(xi, eta, phi, fz, a, b, mu, l1, l2, l3, eta_j, sq, tx, gy, norm, work,
+                   px_out, py_out, slip_out, store):  # fmt: skip
+    """FASTSIM on Kalker's strips for one contact (Kalker 1982; layout in :func:`fastsim`,
+    Notes): (fx, fy, mz, slip_fraction).
+
+    ``eta_j, sq, tx, gy, norm`` are the grid factors of :func:`_grid_pattern`; ``work`` is a
+    (:data:`STRIPS_WORK_ROWS`, ny) float64 scratch array. With ``store`` True the tractions
+    and slip flags of the cells are written to ``px_out``, ``py_out``, ``slip_out`` (ny, nx).
+    All strips advance side by side (the inner loop runs over the strips and vectorises).
+    A plain function compiled where compiled code calls it.
     """
-    np.multiply(px, px, out=r)
-    np.multiply(py, py, out=tmp)
-    r += tmp
-    np.sqrt(r, out=r)
-    np.greater(r, g, out=slip)
-    r += _TINY_TRACTION
-    np.divide(g, r, out=tmp)
-    np.minimum(tmp, 1.0, out=tmp)
-    px *= tmp
-    py *= tmp
-
-
-def _store_column(store, i, px, py, slip) -> None:
-    """Copy the tractions and slip flags of column ``i`` into the (m, ny, nx) ``store``."""
-    store[0][:, :, i] = px
-    store[1][:, :, i] = py
-    store[2][:, :, i] = slip
-
-
-def _march(xi, eta, phi, fz, a, b, mu, l1, l2, l3, nx, eta_j, sq, tx, gy, norm, store):
-    """FASTSIM march for a chunk of m contacts; returns (fx, fy, mz, slip_fraction), each (m,).
-
-    Working arrays have shape (m, ny). ``store`` is None or a tuple of (m, ny, nx) arrays
-    receiving px, py and the slip flags.
-    """
-    col = np.newaxis
-    dx = (2.0 / nx) * a[:, col] * sq  # element length per strip (m, ny)
-    y = b[:, col] * eta_j  # strip centres (m, ny)
-    a_strip = a[:, col] * sq
-    phi_l3 = (phi / l3)[:, col]
-    # constant increment of px per element: -dx (xi/L1 - phi y/L3)
-    dpx = -dx * ((xi / l1)[:, col] - phi_l3 * y)
-    # increment of py from centre i-1 to centre i (i >= 1), midpoint x = a(y) - i dx:
-    # -dx (eta/L2 + phi (a(y) - i dx)/L3) = dpy0 + i dpy1
-    dpy0 = -dx * ((eta / l2)[:, col] + phi_l3 * a_strip)
-    dpy1 = phi_l3 * dx * dx
-    # traction bound at cell (i, j): gfac[j] * tx[i]
-    gfac = (mu * fz / (a * b * norm))[:, col] * gy
-
-    # first half step, from the leading edge x = a(y) to the first centre (midpoint a - dx/4)
-    px = 0.5 * dpx
-    py = 0.5 * dpy0 + 0.125 * dpy1
-    inc = dpy0.copy()  # dpy0 + i dpy1, updated in place
-    spx = np.zeros_like(px)
-    spy = np.zeros_like(px)
-    qpy = np.zeros_like(px)  # running sum of the partial sums of py (for sum i py_i)
-    nslip = np.zeros_like(px)
-    r = np.empty_like(px)
-    g = np.empty_like(px)
-    tmp = np.empty_like(px)
-    slip = np.empty(px.shape, dtype=bool)
-    for i in range(nx):
-        if i > 0:
-            inc += dpy1
-            px += dpx
-            py += inc
-        np.multiply(gfac, tx[i], out=g)
-        _clip_to_bound(px, py, g, slip, r, tmp)
-        spx += px
-        spy += py
-        qpy += spy
-        nslip += slip
-        if store is not None:
-            _store_column(store, i, px, py, slip)
-
-    dy = (2.0 / eta_j.size) * b  # (m,)
-    da = dx * dy[:, col]  # cell area per strip (m, ny)
-    fx = (spx * da).sum(axis=1)
-    fy = (spy * da).sum(axis=1)
-    # sum_i x_i py_i with x_i = a(y) - (i + 1/2) dx and sum_i i py_i = nx spy - qpy
-    sum_xpy = a_strip * spy - dx * (nx * spy - qpy + 0.5 * spy)
-    mz = ((sum_xpy - y * spx) * da).sum(axis=1)
-    slip_fraction = np.minimum((nslip * sq).sum(axis=1) / (nx * sq.sum()), 1.0)
-    return fx, fy, mz, slip_fraction
-
-
-def _march_rect(xi, eta, phi, fz, a, b, mu, l1, l2, l3, scale, rect, store):
-    """FASTSIM on CONTACT's rectangular grid for a chunk of m contacts.
-
-    Returns (fx, fy, mz, slip_fraction), each (m,). Working arrays have shape (m, ny), one
-    entry per grid row; the loop runs over the nx columns from the leading edge (+x).
-    ``store`` is None or a tuple of (m, ny, nx) arrays receiving px, py and the slip flags.
-    """
-    xh, yh, mask, shape, n_in = rect
-    nx, ny = mask.shape
-    col = np.newaxis
-    dx = (2.0 * scale / nx) * a  # (m,)
-    dy = (2.0 * scale / ny) * b
-    y = b[:, col] * yh  # row centres (m, ny)
+    ny = eta_j.size
+    nx = tx.size
+    px, py, dpx, dpy1 = work[_W_PX], work[_W_PY], work[_W_DPX], work[_W_DPY1]
+    inc, gfac, spx, spy = work[_W_INC], work[_W_GFAC], work[_W_SPX], work[_W_SPY]
+    qpy, nslip = work[_W_QPY], work[_W_NSLIP]
     phi_l3 = phi / l3
-    # constant increment of px per element: -dx (xi/L1 - phi y/L3)
-    dpx = -dx[:, col] * ((xi / l1)[:, col] - phi_l3[:, col] * y)
-    # increment of py at column i: -dx (eta/L2 + phi (a xh_i + dx/6)/L3), shape (nx, m, 1)
+    xi_l1 = xi / l1
+    eta_l2 = eta / l2
+    gf = mu * fz / (a * b * norm)  # traction bound at cell (i, j): gf gy[j] tx[i]
+    for j in range(ny):
+        dx = (2.0 / nx) * a * sq[j]  # element length of strip j
+        y = b * eta_j[j]
+        a_strip = a * sq[j]
+        # constant increment of px per element: -dx (xi/L1 - phi y/L3); increment of py from
+        # centre i-1 to centre i, at the midpoint x = a(y) - i dx: dpy0 + i dpy1
+        dpx[j] = -dx * (xi_l1 - phi_l3 * y)
+        dpy0 = -dx * (eta_l2 + phi_l3 * a_strip)
+        dpy1[j] = phi_l3 * dx * dx
+        gfac[j] = gf * gy[j]
+        # first half step, from the leading edge x = a(y) to the first centre
+        px[j] = 0.5 * dpx[j]
+        py[j] = 0.5 * dpy0 + 0.125 * dpy1[j]
+        inc[j] = dpy0
+        spx[j] = 0.0
+        spy[j] = 0.0
+        qpy[j] = 0.0  # running sum of the partial sums of py (for sum_i i py_i)
+        nslip[j] = 0.0
+    for i in range(nx):
+        t = tx[i]
+        if i > 0:
+            for j in range(ny):
+                inc[j] += dpy1[j]
+                px[j] += dpx[j]
+                py[j] += inc[j]
+        for j in range(ny):  # back onto the bound where |p| exceeds it (slip)
+            pxj, pyj, slipping = fastsim_bound(px[j], py[j], gfac[j] * t)
+            nslip[j] += 1.0 if slipping else 0.0
+            px[j] = pxj
+            py[j] = pyj
+            spx[j] += pxj
+            spy[j] += pyj
+            qpy[j] += spy[j]
+            if store:
+                px_out[j, i] = pxj
+                py_out[j, i] = pyj
+                slip_out[j, i] = slipping
+    dy = (2.0 / ny) * b
+    sfx = 0.0
+    sfy = 0.0
+    smz = 0.0
+    sns = 0.0
+    sq_sum = 0.0
+    for j in range(ny):
+        dx = (2.0 / nx) * a * sq[j]
+        da = dx * dy
+        y = b * eta_j[j]
+        a_strip = a * sq[j]
+        sfx += spx[j] * da
+        sfy += spy[j] * da
+        # sum_i x_i py_i with x_i = a(y) - (i + 1/2) dx and sum_i i py_i = nx spy - qpy
+        sum_xpy = a_strip * spy[j] - dx * (nx * spy[j] - qpy[j] + 0.5 * spy[j])
+        smz += (sum_xpy - y * spx[j]) * da
+        sns += nslip[j] * sq[j]
+        sq_sum += sq[j]
+    return sfx, sfy, smz, min(sns / (nx * sq_sum), 1.0)
+
+
+# Rows of the work array of :func:`fastsim_rectangular` (ny values each).
+_R_PX, _R_PY, _R_DPX, _R_SPX, _R_SPY, _R_SXPY, _R_NSLIP = range(7)
+#: Rows of the work array :func:`fastsim_rectangular` needs.
+RECT_WORK_ROWS = 7
+
+
+@jitable(inline="never")
+def fastsim_rectangular(xi, eta, phi, fz, a, b, mu, l1, l2, l3, scale, xh, yh, mask, shape,
+                        n_in, work, px_out, py_out, slip_out, store):  # fmt: skip
+    """FASTSIM on CONTACT's rectangular grid for one contact (CONTACT ``m_solvpt.f90``,
+    ``modif_fastsim``; layout in :func:`fastsim`, Notes): (fx, fy, mz, slip_fraction).
+
+    ``xh, yh, mask, shape, n_in`` are the grid factors of :func:`_rect_pattern`; ``work`` is a
+    (:data:`RECT_WORK_ROWS`, ny) float64 scratch array; ``store`` as :func:`fastsim_strips`.
+    Each grid row is marched from the leading edge (+x), all rows side by side. A plain
+    function compiled where compiled code calls it.
+    """
+    nx = xh.size
+    ny = yh.size
+    px, py, dpx, spx = work[_R_PX], work[_R_PY], work[_R_DPX], work[_R_SPX]
+    spy, sxpy, nslip = work[_R_SPY], work[_R_SXPY], work[_R_NSLIP]
+    dx = (2.0 * scale / nx) * a
+    dy = (2.0 * scale / ny) * b
+    phi_l3 = phi / l3
+    xi_l1 = xi / l1
+    for j in range(ny):
+        # constant increment of px per element: -dx (xi/L1 - phi y/L3)
+        dpx[j] = -dx * (xi_l1 - phi_l3 * (b * yh[j]))
+        px[j] = 0.0
+        py[j] = 0.0
+        spx[j] = 0.0
+        spy[j] = 0.0
+        sxpy[j] = 0.0  # sum_i xh_i py_i
+        nslip[j] = 0.0
+    # increment of py at column i: -dx (eta/L2 + phi (a xh_i + dx/6)/L3) = dpy0 + xh_i dpy1
     dpy0 = -dx * (eta / l2 + phi_l3 * (_FACPHI * dx))
     dpy1 = -dx * phi_l3 * a
-    dpy = (dpy0 + xh[:, col] * dpy1)[:, :, col]
-    gfac = (mu * fz / (a * b))[:, col]  # bound at (i, j): gfac * shape[i, j]
-
-    px = np.zeros_like(y)
-    py = np.zeros_like(y)
-    spx = np.zeros_like(y)
-    spy = np.zeros_like(y)
-    sxpy = np.zeros_like(y)  # sum_i xh_i py_i
-    nslip = np.zeros_like(y)
-    r = np.empty_like(y)
-    g = np.empty_like(y)
-    tmp = np.empty_like(y)
-    slip = np.empty(y.shape, dtype=bool)
+    gfac = mu * fz / (a * b)  # bound at (i, j): gfac shape[i, j]
     for i in range(nx):
-        m_i = mask[i]
-        # step from the previous element; elements outside the contact reset to zero
-        px += dpx
-        px *= m_i
-        py += dpy[i]
-        py *= m_i
-        np.multiply(gfac, shape[i], out=g)
-        _clip_to_bound(px, py, g, slip, r, tmp)
-        spx += px
-        spy += py
-        np.multiply(py, xh[i], out=tmp)
-        sxpy += tmp
-        nslip += slip
-        if store is not None:
-            _store_column(store, i, px, py, slip)
-
+        dpy = dpy0 + xh[i] * dpy1
+        for j in range(ny):
+            # step from the previous element; elements outside the contact reset to zero
+            m = mask[i, j]
+            pxj, pyj, slipping = fastsim_bound((px[j] + dpx[j]) * m, (py[j] + dpy) * m,
+                                               gfac * shape[i, j])  # fmt: skip
+            nslip[j] += 1.0 if slipping else 0.0
+            px[j] = pxj
+            py[j] = pyj
+            spx[j] += pxj
+            spy[j] += pyj
+            sxpy[j] += pyj * xh[i]
+            if store:
+                px_out[j, i] = pxj
+                py_out[j, i] = pyj
+                slip_out[j, i] = slipping
     da = dx * dy
-    fx = spx.sum(axis=1) * da
-    fy = spy.sum(axis=1) * da
-    mz = (a * sxpy.sum(axis=1) - (y * spx).sum(axis=1)) * da
-    slip_fraction = nslip.sum(axis=1) / n_in
-    return fx, fy, mz, slip_fraction
+    sx = 0.0
+    sy = 0.0
+    sxy = 0.0
+    syx = 0.0
+    sns = 0.0
+    for j in range(ny):
+        sx += spx[j]
+        sy += spy[j]
+        sxy += sxpy[j]
+        syx += (b * yh[j]) * spx[j]
+        sns += nslip[j]
+    return sx * da, sy * da, (a * sxy - syx) * da, sns / n_in
+
+
+# --- the loops over contacts (compiled on first use) ------------------------------------------
+
+#: From this many contacts the FASTSIM marches run on several threads.
+FASTSIM_PARALLEL_MIN = 500
+#: Contacts per chunk of the FASTSIM drivers.
+FASTSIM_CHUNK = 16
+
+
+@jitable
+def _at(x, c):
+    """x[c], or x[0] for an array of one value shared by every contact."""
+    return x[c] if x.size > 1 else x[0]
+
+
+@jitable
+def _contact_flexibilities(xi, eta, phi, fz, a, b, mu, g, nu, l1, l2, l3, mode, c):
+    """Contact c's creepages (limited, :func:`limit_creepage`)
+    and flexibilities: Kalker's (mode 0), blended (1) or given in l1, l2, l3 (2)."""
+    x, y, p = limit_creepage(_at(xi, c), _at(eta, c), _at(phi, c), _at(a, c))
+    if mode == 2:
+        return x, y, p, _at(l1, c), _at(l2, c), _at(l3, c)
+    ac = _at(a, c)
+    bc = _at(b, c)
+    c11, c22, c23, _ = kalker_law(ac / bc, _at(nu, c))
+    f1, f2, f3 = fastsim_flexibilities(ac, bc, x, y, p, _at(fz, c), _at(mu, c), _at(g, c), c11,
+                                       c22, c23, mode == 1)  # fmt: skip
+    return x, y, p, f1, f2, f3
+
+
+@kernel(nogil=True)
+def _march_chunks(xi, eta, phi, fz, a, b, mu, g, nu, l1, l2, l3, mode, rect, p1, p2, p3, p4, q1,
+                  q2, s1, s2, out, px_out, py_out, slip_out, store, first, last):  # fmt: skip
+    """FASTSIM of the contacts of chunks first to last - 1 (of FASTSIM_CHUNK contacts) into out
+    (4, n): fx, fy, mz, slip fraction; the tractions and slip flags into px_out, py_out,
+    slip_out (n, ny, nx) if ``store``. The layout's factors: on the strips (``rect`` False,
+    :func:`fastsim_strips`) p1-p4 = eta_j, sq, tx, gy and s1 = norm; on CONTACT's grid
+    (:func:`fastsim_rectangular`) p1, p2 = xh, yh, q1, q2 = mask, shape, s1, s2 = scale,
+    n_in."""
+    work = np.empty((max(STRIPS_WORK_ROWS, RECT_WORK_ROWS), p2.size))
+    for c in range(first * FASTSIM_CHUNK, min(last * FASTSIM_CHUNK, out.shape[1])):
+        x, y, p, f1, f2, f3 = _contact_flexibilities(xi, eta, phi, fz, a, b, mu, g, nu, l1, l2,
+                                                     l3, mode, c)  # fmt: skip
+        k = c if store else 0
+        if rect:
+            res = fastsim_rectangular(x, y, p, _at(fz, c), _at(a, c), _at(b, c), _at(mu, c), f1,
+                                      f2, f3, s1, p1, p2, q1, q2, s2, work, px_out[k],
+                                      py_out[k], slip_out[k], store)  # fmt: skip
+        else:
+            res = fastsim_strips(x, y, p, _at(fz, c), _at(a, c), _at(b, c), _at(mu, c), f1, f2,
+                                 f3, p1, p2, p3, p4, s1, work, px_out[k], py_out[k],
+                                 slip_out[k], store)  # fmt: skip
+        out[0, c], out[1, c], out[2, c], out[3, c] = res
+    return 0
+
+
+def _run(inputs, rect, vectors, grids, scalars, store):
+    """Run the FASTSIM loop over the contacts; ``inputs`` the 12 per-contact arrays (length n
+    or 1) and the mode, then the layout's factors. Returns (fx, fy, mz, slip fraction)."""
+    n = max(x.size for x in inputs[:12])
+    out = np.empty((4, n))
+    if store is None:
+        store = (np.empty((1, 1, 1)), np.empty((1, 1, 1)), np.empty((1, 1, 1), bool), False)
+    else:
+        store = (*store, True)
+    run_chunks(_march_chunks, (*inputs, rect, *vectors, *grids, *scalars, out, *store),
+               -(-n // FASTSIM_CHUNK), n >= FASTSIM_PARALLEL_MIN)  # fmt: skip
+    return out
+
+
+_NO_GRID = np.zeros((1, 1))
+
+
+def march_strips(xi, eta, phi, fz, a, b, mu, g, nu, l1, l2, l3, mode, pattern, store=None):
+    """FASTSIM on Kalker's strips for n contacts: read-only 1-d float64 arrays of length n or
+    1 (:func:`railadhesion.numerics.flatten`), validated; ``mode`` 0 (Kalker's
+    flexibilities), 1 (blended) or 2 (l1, l2, l3 given; else they are ignored); ``pattern``
+    from :func:`_grid_pattern`; ``store`` None or (px, py, slip) arrays (n, ny, nx) for
+    the tractions and slip flags. Returns (fx, fy, mz, slip_fraction) as a (4, n) array."""
+    eta_j, sq, tx, gy, norm = pattern
+    return _run((xi, eta, phi, fz, a, b, mu, g, nu, l1, l2, l3, mode), False,
+                (eta_j, sq, tx, gy), (_NO_GRID, _NO_GRID), (float(norm), 0.0), store)
+
+
+def march_rect(xi, eta, phi, fz, a, b, mu, g, nu, l1, l2, l3, mode, scale, rect, store=None):
+    """FASTSIM on CONTACT's rectangular grid for n contacts; as :func:`march_strips`, ``rect``
+    from :func:`_rect_pattern`."""
+    xh, yh, mask, shape, n_in = rect
+    return _run((xi, eta, phi, fz, a, b, mu, g, nu, l1, l2, l3, mode), True, (xh, yh, xh, yh),
+                (mask, shape), (float(scale), float(n_in)), store)
+
+
+@kernel
+def _strips_one(xi, eta, phi, fz, a, b, mu, g, nu, mode, eta_j, sq, tx, gy, norm):
+    x, y, p = limit_creepage(xi, eta, phi, a)
+    c11, c22, c23, _ = kalker_law(a / b, nu)
+    f1, f2, f3 = fastsim_flexibilities(a, b, x, y, p, fz, mu, g, c11, c22, c23, mode == 1)
+    work = np.empty((STRIPS_WORK_ROWS, eta_j.size))
+    none = np.empty((1, 1))
+    return fastsim_strips(x, y, p, fz, a, b, mu, f1, f2, f3, eta_j, sq, tx, gy, norm, work, none,
+                          none, none > 0.0, False)  # fmt: skip
+
+
+def strips_one(xi, eta, phi, fz, a, b, mu, g, nu, mode, pattern):
+    """FASTSIM on Kalker's strips for one contact given as valid floats, Kalker's (mode 0) or
+    blended (1) flexibilities: (fx, fy, mz, slip_fraction)."""
+    eta_j, sq, tx, gy, norm = pattern
+    return _strips_one(xi, eta, phi, fz, a, b, mu, g, nu, mode, eta_j, sq, tx, gy, float(norm))

@@ -31,16 +31,28 @@ import numpy as np
 
 from railadhesion._labelled import labelled
 from railadhesion._validate import check_finite, check_positive, check_range
+from railadhesion.numerics import jitable, kernel, read_only
 from railadhesion.plausibility import input_checker
 
-__all__ = ["KalkerCoefficients", "kalker_coefficients", "linear_creep_forces"]
+__all__ = [
+    "AOB_MAX",
+    "AOB_MIN",
+    "KalkerCoefficients",
+    "axis_ratio",
+    "kalker_asymptotes",
+    "kalker_coefficients",
+    "kalker_law",
+    "kalker_rows",
+    "kalker_scalar",
+    "linear_creep_forces",
+]
 
 #: Smallest tabulated g = min(a/b, b/a); below it the asymptotes apply.
 _G_MIN = 0.1
 #: Accepted range of a/b. Beyond it the asymptotes over- or underflow (g**2, g**1.5, 1/g):
 #: no contact ellipse is that slender, and a clear error beats inf, NaN or a RuntimeWarning.
-_AOB_MIN = 1e-150
-_AOB_MAX = 1e150
+AOB_MIN = 1e-150
+AOB_MAX = 1e150
 
 
 class KalkerCoefficients(NamedTuple):
@@ -96,59 +108,168 @@ def _load_table() -> tuple[np.ndarray, np.ndarray]:
 
 _COORD, _TABLE = _load_table()
 _NROW = _COORD.size  # 19
-_ROWS = np.ascontiguousarray(np.moveaxis(_TABLE, -1, 0))  # (19 rows, 4 coefficients, 3 nu)
-_ROWS_LIST = _ROWS.tolist()
+# (19 rows, 4 coefficients, 3 nu); compiled code freezes global arrays as constants
+_ROWS = np.ascontiguousarray(np.moveaxis(_TABLE, -1, 0))
 # C33 on the a > b branch at its last two rows (b/a = 0.1 and 0.2), per Poisson column; for
 # b/a < 0.1 C33 is extended as a power law through these two rows (after the nu interpolation).
-_C33_GT_ROWS = (_TABLE[3, :, -1].copy(), _TABLE[3, :, -2].copy())
-_C33_GT_ROWS_LIST = (_C33_GT_ROWS[0].tolist(), _C33_GT_ROWS[1].tolist())
+_C33_01 = np.ascontiguousarray(_TABLE[3, :, -1])
+_C33_02 = np.ascontiguousarray(_TABLE[3, :, -2])
 
 
-def _nu_weights(nu: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Lagrange weights of the parabola in 1/C through nu = 0, 0.25, 0.5 (CONTACT linrol)."""
+_LOG2 = math.log(2.0)
+_LOG4 = math.log(4.0)
+_PI = math.pi
+
+
+@jitable
+def _nu_blend(w0, w1, w2, c0, c1, c2):
+    """C at nu from the columns C(0), C(1/4), C(1/2) and the Lagrange weights w0, w1, w2 of the
+    parabola in 1/C through nu = 0, 0.25, 0.5 (CONTACT linrol)."""
+    return 1.0 / (w0 / c0 + w1 / c1 + w2 / c2)
+
+
+@jitable
+def kalker_asymptotes(g, nu, le):
+    """Kalker's small-g asymptotes (C11, C22, C23, C33) of the branch a/b = g -> 0 (``le``
+    True) or b/a = g -> 0 (False; C33 NaN there, see :func:`kalker_coefficients`, Notes).
+
+    Kalker (1990), Table E.3, as in CONTACT ``linrol``; the C33 of the a/b branch is the
+    strip-theory limit pi^2/(16 (1 - nu) g) (this library's extrapolation).
+    """
+    if le:
+        return (
+            _PI**2 / (4.0 * (1.0 - nu)),
+            _PI**2 / 4.0,
+            _PI * math.sqrt(g) / (3.0 * (1.0 - nu)) * (1.0 + nu * (math.log(16.0 / g) - 5.0)),
+            _PI**2 / (16.0 * (1.0 - nu) * g),
+        )
+    lam = math.log(16.0 / g**2)
+    k = 3.0 - _LOG4
+    den = (1.0 - nu) * lam + 2.0 * nu
+    return (
+        2.0 * _PI / ((lam - 2.0 * nu) * g) * (1.0 + k / (lam - 2.0 * nu)),
+        (2.0 * _PI / g) * (1.0 + (1.0 - nu) * k / den) / den,
+        2.0 * _PI / (3.0 * g**1.5 * ((1.0 - nu) * lam - 2.0 + 4.0 * nu)),
+        math.nan,
+    )
+
+
+@jitable(inline="never")
+def kalker_law(a_over_b, nu):
+    """Kalker's C11, C22, C23, C33 at a/b and Poisson's ratio nu: the law of
+    :func:`kalker_coefficients` (its Notes), for one contact, without validation (a/b in
+    [AOB_MIN, AOB_MAX], nu in [0, 0.5]).
+
+    The table row pair is found from ``t = g`` (a <= b) or ``2 - g`` (a > b), rows 0.1 apart,
+    snapping round-off so that table points are exact; the coefficients are linear in t
+    between the rows, the parabola in 1/C across nu, and below g = 0.1 the corrected
+    asymptotes. A plain function compiled where compiled code calls it (not inlined: it is
+    large and called from several places); from Python call the compiled
+    :data:`kalker_scalar`.
+    """
+    le = a_over_b <= 1.0
+    g = a_over_b if le else 1.0 / a_over_b
     w0 = 8.0 * (nu - 0.25) * (nu - 0.5)
     w1 = -16.0 * (nu - 0.5) * nu
     w2 = 8.0 * nu * (nu - 0.25)
-    return w0, w1, w2
+    t = g if le else 2.0 - g
+    s = (min(max(t, 0.1), 1.9) - 0.1) * 10.0
+    sr = math.floor(s + 0.5)
+    if abs(s - sr) < 1e-9:
+        s = sr
+    i = min(int(s), _NROW - 2)
+    f = s - i
+    out0 = out1 = out2 = out3 = 0.0
+    for k in range(4):
+        c0 = _ROWS[i, k, 0] * (1.0 - f) + _ROWS[i + 1, k, 0] * f
+        c1 = _ROWS[i, k, 1] * (1.0 - f) + _ROWS[i + 1, k, 1] * f
+        c2 = _ROWS[i, k, 2] * (1.0 - f) + _ROWS[i + 1, k, 2] * f
+        c = _nu_blend(w0, w1, w2, c0, c1, c2)
+        if k == 0:
+            out0 = c
+        elif k == 1:
+            out1 = c
+        elif k == 2:
+            out2 = c
+        else:
+            out3 = c
+    if g >= _G_MIN:
+        return out0, out1, out2, out3
+    # the asymptote times 1 + (r - 1) g/0.1, r = table/asymptote at g = 0.1 (continuous there)
+    a0, a1, a2, a3 = kalker_asymptotes(g, nu, le)
+    b0, b1, b2, b3 = kalker_asymptotes(_G_MIN, nu, le)
+    h = g / _G_MIN
+    r0 = a0 * (1.0 + (out0 / b0 - 1.0) * h)
+    r1 = a1 * (1.0 + (out1 / b1 - 1.0) * h)
+    r2 = a2 * (1.0 + (out2 / b2 - 1.0) * h)
+    if le:
+        r3 = a3 * (1.0 + (out3 / b3 - 1.0) * h)
+    else:  # C33, b/a -> 0: the power law through b/a = 0.1 and 0.2
+        c33_01 = _nu_blend(w0, w1, w2, _C33_01[0], _C33_01[1], _C33_01[2])
+        c33_02 = _nu_blend(w0, w1, w2, _C33_02[0], _C33_02[1], _C33_02[2])
+        r3 = c33_01 * h ** (math.log(c33_02 / c33_01) / _LOG2)
+    return r0, r1, r2, r3
 
 
-def _nu_blend(w, c0, c1, c2):
-    """C at nu from the columns C(0), C(1/4), C(1/2) and the weights ``w`` of :func:`_nu_weights`.
-
-    The parabola in 1/C (CONTACT linrol): ``1/C = w0/C(0) + w1/C(1/4) + w2/C(1/2)``.
-    """
-    return 1.0 / (w[0] / c0 + w[1] / c1 + w[2] / c2)
+#: The most distinct (a/b, nu) pairs :func:`kalker_rows` remembers in a chunk.
+_MEMO = 8
 
 
-def _asymptotes(g: np.ndarray, nu: np.ndarray, le: np.ndarray) -> np.ndarray:
-    """Kalker's small-g asymptotes of C11, C22, C23, C33; shape (4, *g.shape).
+@jitable(inline="never")
+def kalker_rows(buf, ratio_row, nu_row, out_row, chunk, m):
+    """Kalker's C11, C22, C23 (:func:`kalker_law`) of the m contacts of a chunk buffer (rows
+    of ``chunk`` values in the 1-d ``buf``: a/b in row ``ratio_row``, nu in ``nu_row``) into
+    the rows ``out_row`` to ``out_row + 2``. A lookup cache of a batch loop, not a law: each
+    distinct (a/b, nu) is looked up once (an a/b that is constant up to rounding takes a few
+    values); after :data:`_MEMO` distinct pairs the rest contact by contact. Returns False if
+    an a/b is outside [AOB_MIN, AOB_MAX] (its coefficients are then those of a/b = 1)."""
+    memo = np.empty((_MEMO, 5))
+    used = 0
+    last = -1
+    ok = True
+    rb, nb, ob = ratio_row * chunk, nu_row * chunk, out_row * chunk
+    for k in range(m):
+        r = buf[rb + k]
+        nk = buf[nb + k]
+        j = last
+        if j < 0 or not (memo[j, 0] == r and memo[j, 1] == nk):
+            j = -1
+            for e in range(used):
+                if memo[e, 0] == r and memo[e, 1] == nk:
+                    j = e
+                    break
+        if j >= 0:
+            c11, c22, c23 = memo[j, 2], memo[j, 3], memo[j, 4]
+            last = j
+        else:
+            if not AOB_MIN <= r <= AOB_MAX:
+                ok = False
+                r = 1.0
+            c11, c22, c23, _ = kalker_law(r, nk)
+            if used < _MEMO:
+                memo[used, 0] = buf[rb + k]
+                memo[used, 1] = nk
+                memo[used, 2], memo[used, 3], memo[used, 4] = c11, c22, c23
+                last = used
+                used += 1
+        buf[ob + k] = c11
+        buf[ob + chunk + k] = c22
+        buf[ob + 2 * chunk + k] = c23
+    return ok
 
-    ``le`` selects the branch a/b = g -> 0 (True) or b/a = g -> 0 (False). C33 is only
-    provided on the a/b -> 0 branch (strip theory, see kalker_coefficients Notes); on the
-    other branch the returned C33 is a placeholder (NaN) that the caller replaces.
-    """
-    pi = np.pi
-    one_m_nu = 1.0 - nu
-    # a/b = g -> 0 (contact wide laterally, short in rolling direction)
-    c11_le = pi**2 / (4.0 * one_m_nu)
-    c22_le = np.full_like(g, pi**2 / 4.0)
-    c23_le = pi * np.sqrt(g) / (3.0 * one_m_nu) * (1.0 + nu * (np.log(16.0 / g) - 5.0))
-    c33_le = pi**2 / (16.0 * one_m_nu * g)
-    # b/a = g -> 0 (contact long in rolling direction), Lambda = ln(16/g^2)
-    lam = np.log(16.0 / g**2)
-    k = 3.0 - np.log(4.0)
-    c11_gt = 2.0 * pi / ((lam - 2.0 * nu) * g) * (1.0 + k / (lam - 2.0 * nu))
-    den = one_m_nu * lam + 2.0 * nu
-    c22_gt = (2.0 * pi / g) * (1.0 + one_m_nu * k / den) / den
-    c23_gt = 2.0 * pi / (3.0 * g**1.5 * (one_m_nu * lam - 2.0 + 4.0 * nu))
-    return np.stack(
-        [
-            np.where(le, c11_le, c11_gt),
-            np.where(le, c22_le, c22_gt),
-            np.where(le, c23_le, c23_gt),
-            np.where(le, c33_le, np.nan),
-        ]
-    )
+
+#: Compiled :func:`kalker_law`, (c11, c22, c23, c33) of one contact (built on first call;
+#: its numba dispatcher, for numba code: :func:`railadhesion.models.kernels.kalker_scalar`).
+kalker_scalar = kernel(kalker_law)
+
+
+@kernel(nogil=True)
+def _kalker_into(a_over_b, nu, out):
+    """Kalker's coefficients of 1-d arrays a/b and nu (length n or 1) into out (4, n)."""
+    sr = 1 if a_over_b.size > 1 else 0
+    sn = 1 if nu.size > 1 else 0
+    for i in range(out.shape[1]):
+        out[0, i], out[1, i], out[2, i], out[3, i] = kalker_law(a_over_b[i * sr], nu[i * sn])
 
 
 @labelled(units="1")
@@ -203,6 +324,9 @@ def kalker_coefficients(a_over_b, poisson) -> KalkerCoefficients:
     in 1/C is not monotonic in nu near nu = 0.05 and makes C33 rise slightly (about 1 %)
     with a/b beyond a/b = 7 for 0.04 <= nu <= 0.16.
 
+    Implementation: :func:`kalker_law`, compiled (numba; for arrays in a loop over the
+    contacts).
+
     References
     ----------
     J. J. Kalker, *Three-dimensional elastic bodies in rolling contact*, Kluwer, 1990,
@@ -217,94 +341,15 @@ def kalker_coefficients(a_over_b, poisson) -> KalkerCoefficients:
     >>> [round(float(x), 3) for x in kalker_coefficients(1.6, 0.28)]
     [4.824, 4.484, 2.188, 0.895]
     """
-    r = check_range(a_over_b, "a_over_b", _AOB_MIN, _AOB_MAX)
+    r = check_range(a_over_b, "a_over_b", AOB_MIN, AOB_MAX)
     nu = check_range(poisson, "poisson", 0.0, 0.5)
-    if r.ndim == 0 and nu.ndim == 0:
-        return KalkerCoefficients(*_coefficients_scalar(float(r), float(nu)))
-    if r.shape != nu.shape:
-        r, nu = np.broadcast_arrays(r, nu)
-    le = r <= 1.0
-    g = np.where(le, r, 1.0 / r)
-    t = np.where(le, g, 2.0 - g)
-    # position in the table (rows 0.1 apart); snap round-off so table points are exact
-    s = (np.clip(t, _COORD[0], _COORD[-1]) - _COORD[0]) * 10.0
-    s_round = np.round(s)
-    s = np.where(np.abs(s - s_round) < 1e-9, s_round, s)
-    i = np.minimum(s.astype(np.intp), _NROW - 2)
-    f = (s - i)[..., None, None]
-    cg = _ROWS[i] * (1.0 - f) + _ROWS[i + 1] * f  # (*shape, 4 coefficients, 3 nu columns)
-    w = _nu_weights(nu[..., None])
-    coef = np.moveaxis(_nu_blend(w, cg[..., 0], cg[..., 1], cg[..., 2]), -1, 0)
-
-    small = g < _G_MIN
-    if np.any(small):
-        gs, nus, les = g[small], nu[small], le[small]
-        asym = _asymptotes(gs, nus, les)
-        asym01 = _asymptotes(np.full_like(gs, _G_MIN), nus, les)
-        # where g < 0.1, ``coef`` holds the table value at g = 0.1 (t was clipped above)
-        corrected = asym * (1.0 + (coef[:, small] / asym01 - 1.0) * (gs / _G_MIN))
-        # C33 on the b/a -> 0 branch: nu parabola at b/a = 0.1 and 0.2, then a power law in g
-        w_small = _nu_weights(nus)
-        r01, r02 = _C33_GT_ROWS
-        c33_01 = _nu_blend(w_small, *r01)
-        c33_02 = _nu_blend(w_small, *r02)
-        c33_gt = c33_01 * (gs / _G_MIN) ** (np.log(c33_02 / c33_01) / np.log(2.0))
-        corrected[3] = np.where(les, corrected[3], c33_gt)
-        coef[:, small] = corrected
-    return KalkerCoefficients(coef[0], coef[1], coef[2], coef[3])
-
-
-def _coefficients_scalar(r: float, nu: float) -> tuple[float, float, float, float]:
-    """Same as :func:`kalker_coefficients` for one (already validated) pair, in plain floats."""
-    le = r <= 1.0
-    g = r if le else 1.0 / r
-    w = _nu_weights(nu)
-    t = g if le else 2.0 - g
-    s = (min(max(t, 0.1), 1.9) - 0.1) * 10.0
-    if abs(s - round(s)) < 1e-9:
-        s = float(round(s))
-    i = min(int(s), _NROW - 2)
-    f = s - i
-    lo, hi = _ROWS_LIST[i], _ROWS_LIST[i + 1]
-    coef = []
-    for k in range(4):
-        c0 = lo[k][0] * (1.0 - f) + hi[k][0] * f
-        c1 = lo[k][1] * (1.0 - f) + hi[k][1] * f
-        c2 = lo[k][2] * (1.0 - f) + hi[k][2] * f
-        coef.append(_nu_blend(w, c0, c1, c2))
-    if g >= _G_MIN:
-        return tuple(coef)
-    asym = _asymptotes_scalar(g, nu, le)
-    asym01 = _asymptotes_scalar(_G_MIN, nu, le)
-    h = g / _G_MIN
-    out = [a * (1.0 + (c / a01 - 1.0) * h) for a, a01, c in zip(asym, asym01, coef, strict=True)]
-    if not le:
-        r01, r02 = _C33_GT_ROWS_LIST
-        c33_01 = _nu_blend(w, *r01)
-        c33_02 = _nu_blend(w, *r02)
-        out[3] = c33_01 * (g / _G_MIN) ** (math.log(c33_02 / c33_01) / math.log(2.0))
-    return tuple(out)
-
-
-def _asymptotes_scalar(g: float, nu: float, le: bool) -> tuple[float, float, float, float]:
-    """Scalar version of :func:`_asymptotes` for one branch (C33 NaN on the b/a branch)."""
-    pi = math.pi
-    if le:
-        return (
-            pi**2 / (4.0 * (1.0 - nu)),
-            pi**2 / 4.0,
-            pi * math.sqrt(g) / (3.0 * (1.0 - nu)) * (1.0 + nu * (math.log(16.0 / g) - 5.0)),
-            pi**2 / (16.0 * (1.0 - nu) * g),
-        )
-    lam = math.log(16.0 / g**2)
-    k = 3.0 - math.log(4.0)
-    den = (1.0 - nu) * lam + 2.0 * nu
-    return (
-        2.0 * pi / ((lam - 2.0 * nu) * g) * (1.0 + k / (lam - 2.0 * nu)),
-        (2.0 * pi / g) * (1.0 + (1.0 - nu) * k / den) / den,
-        2.0 * pi / (3.0 * g**1.5 * ((1.0 - nu) * lam - 2.0 + 4.0 * nu)),
-        math.nan,
-    )
+    if r.ndim == 0 and nu.ndim == 0:  # one contact: one compiled call
+        return KalkerCoefficients(*kalker_scalar.dispatcher(float(r), float(nu)))
+    shape = np.broadcast_shapes(r.shape, nu.shape)
+    coef = np.empty((4, math.prod(shape)))
+    _kalker_into(*(read_only(np.ascontiguousarray(np.broadcast_to(x, shape)).reshape(-1))
+                   if x.size > 1 else read_only(x.reshape(1)) for x in (r, nu)), coef)  # fmt: skip
+    return KalkerCoefficients(*(c.reshape(shape) for c in coef))
 
 
 def axis_ratio(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -312,9 +357,9 @@ def axis_ratio(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     :func:`kalker_coefficients` (no overflow warning for absurd pairs such as 1e300/1e-300)."""
     with np.errstate(over="ignore", under="ignore"):
         r = np.true_divide(a, b)
-    if not np.all((r >= _AOB_MIN) & (r <= _AOB_MAX)):
+    if not np.all((r >= AOB_MIN) & (r <= AOB_MAX)):
         raise ValueError(
-            f"a, b: the axis ratio a/b must be in [{_AOB_MIN:g}, {_AOB_MAX:g}], got "
+            f"a, b: the axis ratio a/b must be in [{AOB_MIN:g}, {AOB_MAX:g}], got "
             f"{np.ravel(r)[:3].tolist()}"
         )
     return r

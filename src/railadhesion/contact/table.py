@@ -36,47 +36,24 @@ import math
 from functools import lru_cache
 from importlib import resources
 
-import numba
 import numpy as np
 from llvmlite import ir
-from numba import njit, types
+from numba import types
 from numba.extending import intrinsic
 
-from railadhesion import _jit
 from railadhesion._validate import (
     as_float_array,
     check_finite,
     check_nonnegative,
     check_positive,
 )
-from railadhesion.contact.exact import _check_friction_law
-from railadhesion.contact.kalker import kalker_coefficients
-from railadhesion.models import kernels as _models_kernels
-from railadhesion.models.kernels import (
-    _TASKS_PER_THREAD,
-    _atan_nonneg,
-    _chunk,
-    _exp_into,
-    _fill,
-    _thread_pool,
-)
-from railadhesion.models.kernels import kalker_scalar as _kalker_scalar
+from railadhesion.contact.exact import check_friction_law
+from railadhesion.contact.friction import falling_friction_factor
+from railadhesion.contact.kalker import kalker_coefficients, kalker_scalar
+from railadhesion.numerics import atan_nonneg, chunk_of, fill, jit, run_chunks
 from railadhesion.plausibility import input_checker
 
 __all__ = ["exact_table_forces", "table_axes"]
-
-# The kernels below inline njit helpers of railadhesion.models.kernels, which numba's cache of
-# this file does not track: a checksum of that module is compiled in, and a mismatch drops
-# this module's cached code (railadhesion._jit.guard_cache).
-_DEPENDENCY_FINGERPRINT = _jit.source_checksum(_models_kernels)
-
-
-@njit(cache=True)
-def _compiled_dependency_fingerprint():
-    return _DEPENDENCY_FINGERPRINT
-
-
-_jit.guard_cache(_compiled_dependency_fingerprint, __file__, _DEPENDENCY_FINGERPRINT)
 
 #: Poisson's ratio of the table.
 TABLE_POISSON = 0.28
@@ -187,8 +164,8 @@ def _locate_uniform(v, v0, inv_h, n):
     return i, q - i
 
 
-_catmull_rom_jit = njit(cache=True, error_model="numpy", inline="always")(_catmull_rom)
-_locate_jit = njit(cache=True, error_model="numpy", inline="always")(_locate_uniform)
+_catmull_rom_jit = jit(inline="always")(_catmull_rom)
+_locate_jit = jit(inline="always")(_locate_uniform)
 
 
 @lru_cache(maxsize=32)
@@ -234,7 +211,12 @@ def _contract(typingctx, tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd2, w
     (t, theta) pair are 4 _NOUT contiguous doubles, loaded and accumulated as one vector
     (numba does not vectorise such short fixed loops itself: they are unrolled before its
     loop vectoriser runs, and its SLP vectoriser is off). The products are summed along
-    theta, then t, then u."""
+    theta, then t, then u.
+
+    Why hand-written IR: the same sums in plain numba code (``tests/contact/
+    test_table_kernel.py``, which holds this function to it) made the whole lookup about three
+    times slower (measured side by side, one thread; docs/kernels.md).
+    The only LLVM IR of the package; it uses numba's public extension API (``intrinsic``)."""
     f64 = types.float64
     if not (isinstance(tab, types.Array) and tab.dtype == f64 and tab.ndim == 1
             and tab.layout == "C" and all(isinstance(v, types.Integer) for v in (base, st, sd))
@@ -291,34 +273,27 @@ def _contract(typingctx, tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd2, w
 # Polach kernels, railadhesion.models.kernels).
 
 
-@njit(cache=True, error_model="numpy")
+@jit
 def _friction_factor(xs, ys, lvs, las, lbs, rows, m):
-    """Falling friction: the coefficient's factor (1 - A) exp(-B V |(xi, eta)|) + A (Polach's
-    global slip velocity) and its inverse, into rows; 1 where A = 1 or B V = 0."""
-    fac, inv, arg, tmp = rows[_R_FAC], rows[_R_INV], rows[_R_ARG], rows[_R_TMP]
+    """Falling friction: the coefficient's factor mu/mu0 (:func:`falling_friction_factor`) at
+    Polach's global slip velocity V |(xi, eta)|, and its inverse, into rows."""
+    fac, inv = rows[_R_FAC], rows[_R_INV]
     for k in range(m):
-        arg[k] = -(lbs[k] * lvs[k]) * math.sqrt(xs[k] * xs[k] + ys[k] * ys[k])
-    _exp_into(arg, fac, tmp, m)
-    for k in range(m):  # beyond _exp_into's range (exp(x) < 1e-304): libm's exp
-        if not arg[k] >= -700.0:
-            fac[k] = math.exp(arg[k])
-    for k in range(m):
-        ra = las[k]
-        falling = (ra != 1.0) & (lbs[k] * lvs[k] > 0.0)
-        fac[k] = (1.0 - ra) * fac[k] + ra if falling else 1.0
+        w = lvs[k] * math.sqrt(xs[k] * xs[k] + ys[k] * ys[k])
+        fac[k] = falling_friction_factor(w, las[k], lbs[k])
     for k in range(m):
         f = fac[k]
         inv[k] = 1.0 / (f if f > 0.0 else 1.0) if f > 0.0 else 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@jit
 def _scaled(cs, factor, inv, out, m):
     """out = cs factor inv (Kalker-scaled creepage of the looked-up coefficient)."""
     for k in range(m):
         out[k] = cs[k] * factor[k] * inv[k]
 
 
-@njit(cache=True, error_model="numpy")
+@jit
 def _coordinates(rows, m):
     """Kalker-scaled (X, Y, S) -> table coordinates (t, theta, u) in place, reflected into
     X >= 0, Y >= 0 (point symmetry: all outputs change sign; mirror in y: Fy and Mz change
@@ -336,19 +311,19 @@ def _coordinates(rows, m):
         y = sy * y
         p = sy * p
         r = math.sqrt(x * x + y * y)
-        xr[k] = _TWO_PI * _atan_nonneg(r / R0)
+        xr[k] = _TWO_PI * atan_nonneg(r / R0)
         # direction in [0, pi/2] from the smaller over the larger of x, y (both >= 0 here)
         hi = max(x, y)
         lo = min(x, y)
-        a = _atan_nonneg(lo / (hi if hi > 0.0 else 1.0))
+        a = atan_nonneg(lo / (hi if hi > 0.0 else 1.0))
         yr[k] = 0.5 * math.pi - a if y > x else a
-        u = _TWO_PI * _atan_nonneg(abs(p) / S0)
+        u = _TWO_PI * atan_nonneg(abs(p) / S0)
         pr[k] = -u if p < 0.0 else u
         sgr[k] = sgn
         syr[k] = sy
 
 
-@njit(cache=True, error_model="numpy")
+@jit
 def _weights(v, v0, inv_h, n, stride, base, w, m):
     """Cubic weights along one axis into w[0..3]; the axis' part of the contact's first
     table row (node index times ``stride``) added to base."""
@@ -363,7 +338,7 @@ def _weights(v, v0, inv_h, n, stride, base, w, m):
         base[k] = base[k] + i * stride
 
 
-@njit(cache=True, error_model="numpy")
+@jit
 def _gather(tab, rows, m, st, sd, sa):
     """The interpolated outputs of each contact (sa > 0: also along log(a/b), the planes sa
     apart)."""
@@ -393,7 +368,7 @@ def _gather(tab, rows, m, st, sd, sa):
         f2[k] = a2
 
 
-@njit(cache=True, error_model="numpy")
+@jit
 def _cap(f0, f1, m):
     """|(Fx, Fy)| / (mu Fz) capped at 1 (Coulomb's bound)."""
     for k in range(m):
@@ -405,7 +380,7 @@ def _cap(f0, f1, m):
         f1[k] = a1 / c
 
 
-@njit(cache=True, error_model="numpy")
+@jit
 def _forces(rows, kfs, kms, ox, oy, oz, m):
     """Forces and moment from the normalised outputs: signs, mu Fz and mu Fz c scales."""
     sgr, syr, fac = rows[_R_SGN], rows[_R_SY], rows[_R_FAC]
@@ -419,7 +394,7 @@ def _forces(rows, kfs, kms, ox, oy, oz, m):
         oz[k] = sgn * sy * fac[k] * kms[k] * f2[k]
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@jit(nogil=True)
 def _lookup_chunks(tab, dims, strides, origin, inv_step, laob, xi, eta, phi, kx, ky, ks, kf,
                    km, lv, la, lb, out, first, last):  # fmt: skip
     """Cubic (Catmull-Rom) interpolation, per axis, of the 3 outputs at Kalker-scaled
@@ -451,7 +426,7 @@ def _lookup_chunks(tab, dims, strides, origin, inv_step, laob, xi, eta, phi, kx,
     m0 = max(min(_CHUNK, n), 1)
     single = np.empty((12, m0))  # values shared by all contacts, repeated over a chunk
     for j, x in enumerate((laob, xi, eta, phi, kx, ky, ks, kf, km, lv, la, lb)):
-        _fill(single[j], x[0] if x.size > 0 else 0.0, m0)
+        fill(single[j], x[0] if x.size > 0 else 0.0, m0)
     rows = np.empty((_ROWS, m0))
     # Coulomb friction for every contact (one test for the whole call)
     coulomb = (
@@ -461,39 +436,39 @@ def _lookup_chunks(tab, dims, strides, origin, inv_step, laob, xi, eta, phi, kx,
         and not (la[0] != 1.0 and lb[0] * lv[0] > 0.0)
     )
     if coulomb:
-        _fill(rows[_R_FAC], 1.0, m0)
-        _fill(rows[_R_INV], 1.0, m0)
+        fill(rows[_R_FAC], 1.0, m0)
+        fill(rows[_R_INV], 1.0, m0)
     for c in range(first, last):
         lo = c * _CHUNK
         hi = min(lo + _CHUNK, n)
         m = hi - lo
-        xs = _chunk(xi, single[1], lo, hi)
-        ys = _chunk(eta, single[2], lo, hi)
+        xs = chunk_of(xi, single[1], lo, hi)
+        ys = chunk_of(eta, single[2], lo, hi)
         if not coulomb:
-            _friction_factor(xs, ys, _chunk(lv, single[9], lo, hi),
-                             _chunk(la, single[10], lo, hi), _chunk(lb, single[11], lo, hi),
+            _friction_factor(xs, ys, chunk_of(lv, single[9], lo, hi),
+                             chunk_of(la, single[10], lo, hi), chunk_of(lb, single[11], lo, hi),
                              rows, m)  # fmt: skip
         inv = rows[_R_INV]
-        _scaled(xs, _chunk(kx, single[4], lo, hi), inv, rows[_R_X], m)
-        _scaled(ys, _chunk(ky, single[5], lo, hi), inv, rows[_R_Y], m)
-        _scaled(_chunk(phi, single[3], lo, hi), _chunk(ks, single[6], lo, hi), inv, rows[_R_S],
+        _scaled(xs, chunk_of(kx, single[4], lo, hi), inv, rows[_R_X], m)
+        _scaled(ys, chunk_of(ky, single[5], lo, hi), inv, rows[_R_Y], m)
+        _scaled(chunk_of(phi, single[3], lo, hi), chunk_of(ks, single[6], lo, hi), inv, rows[_R_S],
                 m)  # fmt: skip
         _coordinates(rows, m)
         base = rows[_R_BASE]
-        _fill(base, 0.0, m)
+        fill(base, 0.0, m)
         _weights(rows[_R_X], origin[1], inv_step[1], nt, st, base, rows[_R_WT : _R_WT + 4], m)
         _weights(rows[_R_Y], origin[2], inv_step[2], nd, sd, base, rows[_R_WD : _R_WD + 4], m)
         _weights(rows[_R_S], origin[3], inv_step[3], nu, su, base, rows[_R_WU : _R_WU + 4], m)
         if sa > 0:
-            laobs = _chunk(laob, single[0], lo, hi)
+            laobs = chunk_of(laob, single[0], lo, hi)
             _weights(laobs, origin[0], inv_step[0], na, sa, base, rows[_R_WA : _R_WA + 4], m)
         _gather(tab, rows, m, st, sd, sa)
         _cap(rows[_R_F0], rows[_R_F1], m)
-        _forces(rows, _chunk(kf, single[7], lo, hi), _chunk(km, single[8], lo, hi),
+        _forces(rows, chunk_of(kf, single[7], lo, hi), chunk_of(km, single[8], lo, hi),
                 out[0, lo:hi], out[1, lo:hi], out[2, lo:hi], m)  # fmt: skip
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@jit(nogil=True)
 def _lookup_one(tab, dims, strides, origin, inv_step, laob, xi, eta, phi, kx, ky, ks, kf, km,
                 lv, la, lb):  # fmt: skip
     """:func:`_lookup_chunks` for one contact given as floats, on the full 4-D table
@@ -532,7 +507,7 @@ def _scalar_forces(xi, eta, phi, fz, a, b, mu, g, nu, speed, ratio, decay):
     aob = a / b
     if not AOB_MIN * (1 - 1e-12) <= aob <= AOB_MAX * (1 + 1e-12):
         return None
-    c11, c22, c23, _ = _kalker_scalar(aob, nu)
+    c11, c22, c23, _ = kalker_scalar(aob, nu)
     c = math.sqrt(a * b)
     tau = mu * (1.5 / math.pi) * fz / (a * b * g)
     f = (1.5 / math.pi) / tau if tau > 0.0 else 0.0
@@ -547,10 +522,8 @@ def _interp(d, laob, shape, xi, eta, phi, kx, ky, ks, kf, km, lv, la, lb):
     """Fx, Fy, Mz of the contacts (``shape``); every input broadcasts to ``shape``. One a/b
     for all contacts (the usual case) is looked up in a 3-D slice of the table.
 
-    From _PARALLEL_MIN contacts on, the chunks are split into tasks run by
-    ``numba.get_num_threads()`` Python threads (the kernel releases the GIL; the package's
-    pool, as Polach's kernels: handed out one by one, so that a thread held up on a busy
-    machine is balanced by the others)."""
+    From _PARALLEL_MIN contacts on, the chunks run on ``numba.get_num_threads()`` threads
+    (:func:`railadhesion.numerics.run_chunks`; the kernel releases the GIL)."""
     n = math.prod(shape)
 
     def flat(v):  # length 1 (shared) or n; anything else is broadcast out; read-only
@@ -571,17 +544,7 @@ def _interp(d, laob, shape, xi, eta, phi, kx, ky, ks, kf, km, lv, la, lb):
         table, laobs = d["padded_flat"], flat(laob)
     head = (table, d["dims"], d["strides"], d["origin"], d["inv_step"], laobs, *args, out)
     nchunk = (n + _CHUNK - 1) // _CHUNK
-    nthreads = numba.get_num_threads() if n >= _PARALLEL_MIN else 1
-    if nthreads <= 1 or nchunk < 2:
-        _lookup_chunks(*head, 0, nchunk)
-    else:
-        ntask = min(nchunk, _TASKS_PER_THREAD * nthreads)
-        bounds = [nchunk * t // ntask for t in range(ntask + 1)]
-        pool = _thread_pool(nthreads)
-        tasks = [pool.submit(_lookup_chunks, *head, bounds[t], bounds[t + 1])
-                 for t in range(ntask)]  # fmt: skip
-        for task in tasks:
-            task.result()
+    run_chunks(_lookup_chunks, head, nchunk, n >= _PARALLEL_MIN)
     return out.reshape(3, *shape)
 
 
@@ -656,15 +619,9 @@ def exact_table_forces(
     up to about 0.4 % near full sliding). Accuracy against the exact solver:
     ``docs/validation/exact_models.md``.
 
-    **Cost** (``benchmarks/bench_exact.py --table``, 2-core machine shared with other jobs,
-    load average 1.1): with one a/b for all contacts, about 0.05 us per contact at 2e5
-    and 1e6 contacts with spin, 2.2-2.6 times the package's vectorised
-    :func:`~railadhesion.models.polach.polach_forces` on the same contacts, with Coulomb or
-    falling friction and at nu = 0.25 alike (1.7-3.3 times over five runs, with the load);
-    with a/b varying per contact about 0.6 us. One contact given as Python floats takes a
-    scalar path (checks in plain Python, one compiled call): about 7 us a call (polach_forces
-    2.8 us in the same run; before this path, about 190 us).
-    Parallel from 1e5 contacts (``numba.get_num_threads()`` threads).
+    **Cost**: ``benchmarks/bench_exact.py --table`` (figures in ``docs/performance.md``). One
+    contact given as Python floats takes a scalar path (checks in plain Python, one compiled
+    call). Parallel from 1e5 contacts (``numba.get_num_threads()`` threads).
 
     **Falling friction.** The exact solution with a slip-velocity dependent coefficient has
     a coefficient that varies over the contact with the local slip velocity; the table
@@ -722,7 +679,7 @@ def exact_table_forces(
             f"poisson must be in [{POISSON_MIN}, {POISSON_MAX}] for the table model (tabulated "
             f"at {TABLE_POISSON}, validated over that range), got {poisson!r}"
         )
-    ratio, decay, v = _check_friction_law(speed, friction_ratio, friction_decay)
+    ratio, decay, v = check_friction_law(speed, friction_ratio, friction_decay)
     aob = a_ / b_
     if not np.all((aob >= AOB_MIN * (1 - 1e-12)) & (aob <= AOB_MAX * (1 + 1e-12))):
         raise ValueError(f"a/b must be in [{AOB_MIN}, {AOB_MAX}] for the table model")

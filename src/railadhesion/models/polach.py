@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 
@@ -35,11 +34,48 @@ from railadhesion._validate import (
     check_positive,
     check_range,
 )
-from railadhesion.contact.kalker import _AOB_MAX, _AOB_MIN, axis_ratio, kalker_coefficients
+from railadhesion.contact.friction import falling_friction_factor
+from railadhesion.contact.kalker import (
+    AOB_MAX,
+    AOB_MIN,
+    axis_ratio,
+    kalker_law,
+    kalker_rows,
+    kalker_scalar,
+)
 from railadhesion.models.parameters import PolachParameters, polach_parameters
+from railadhesion.numerics import (
+    CHUNK,
+    FINITE,
+    FRACTION,
+    NONNEGATIVE,
+    POISSON,
+    POSITIVE,
+    as_scalars,
+    atan_nonneg,
+    count_outside,
+    exp,
+    fill,
+    fill_row,
+    flatten,
+    hypot,
+    jitable,
+    kernel,
+    load_row,
+    output_chunk,
+    run_chunks,
+)
 from railadhesion.plausibility import input_checker
 
-__all__ = ["Polach", "PolachContact", "polach_forces"]
+__all__ = [
+    "Polach",
+    "PolachContact",
+    "polach_contact_terms",
+    "polach_curve",
+    "polach_force",
+    "polach_forces",
+    "polach_law",
+]
 
 _TWO_OVER_PI = 2.0 / math.pi
 _PI_OVER_4 = math.pi / 4.0
@@ -48,15 +84,285 @@ _PI_OVER_4 = math.pi / 4.0
 # clipped: F_yS ~ |s_yC| / (1 + eps_psi^2)^2 with eps_psi proportional to |s_yC|, so a clipped
 # eps_psi would let F_yS grow without bound at huge creepages; (1 + eps_psi^2) = inf gives 0.
 _EPS_MAX = 1e50
-_SCALAR_TYPES = (float, int, np.float64)
 _INF = math.inf
 
 
-@lru_cache(maxsize=4096)
-def _kalker_scalar(a_over_b: float, poisson: float) -> tuple[float, float, float]:
-    """C11, C22, C23 for scalar inputs, memoised (repeated geometries cost ~0.1 us)."""
-    c = kalker_coefficients(a_over_b, poisson)
-    return float(c.c11), float(c.c22), float(c.c23)
+# --- the law (plain functions compiled where compiled code calls them) ----------------------
+
+
+@jitable(inline="always")
+def polach_contact_terms(sx, sy, psi, a, b, g, c11, c22, c23):
+    """The parameter-independent part of Polach's model for one contact (the formulas of
+    :func:`polach_forces`, Notes; shared by WILAC's four conditions):
+    (s_C, s, pi G a b c_jj s_C / 4, |s_yC|, K_psi, (8/3) G c^3 C23 |s_yC| / a,
+    G c^3 C23 psi / s_C), c = sqrt(ab); the last is 0 without spin or creepage."""
+    syc = sy + psi * a
+    syc = syc if abs(syc) > abs(sy) else sy
+    sc = hypot(sx, syc)
+    s = hypot(sx, sy)
+    cjj = hypot(c11 * sx, c22 * sy) / s if s > 0.0 else c22
+    eps_num = _PI_OVER_4 * g * a * b * cjj * sc
+    abs_syc = abs(syc)
+    k_psi = 1.0 + 6.3 * (1.0 - exp(-(a / b)))
+    gc3c23 = g * a * b * math.sqrt(a * b) * c23
+    epsp_num = 8.0 / 3.0 * gc3c23 / a * abs_syc
+    fys_pre = gc3c23 * (psi / sc) if (psi != 0.0) & (sc > 0.0) else 0.0
+    return sc, s, eps_num, abs_syc, k_psi, epsp_num, fys_pre
+
+
+@jitable(inline="always")
+def polach_force(sx, sy, q, v, sc, s, eps_num, abs_syc, k_psi, epsp_num, fys_pre, k_a, k_s,
+                 mu0, big_a, big_b):  # fmt: skip
+    """Polach's forces (fx, fy) [N] of one contact from its :func:`polach_contact_terms` and
+    one parameter set (k_A, k_S, mu0, A, B): the falling friction at the slip velocity
+    s_C V, the force law, the spin term and the spin cap of :func:`polach_forces`, Notes.
+    Zero without creepage, or when friction is gone (A = 0 and exp(-B w) underflowed)."""
+    qmu = q * (mu0 * falling_friction_factor(sc * v, big_a, big_b))
+    eps = min(eps_num / qmu, _EPS_MAX)
+    x = k_a * eps
+    f_over_sc = _TWO_OVER_PI * qmu * (x / (1.0 + x * x) + atan_nonneg(k_s * eps)) / sc
+    eps_psi = epsp_num / (k_psi * qmu)
+    e2 = 1.0 + eps_psi * eps_psi  # may be inf: then F_yS = 0
+    # |psi|/s_C <= 2/a and |s_yC|/e2 is bounded: this order cannot overflow
+    fys = fys_pre * (abs_syc / e2) / e2
+    fx = -f_over_sc * sx
+    fy = -(f_over_sc * sy + fys)
+    # spin cap at max(mu Q, |F of the creepage part|): removes only the overshoot of F_yS
+    limit = max(qmu, f_over_sc * s)
+    total = hypot(fx, fy)
+    scale = limit / total if (fys != 0.0) & (total > limit) else 1.0
+    active = (sc > 0.0) & (qmu > 0.0)
+    return (fx * scale if active else 0.0), (fy * scale if active else 0.0)
+
+
+@jitable(inline="always")
+def polach_law(creep_x, creep_y, spin, normal_force, speed, a, b, G, nu, c11, c22, c23, k_A,
+               k_S, mu0, A, B):  # fmt: skip
+    """Polach's forces (fx, fy) [N] of one contact, Kalker's signs (:func:`polach_forces`,
+    without validation). ``c11 <= 0`` looks Kalker's C11, C22, C23 up from a/b and nu
+    (:func:`railadhesion.contact.kalker.kalker_law`); else they are used as given.
+
+    Compiled: :func:`railadhesion.models.kernels.polach_scalar`.
+    """
+    if not c11 > 0.0:
+        c11, c22, c23, _ = kalker_law(a / b, nu)
+    t = polach_contact_terms(creep_x, creep_y, spin, a, b, G, c11, c22, c23)
+    return polach_force(creep_x, creep_y, normal_force, speed, t[0], t[1], t[2], t[3], t[4],
+                        t[5], t[6], k_A, k_S, mu0, A, B)  # fmt: skip
+
+
+@jitable
+def polach_curve(creep, slope, inverse_mu, ratio):
+    """Polach's (2005) adhesion-creep curve without falling friction, and two derivatives.
+
+    ``creep`` >= 0 the creep magnitude [-], ``slope`` > 0 the initial slope d(F/Q)/d creep,
+    ``inverse_mu`` >= 0 the inverse of the friction coefficient mu (the curve's asymptote; 0
+    gives the straight line), ``ratio`` = k_S / k_A > 0. Returns ``(F/Q, d/d creep,
+    d/d slope)``.
+
+    Polach (Wear 258 (2005) 992-1000; ``docs`` MODELS §3) for pure longitudinal creepage,
+    A = 1 (no falling friction): ``F/Q = (2 mu/pi) (k_A eps/(1 + (k_A eps)**2) +
+    arctan(k_S eps))`` with ``eps = K creep / mu`` (K = (pi/4) G a b C11 / Q), whose initial
+    slope is ``slope = (2/pi)(k_A + k_S) K``. With ``x = k_A eps = pi slope creep q /
+    (2 (1 + ratio))``: ``F/Q = (2/pi) z (1/(1 + x**2) + ratio atan(ratio x)/(ratio x))``,
+    ``z = x / q``, finite at q = 0 (the line ``slope * creep``); d/d creep =
+    ``slope F'(x)/(1 + ratio)`` and d/d slope = ``creep F'(x)/(1 + ratio)`` with
+    ``F'(x) = (1 - x**2)/(1 + x**2)**2 + ratio/(1 + (ratio x)**2)``. Written for the on-board
+    monitor's estimator; compiled: :func:`railadhesion.models.kernels.polach_curve_scalar`.
+    """
+    z = math.pi * slope * creep / (2.0 * (1.0 + ratio))
+    x = z * inverse_mu
+    y = ratio * x
+    g = math.atan(y) / y if y > 1e-6 else 1.0 - y * y / 3.0
+    xx = x * x
+    f = 2.0 / math.pi * z * (1.0 / (1.0 + xx) + ratio * g)
+    fp = (1.0 - xx) / ((1.0 + xx) * (1.0 + xx)) + ratio / (1.0 + y * y)
+    return f, slope * fp / (1.0 + ratio), creep * fp / (1.0 + ratio)
+
+
+# --- compiled entry points (numba, built on first use) ---------------------------------------
+
+#: Compiled :func:`polach_law`: (fx, fy) of one contact, no validation (its numba dispatcher,
+#: for numba code: :func:`railadhesion.models.kernels.polach_scalar`).
+polach_scalar = kernel(polach_law)
+
+
+@jitable
+def polach_bad_input(sx, sy, psi, q, v, a, b, g, nu, k_a, k_s, mu0, big_a, big_b):
+    """Position (in :func:`polach_law`'s argument order) of the first argument outside the
+    range :func:`polach_forces` accepts, 17 for an a/b outside Kalker's range, or -1."""
+    if not math.isfinite(sx):
+        return 0
+    if not math.isfinite(sy):
+        return 1
+    if not math.isfinite(psi):
+        return 2
+    if not 0.0 < q < _INF:
+        return 3
+    if not 0.0 <= v < _INF:
+        return 4
+    if not 0.0 < a < _INF:
+        return 5
+    if not 0.0 < b < _INF:
+        return 6
+    if not 0.0 < g < _INF:
+        return 7
+    if not 0.0 <= nu <= 0.5:
+        return 8
+    if not 0.0 < k_a <= 1.0:
+        return 12
+    if not 0.0 < k_s <= 1.0:
+        return 13
+    if not 0.0 < mu0 < _INF:
+        return 14
+    if not 0.0 <= big_a < _INF:
+        return 15
+    if not 0.0 <= big_b < _INF:
+        return 16
+    if not AOB_MIN <= a / b <= AOB_MAX:
+        return 17
+    return -1
+
+
+@kernel
+def polach_checked(creep_x, creep_y, spin, normal_force, speed, a, b, G, nu, c11, c22, c23,
+                   k_A, k_S, mu0, A, B):  # fmt: skip
+    """:func:`polach_law` with validation: (fx, fy, bad), ``bad`` = -1 if every argument is in
+    range, else :func:`polach_bad_input` (the forces are then NaN)."""
+    bad = polach_bad_input(creep_x, creep_y, spin, normal_force, speed, a, b, G, nu, k_A, k_S,
+                           mu0, A, B)  # fmt: skip
+    if bad >= 0:
+        return math.nan, math.nan, bad
+    fx, fy = polach_law(creep_x, creep_y, spin, normal_force, speed, a, b, G, nu, c11, c22, c23,
+                        k_A, k_S, mu0, A, B)  # fmt: skip
+    return fx, fy, -1
+
+
+@kernel
+def _contact_forces(creep_x, creep_y, spin, normal_force, speed, data):
+    """:func:`polach_law` with one contact's fixed data ``data`` = (a, b, G, nu, c11, c22, c23,
+    k_A, k_S, mu0, A, B) (:class:`PolachContact`)."""
+    return polach_law(creep_x, creep_y, spin, normal_force, speed, data[0], data[1], data[2],
+                      data[3], data[4], data[5], data[6], data[7], data[8], data[9], data[10],
+                      data[11])  # fmt: skip
+
+
+def _contact_kernel():
+    """The dispatcher of :func:`_contact_forces`, compiled for float64 arguments only: other
+    numbers (ints, NumPy scalars) are converted by numba's dispatcher instead of compiling
+    new versions."""
+    dispatcher = _contact_forces.dispatcher
+    if not dispatcher.signatures:
+        dispatcher.compile("UniTuple(float64, 2)(float64, float64, float64, float64, float64, "
+                           "float64[::1])")  # fmt: skip
+        dispatcher.disable_compile()
+    return dispatcher
+
+
+# Rows of the chunk buffer of the batch loops of Polach and WILAC (rows of CHUNK values): the
+# contact's inputs, a/b and Kalker's coefficients first (ROW_X to ROW_C23, shared by both
+# loops), then each model's own rows. One buffer, rows a constant CHUNK apart: the loop over a
+# chunk reads one array at known distances and writes few, which LLVM vectorises with few
+# run-time aliasing checks (a loop reading many arrays needs a check per pair and is not
+# vectorised).
+ROW_X, ROW_Y, ROW_PSI, ROW_Q, ROW_V, ROW_A, ROW_B, ROW_G, ROW_NU = range(9)
+ROW_RATIO, ROW_C11, ROW_C22, ROW_C23 = range(9, 13)
+CONTACT_ROWS = 13
+_MU0, _KA, _KS, _BA, _BB = range(CONTACT_ROWS, CONTACT_ROWS + 5)
+_ROWS = CONTACT_ROWS + 5
+# the rows of the driver's 14 inputs, in their order
+_INPUT_ROWS = (ROW_X, ROW_Y, ROW_PSI, ROW_Q, ROW_V, ROW_A, ROW_B, ROW_G, ROW_NU, _MU0, _KA, _KS,
+               _BA, _BB)  # fmt: skip
+#: From this many contacts the batch loop runs on ``numba.get_num_threads()`` threads
+#: (below, thread start-up and waiting for a descheduled thread cost more than the work).
+PARALLEL_MIN = 100_000
+
+
+@jitable
+def polach_count_bad(sx, sy, psi, q, v, a, b, g, nu, lo, m):
+    """Number of values of the contact inputs of :func:`polach_forces` outside their ranges
+    among contacts lo to lo + m (arrays of n values, or of one value for every contact)."""
+    return (count_outside(sx, FINITE, lo, m) + count_outside(sy, FINITE, lo, m)
+            + count_outside(psi, FINITE, lo, m) + count_outside(q, POSITIVE, lo, m)
+            + count_outside(v, NONNEGATIVE, lo, m) + count_outside(a, POSITIVE, lo, m)
+            + count_outside(b, POSITIVE, lo, m) + count_outside(g, POSITIVE, lo, m)
+            + count_outside(nu, POISSON, lo, m))  # fmt: skip
+
+
+@jitable
+def polach_fixed_shape(a, b, nu, buf, c11_row, count):
+    """If a, b and nu hold one value each: Kalker's C11, C22, C23 looked up once, into the
+    rows ``c11_row`` to ``c11_row + 2`` (``count`` values each); returns (fixed, ok), ``ok``
+    False if that a/b is outside Kalker's range."""
+    if not (a.size == 1 and b.size == 1 and nu.size == 1):
+        return False, True
+    r = a[0] / b[0]
+    ok = AOB_MIN <= r <= AOB_MAX and 0.0 <= nu[0] <= 0.5
+    c11, c22, c23, _ = kalker_law(r if ok else 1.0, nu[0] if ok else 0.25)
+    fill(buf[c11_row * CHUNK :], c11, count)
+    fill(buf[(c11_row + 1) * CHUNK :], c22, count)
+    fill(buf[(c11_row + 2) * CHUNK :], c23, count)
+    return True, ok
+
+
+@jitable
+def chunk_coefficients(buf, fixed, m):
+    """Kalker's coefficients of a chunk's contacts into rows ROW_C11 to ROW_C23 (unless
+    ``fixed``: then filled once per call by :func:`polach_fixed_shape`); False if an a/b is
+    outside Kalker's range."""
+    if fixed:
+        return True
+    for k in range(m):
+        buf[ROW_RATIO * CHUNK + k] = buf[ROW_A * CHUNK + k] / buf[ROW_B * CHUNK + k]
+    return kalker_rows(buf, ROW_RATIO, ROW_NU, ROW_C11, CHUNK, m)
+
+
+@jitable(inline="always")
+def chunk_contact_terms(buf, k):
+    """:func:`polach_contact_terms` of contact k of a chunk buffer."""
+    return polach_contact_terms(
+        buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k], buf[ROW_PSI * CHUNK + k],
+        buf[ROW_A * CHUNK + k], buf[ROW_B * CHUNK + k], buf[ROW_G * CHUNK + k],
+        buf[ROW_C11 * CHUNK + k], buf[ROW_C22 * CHUNK + k], buf[ROW_C23 * CHUNK + k])  # fmt: skip
+
+
+@kernel(nogil=True)
+def _polach_chunks(sx, sy, psi, q, v, a, b, g, nu, mu0, k_a, k_s, big_a, big_b, fx, fy, first,
+                   last):  # fmt: skip
+    """:func:`polach_law` of the contacts of chunks ``first`` to ``last - 1`` (of CHUNK
+    contacts) into fx, fy (length n); the other arguments are 1-d float64 arrays of length n
+    or 1 (one value for every contact). Validates in the same pass; returns the number of
+    chunks with an argument out of range (their forces are NaN)."""
+    n = fx.size
+    count = min(CHUNK, n)
+    buf = np.empty(_ROWS * CHUNK)
+    inputs = (sx, sy, psi, q, v, a, b, g, nu, mu0, k_a, k_s, big_a, big_b)
+    for j in range(14):
+        fill_row(buf, _INPUT_ROWS[j], inputs[j], count)
+    fixed, shape_ok = polach_fixed_shape(a, b, nu, buf, ROW_C11, count)
+    nbad = 0
+    for c in range(first, last):
+        lo = c * CHUNK
+        m = min(CHUNK, n - lo)
+        bad = polach_count_bad(sx, sy, psi, q, v, a, b, g, nu, lo, m) + (
+            count_outside(mu0, POSITIVE, lo, m) + count_outside(k_a, FRACTION, lo, m)
+            + count_outside(k_s, FRACTION, lo, m) + count_outside(big_a, NONNEGATIVE, lo, m)
+            + count_outside(big_b, NONNEGATIVE, lo, m))  # fmt: skip
+        for j in range(14):
+            load_row(buf, _INPUT_ROWS[j], inputs[j], lo, m)
+        ok = chunk_coefficients(buf, fixed, m) and bad == 0 and shape_ok
+        ox, oy = output_chunk(fx, fy, lo, m, ok)  # views: the loop writes the outputs directly
+        if not ok:
+            nbad += 1
+            continue
+        for k in range(m):  # the law, inlined: vectorised
+            t = chunk_contact_terms(buf, k)
+            ox[k], oy[k] = polach_force(
+                buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k], buf[ROW_Q * CHUNK + k],
+                buf[ROW_V * CHUNK + k], t[0], t[1], t[2], t[3], t[4], t[5], t[6],
+                buf[_KA * CHUNK + k], buf[_KS * CHUNK + k], buf[_MU0 * CHUNK + k],
+                buf[_BA * CHUNK + k], buf[_BB * CHUNK + k])  # fmt: skip
+    return nbad
 
 
 @labelled(units=("N", "N"))
@@ -154,13 +460,13 @@ def polach_forces(
 
     C11, C22, C23 come from :func:`railadhesion.contact.kalker.kalker_coefficients` at a/b.
 
-    Implementation: compiled kernels (:mod:`railadhesion.models.kernels`, numba, compiled on
-    first use and cached on disk) evaluate the model, validating in the same pass; the
-    Kalker lookup is done once per call when a/b and nu are constant. The NumPy reference
-    (``_polach_reference`` for arrays, ``_polach_scalar`` for scalars) is the readable
-    implementation the tests hold the kernels to (1e-12 relative); it also raises the errors
-    naming the argument. For repeated calls on one contact see :class:`PolachContact`; from
-    numba code, :func:`railadhesion.models.kernels.polach_scalar`.
+    Implementation: the law is :func:`polach_law` (:func:`polach_contact_terms`,
+    :func:`polach_force`), compiled (numba, on first use, cached on disk) and looped over the
+    contacts by :mod:`railadhesion.models.kernels`, validating in the same pass; the Kalker
+    lookup is done once per call when a/b and nu are constant. The tests hold it to an
+    independent NumPy oracle (``tests/oracles/polach.py``) at 1e-12 relative. For repeated
+    calls on one contact see :class:`PolachContact`; from numba code,
+    :func:`railadhesion.models.kernels.polach_scalar`.
 
     Implementation detail [derived here]: substituting delta, Polach's K_M simplifies
     exactly to K_M = -(2/3) eps_psi / (1 + eps_psi^2)^2, hence
@@ -232,118 +538,24 @@ def polach_forces(
         creep_long, creep_lat, spin, normal_force, speed, a, b,
         mu0, k_A, k_S, A, B, shear_modulus, poisson,
     )  # fmt: skip
-    scalars = _scalars(args)
+    scalars = as_scalars(args)
     if scalars is None:
         out = _polach_array(*args)
         _PLAUSIBLE(args)  # implausible inputs warn (docs/checks.md); errors were raised above
         return out
     sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu = scalars
-    fx, fy, bad = _kernels().polach_checked(
+    fx, fy, bad = polach_checked.dispatcher(
         sx, sy, psi, q, v, a, b, g, nu, 0.0, 0.0, 0.0, k_a, k_s, mu0, big_a, big_b
     )
     if bad >= 0:
-        _polach_scalar(*scalars)  # the reference scalar path raises the error naming it
-        raise AssertionError("polach kernel flagged an input the reference accepts")
+        check_polach_inputs(*scalars)  # raises the error naming the argument
+        raise AssertionError("polach kernel flagged an input the checks accept")
     _PLAUSIBLE(scalars)  # implausible inputs warn (docs/checks.md)
     return np.float64(fx), np.float64(fy)
 
 
-def _scalars(values) -> tuple | list | None:
-    """``values`` for the scalar fast path, or ``None`` if any of them is not a real scalar.
-
-    Python and NumPy scalars and 0-d arrays qualify (no array work is then needed); ``float``
-    and ``numpy.float64`` are passed through, ints, other NumPy scalars and 0-d arrays become
-    floats (so that the compiled kernels see one signature).
-    """
-    for v in values:  # the common case first: Python floats only
-        if type(v) is not float:
-            break
-    else:
-        return values
-    scalars = []
-    for v in values:
-        t = type(v)
-        if t is float or t is np.float64:
-            scalars.append(v)
-        elif t is int:
-            scalars.append(float(v))
-        elif isinstance(v, np.generic | np.ndarray) and v.ndim == 0 and v.dtype.kind in "fiu":
-            scalars.append(float(v))
-        else:
-            return None
-    return scalars
-
-
 def _bad(name: str, rng: str, value) -> ValueError:
     return ValueError(f"{name} must be in {rng}, got {float(value)!r}")
-
-
-def _polach_scalar(
-    sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu, check_contact=True
-):
-    """Scalar path of :func:`polach_forces` with the ``math`` module (a few microseconds).
-
-    ``check_contact=False`` checks only the five model parameters: for a caller (WILAC) that
-    evaluates several parameter sets on one contact whose other inputs an earlier call with
-    ``check_contact=True`` has already validated.
-    """
-    isf = math.isfinite
-    if check_contact:
-        for name, val in (("creep_long", sx), ("creep_lat", sy), ("spin", psi)):
-            if not isf(val):
-                raise ValueError(f"{name} must be finite (no NaN or inf), got {float(val)!r}")
-        positive = (
-            ("normal_force", q), ("a", a), ("b", b), ("mu0", mu0), ("shear_modulus", g),
-        )  # fmt: skip
-        nonnegative = (("speed", v), ("A", big_a), ("B", big_b))
-    else:
-        positive = (("mu0", mu0),)
-        nonnegative = (("A", big_a), ("B", big_b))
-    for name, val in (("k_A", k_a), ("k_S", k_s)):
-        if not 0.0 < val <= 1.0:  # NaN fails too
-            raise _bad(name, "(0.0, 1.0]", val)
-    for name, val in positive:
-        if not (val > 0 and isf(val)):
-            raise _bad(name, "(0, inf)", val)
-    for name, val in nonnegative:
-        if not (val >= 0 and isf(val)):
-            raise _bad(name, "[0, inf)", val)
-    if check_contact and not 0.0 <= nu <= 0.5:
-        raise _bad("poisson", "[0.0, 0.5]", nu)
-
-    a_over_b = a / b
-    if not _AOB_MIN <= a_over_b <= _AOB_MAX:  # kalker_coefficients' range; message names a, b
-        axis_ratio(np.float64(a), np.float64(b))
-    c11, c22, c23 = _kalker_scalar(a_over_b, float(nu))
-    syc = sy + psi * a
-    if not abs(syc) > abs(sy):
-        syc = sy
-    sc = math.hypot(sx, syc)
-    if sc == 0.0:  # then psi == 0 too: no creepage, no force
-        return np.float64(0.0), np.float64(0.0)
-    s = math.hypot(sx, sy)
-    cjj = math.hypot(c11 * sx, c22 * sy) / s if s > 0.0 else c22
-    mu = mu0 * ((1.0 - big_a) * math.exp(-big_b * sc * v) + big_a)
-    qmu = q * mu
-    if qmu == 0.0:  # A = 0 and exp(-B w) underflowed: no friction left, no force
-        return np.float64(0.0), np.float64(0.0)
-    eps = min(_PI_OVER_4 * g * a * b * cjj * sc / qmu, _EPS_MAX)
-    x = k_a * eps
-    f_over_sc = _TWO_OVER_PI * qmu * (x / (1.0 + x * x) + math.atan(k_s * eps)) / sc
-    k_psi = 1.0 + 6.3 * (1.0 - math.exp(-a_over_b))
-    gc3c23 = g * a * b * math.sqrt(a * b) * c23
-    eps_psi = 8.0 / 3.0 * gc3c23 / a * abs(syc) / (k_psi * qmu)
-    e2 = 1.0 + eps_psi * eps_psi  # may be inf (float overflow): then F_yS = 0
-    # |psi|/s_C <= 2/a and |s_yC|/e2 is bounded: this order cannot overflow (a product
-    # psi*|s_yC| first would, for huge creepages, and give inf*0 = NaN after the cap)
-    fys = gc3c23 * (psi / sc) * (abs(syc) / e2) / e2
-    fx, fy = -f_over_sc * sx, -(f_over_sc * sy + fys)
-    if fys != 0.0:  # spin cap (see Notes): removes only the overshoot the spin term adds
-        limit = max(qmu, f_over_sc * math.hypot(sx, sy))
-        total = math.hypot(fx, fy)
-        if total > limit:
-            fx, fy = fx * (limit / total), fy * (limit / total)
-    return np.float64(fx), np.float64(fy)
 
 
 _ARG_NAMES = (
@@ -354,103 +566,46 @@ _ARG_NAMES = (
 _PLAUSIBLE = input_checker(_ARG_NAMES)
 
 
-_KERNELS = []
-
-
-def _kernels():
-    """The compiled kernels (:mod:`railadhesion.models.kernels`), imported on first use so
-    that ``import railadhesion`` does not import numba."""
-    if _KERNELS:
-        return _KERNELS[0]
-    from railadhesion.models import kernels
-
-    _KERNELS.append(kernels)
-    return kernels
-
-
 def _polach_array(*args):
-    """Array path of :func:`polach_forces`: the compiled kernel, validated in the same pass.
-
-    Gives the numbers of :func:`_polach_reference` (to rounding). If any argument is out of
-    range, the reference runs to raise the error naming it.
-    """
+    """Array path of :func:`polach_forces`: the compiled batch kernel, validated in the same
+    pass; if any argument is out of range, :func:`_check_inputs` raises the error naming it."""
     arrays = [as_float_array(x, name) for x, name in zip(args, _ARG_NAMES, strict=True)]
-    k = _kernels()
-    shape, n, flat = k.flatten_args(arrays)
-    fx, fy, ok = k.polach_many(flat, n)
-    if not ok:
-        _polach_reference(*arrays)  # raises the ValueError naming the argument
-        raise AssertionError("polach kernel flagged an input the reference accepts")
+    shape, n, flat = flatten(arrays)
+    sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu = flat
+    fx = np.empty(n)  # allocated by NumPy: its large arrays are reused from call to call
+    fy = np.empty(n)
+    nbad = run_chunks(_polach_chunks, (sx, sy, psi, q, v, a, b, g, nu, mu0, k_a, k_s, big_a,
+                                       big_b, fx, fy), -(-n // CHUNK), n >= PARALLEL_MIN)
+    if sum(nbad):
+        check_polach_inputs(*arrays)
+        raise AssertionError("polach kernel flagged an input the checks accept")
     if not shape:
         return np.float64(fx[0]), np.float64(fy[0])
     return fx.reshape(shape), fy.reshape(shape)
 
 
-def _polach_reference(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu):
-    """NumPy reference of the array path of :func:`polach_forces` (validated, broadcast, no
-    Python loops): the readable implementation the compiled kernel is tested against."""
-    sx = check_finite(sx, "creep_long")
-    sy = check_finite(sy, "creep_lat")
-    psi = check_finite(psi, "spin")
-    q = check_positive(q, "normal_force")
-    v = check_nonnegative(v, "speed")
-    a = check_positive(a, "a")
-    b = check_positive(b, "b")
-    mu0 = check_positive(mu0, "mu0")
-    k_a = check_range(k_a, "k_A", 0.0, 1.0, closed="right")
-    k_s = check_range(k_s, "k_S", 0.0, 1.0, closed="right")
-    big_a = check_nonnegative(big_a, "A")
-    big_b = check_nonnegative(big_b, "B")
-    g = check_positive(g, "shear_modulus")
-    nu = check_range(nu, "poisson", 0.0, 0.5)
-
-    a_over_b = axis_ratio(a, b)
-    coef = kalker_coefficients(a_over_b, nu)
-    c11, c22, c23 = coef.c11, coef.c22, coef.c23
-
-    syc = sy + psi * a
-    syc = np.where(np.abs(syc) > np.abs(sy), syc, sy)
-    sc = np.hypot(sx, syc)
-    moving = sc > 0.0
-    sc_safe = np.where(moving, sc, 1.0)
-    s = np.hypot(sx, sy)
-    has_s = s > 0.0
-    cjj = np.where(has_s, np.hypot(c11 * sx, c22 * sy) / np.where(has_s, s, 1.0), c22)
-
-    mu = mu0 * ((1.0 - big_a) * np.exp(-big_b * (sc * v)) + big_a)
-    qmu = q * mu
-    # qmu == 0 only if A = 0 and exp(-B w) underflowed: no friction left, no force
-    active = moving & (qmu > 0.0)
-    qmu = np.where(qmu > 0.0, qmu, 1.0)
-    k_psi = 1.0 + 6.3 * (1.0 - np.exp(-a_over_b))
-    gc3c23 = g * a * b * np.sqrt(a * b) * c23
-    abs_syc = np.abs(syc)
-    with np.errstate(over="ignore"):  # huge gradients become inf (eps is then clipped)
-        eps = np.minimum(_PI_OVER_4 * g * a * b * cjj * sc / qmu, _EPS_MAX)
-        eps_psi = (8.0 / 3.0) * gc3c23 / a * abs_syc / (k_psi * qmu)
-        e2 = 1.0 + eps_psi * eps_psi  # inf gives F_yS = 0
-    x = k_a * eps
-    f_over_sc = _TWO_OVER_PI * qmu * (x / (1.0 + x * x) + np.arctan(k_s * eps)) / sc_safe
-    fys = gc3c23 * (psi / sc_safe) * (abs_syc / e2) / e2  # same order as the scalar path
-
-    fx = np.where(active, -f_over_sc * sx, 0.0)
-    fy = np.where(active, -(f_over_sc * sy + fys), 0.0)
-    total = np.hypot(fx, fy)
-    # spin cap at max(mu Q, |F|) where F_yS != 0 (see Notes); divide only where it applies
-    # (limit/total of a tiny force would overflow)
-    limit = np.maximum(qmu, f_over_sc * np.hypot(sx, sy))
-    over = (total > limit) & (fys != 0.0) & active
-    scale = np.where(over, limit / np.where(over, total, 1.0), 1.0)
-    fx, fy = fx * scale, fy * scale
-    if fx.ndim == 0:
-        return np.float64(fx), np.float64(fy)
-    # the five parameters may not reach fx (e.g. spin-only shapes): broadcast both fully
-    shape = np.broadcast_shapes(fx.shape, fy.shape)
-    if fx.shape != shape:
-        fx = np.broadcast_to(fx, shape).copy()
-    if fy.shape != shape:
-        fy = np.broadcast_to(fy, shape).copy()
-    return fx, fy
+def check_polach_inputs(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu,
+                        contact=True):  # fmt: skip
+    """Raise the ``ValueError`` naming the first argument of :func:`polach_forces` (in the
+    order of its signature) outside its range; ``contact=False`` checks only the five model
+    parameters. The compiled paths validate in the same pass and call this to raise."""
+    if contact:
+        check_finite(sx, "creep_long")
+        check_finite(sy, "creep_lat")
+        check_finite(psi, "spin")
+        check_positive(q, "normal_force")
+        check_nonnegative(v, "speed")
+        check_positive(a, "a")
+        check_positive(b, "b")
+    check_positive(mu0, "mu0")
+    check_range(k_a, "k_A", 0.0, 1.0, closed="right")
+    check_range(k_s, "k_S", 0.0, 1.0, closed="right")
+    check_nonnegative(big_a, "A")
+    check_nonnegative(big_b, "B")
+    if contact:
+        check_positive(g, "shear_modulus")
+        check_range(nu, "poisson", 0.0, 0.5)
+        axis_ratio(np.asarray(a, float), np.asarray(b, float))
 
 
 @dataclass(frozen=True)
@@ -528,7 +683,7 @@ class PolachContact:
     once); :meth:`forces` then evaluates :func:`polach_forces` for new creepages (and
     optionally a new speed or normal force) through the compiled scalar kernel
     (:func:`railadhesion.models.kernels.polach_scalar`, compiled for float64 arguments only:
-    ints and NumPy scalars are converted), well under a microsecond a call, and returns
+    ints and NumPy scalars are converted), and returns
     Python floats. The same numbers as :func:`polach_forces` with scalar arguments. Building
     one imports numba (the kernel is loaded from numba's cache, or compiled once).
 
@@ -574,17 +729,17 @@ class PolachContact:
                  shear_modulus=8.2e10, poisson=0.28):  # fmt: skip
         values = (0.0, 0.0, 0.0, normal_force, speed, a, b, mu0, k_A, k_S, A, B,
                   shear_modulus, poisson)  # fmt: skip
-        scalars = _scalars(values)
+        scalars = as_scalars(values)
         if scalars is None:
             raise ValueError("PolachContact holds one contact: every argument must be a scalar")
-        _polach_scalar(*scalars)  # validates every argument, errors name it
+        check_polach_inputs(*scalars)  # validates every argument, errors name it
         _PLAUSIBLE(scalars)  # implausible inputs warn (docs/checks.md), once per contact
         (_, _, _, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu) = (float(x) for x in scalars)
         self.normal_force, self.speed, self.a, self.b = q, v, a, b
         self.mu0, self.k_A, self.k_S, self.A, self.B = mu0, k_a, k_s, big_a, big_b
         self.shear_modulus, self.poisson = g, nu
-        self.c11, self.c22, self.c23 = _kernels().kalker_scalar(a / b, nu)[:3]
-        object.__setattr__(self, "_kernel", _kernels().contact_kernel())
+        self.c11, self.c22, self.c23 = kalker_scalar(a / b, nu)[:3]
+        object.__setattr__(self, "_kernel", _contact_kernel())
         self._refresh()
 
     def _refresh(self) -> None:

@@ -52,11 +52,15 @@ from railadhesion._validate import (
     check_nonnegative,
     check_positive,
 )
+from railadhesion.numerics import flatten, jitable, kernel
 from railadhesion.plausibility import input_checker
 
 __all__ = [
     "TwoDTraction",
     "carter",
+    "carter_law",
+    "fletcher_curve",
+    "fletcher_law",
     "elastic_foundation",
     "fletcher",
     "creep_from_surface_speeds",
@@ -93,33 +97,116 @@ class TwoDTraction(NamedTuple):
     stick_half_width: np.ndarray
 
 
-def _inputs(creep, normal_load, half_width, radius, mu):
-    """Validated float arrays of the arguments shared by all 2D models."""
-    xi = check_finite(creep, "creep")
-    load = check_nonnegative(normal_load, "normal_load")
-    a = check_positive(half_width, "half_width")
-    r = check_positive(radius, "radius")
-    m = check_nonnegative(mu, "mu")
-    return xi, load, a, r, m
+@jitable
+def _ratio_or_inf(num, den):
+    """num/den for num, den >= 0: 0 where num == 0, inf where only den == 0."""
+    if num == 0.0:
+        return 0.0
+    return num / den if den > 0.0 else math.inf
+
+
+@jitable
+def _sign(x):
+    """The sign of x: -1, 1, or 0 for zero (as NumPy's)."""
+    return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
+
+
+@jitable
+def carter_law(creep, normal_load, half_width, radius, mu):
+    """Carter's traction, its stick and slip parts [N/m] and the stick half-width [m] of one
+    line contact (Carter 1926; Johnson 1985, chapter 8; the formulas in :func:`carter`,
+    Notes): (traction, stick, slip, stick_half_width)."""
+    kappa = min(_ratio_or_inf(abs(creep) * radius, mu * half_width), 1.0)
+    total = 2.0 * kappa - kappa * kappa
+    s = 2.0 * kappa - 1.0
+    slip_frac = (math.asin(s) + s * math.sqrt(1.0 - s * s) + 0.5 * math.pi) / math.pi
+    scale = _sign(-creep) * mu * normal_load
+    traction = scale * total
+    slip = scale * slip_frac
+    return traction, traction - slip, slip, half_width * (1.0 - kappa)
+
+
+@jitable
+def fletcher_law(creep, normal_load, half_width, radius, mu, k_a, k_s):
+    """Fletcher's (2013) traction, its stick part Q_A and slip part Q_S [N/m] and the stick
+    half-width c [m] of one line contact, eqs. (8)-(12) (:func:`fletcher`, Notes):
+    (traction, stick, slip, stick_half_width)."""
+    mag = abs(creep)
+    # eq. (8): c = max(a - 2 k_a xi R / (3 k_s mu), 0)
+    c = max(half_width - _ratio_or_inf(2.0 * k_a * mag * radius, 3.0 * k_s * mu), 0.0)
+    u = c / half_width
+    # eq. (9): Q_A / P = 2 k_a c^2 xi R / a^3
+    stick_frac = 2.0 * k_a * u * u * mag * radius / half_width
+    # eq. (11): Q_S / P = 3/2 mu k_s (a - c)/a - 1/4 mu k_s (a^3 - (2c - a)^3)/a^3
+    w = 2.0 * u - 1.0
+    slip_frac = mu * k_s * (1.5 * (1.0 - u) - 0.25 * (1.0 - w * w * w))
+    scale = _sign(-creep) * normal_load
+    stick = scale * stick_frac
+    slip = scale * slip_frac
+    return stick + slip, stick, slip, c  # eq. (12)
+
+
+@jitable
+def fletcher_curve(creep, slope, inverse_mu):
+    """Fletcher's (2013) 2D creep curve with k_s = 1 and its partial derivatives.
+
+    ``creep`` >= 0 is the creep magnitude xi [-], ``slope`` > 0 the initial slope
+    d(Q/P)/d xi = 2 k_a R / a [-], ``inverse_mu`` >= 0 the inverse 1/mu of the friction
+    coefficient (the saturation level of the curve); 0 gives the limit mu -> inf, the straight
+    line ``slope * creep``. Returns ``(Q/P, d/d creep, d/d slope, d/d inverse_mu)``.
+
+    Fletcher's eqs. (8)-(12) (Proc. IMechE Part J 227(6) (2013) 529-537) reduce to
+    ``Q/P = mu (1 - (c/a)**3)`` with ``c/a = max(1 - x/mu, 0)`` and ``x = 2 k_a xi R/(3 a)
+    = slope * xi / 3`` (:func:`railadhesion.models.twod.fletcher`, its Notes). Written with
+    u = 1 - x q (q = 1/mu): ``Q/P = x (3 - 3 x q + x**2 q**2)`` while u > 0 (finite at q = 0),
+    ``1/q`` at and beyond full slip (u <= 0); d/d xi = slope u**2, d/d slope = xi u**2,
+    d/d q = -x**2 (3 - 2 x q) before full slip, 0, 0, -1/q**2 beyond.
+    """
+    x = slope * creep / 3.0
+    u = 1.0 - x * inverse_mu
+    if u > 0.0:
+        uu = u * u
+        return (x * (3.0 - 3.0 * x * inverse_mu + x * x * inverse_mu * inverse_mu),
+                slope * uu, creep * uu, -x * x * (3.0 - 2.0 * x * inverse_mu))
+    return 1.0 / inverse_mu, 0.0, 0.0, -1.0 / (inverse_mu * inverse_mu)
+
+
+@kernel(nogil=True)
+def _twod_into(fletcher, xi, load, a, r, m, ka, ks, out):
+    """:func:`fletcher_law` (``fletcher``) or :func:`carter_law` of arrays of length n or 1
+    into out (4, n)."""
+    for k in range(out.shape[1]):
+        x, p, h, rr, mu = (xi[k if xi.size > 1 else 0], load[k if load.size > 1 else 0],
+                           a[k if a.size > 1 else 0], r[k if r.size > 1 else 0],
+                           m[k if m.size > 1 else 0])  # fmt: skip
+        if fletcher:
+            res = fletcher_law(x, p, h, rr, mu, ka[k if ka.size > 1 else 0],
+                               ks[k if ks.size > 1 else 0])  # fmt: skip
+        else:
+            res = carter_law(x, p, h, rr, mu)
+        out[0, k], out[1, k], out[2, k], out[3, k] = res
+
+
+def _evaluate(fletcher, creep, normal_load, half_width, radius, mu, k_a, k_s) -> TwoDTraction:
+    """Validate the inputs (errors name them), then the compiled law over their broadcast."""
+    inputs = [
+        check_finite(creep, "creep"),
+        check_nonnegative(normal_load, "normal_load"),
+        check_positive(half_width, "half_width"),
+        check_positive(radius, "radius"),
+        check_nonnegative(mu, "mu"),
+        check_positive(k_a, "k_a"),
+        check_positive(k_s, "k_s"),
+    ]
+    shape, n, flat = flatten(inputs)
+    out = np.empty((4, n))
+    _twod_into(fletcher, *flat, out)
+    _PLAUSIBLE((inputs[0], inputs[2], inputs[3]))  # implausible inputs warn (docs/checks.md)
+    return TwoDTraction(*(x.reshape(shape)[()] for x in out))
 
 
 #: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
 _PLAUSIBLE = input_checker(("creep", "half_width", "radius"))
-
-
-def _ratio_or_inf(num: np.ndarray, den: np.ndarray) -> np.ndarray:
-    """``num / den`` for ``num >= 0, den >= 0``: 0 where num == 0, inf where only den == 0.
-
-    No floating-point warnings are raised (the test configuration turns them into errors).
-    """
-    shape = np.broadcast_shapes(num.shape, den.shape)
-    out = np.divide(num, den, out=np.zeros(shape), where=den > 0)
-    return np.where((den <= 0) & (num > 0), np.inf, out)
-
-
-def _scalar(x: np.ndarray):
-    """0-d arrays become NumPy scalars; other arrays are returned unchanged."""
-    return x[()]
 
 
 @labelled(units=TWOD_UNITS)
@@ -180,20 +267,7 @@ def carter(creep, normal_load, half_width, radius, mu) -> TwoDTraction:
     >>> round(float(res.stick_half_width * 1e3), 4)
     0.6
     """
-    xi, load, a, r, m = _inputs(creep, normal_load, half_width, radius, mu)
-    kappa = np.minimum(_ratio_or_inf(np.abs(xi) * r, m * a), 1.0)
-    total = 2.0 * kappa - kappa * kappa
-    s = 2.0 * kappa - 1.0
-    slip_frac = (np.arcsin(s) + s * np.sqrt(1.0 - s * s) + 0.5 * np.pi) / np.pi
-    scale = np.sign(-xi) * m * load
-    traction = scale * total
-    slip = scale * slip_frac
-    stick = traction - slip
-    stick_half_width = a * (1.0 - kappa) * np.ones_like(traction)
-    _PLAUSIBLE((xi, a, r))  # implausible inputs warn (docs/checks.md)
-    return TwoDTraction(
-        _scalar(traction), _scalar(stick), _scalar(slip), _scalar(stick_half_width)
-    )
+    return _evaluate(False, creep, normal_load, half_width, radius, mu, 1.0, 1.0)
 
 
 @labelled(units=TWOD_UNITS)
@@ -260,26 +334,7 @@ def fletcher(creep, normal_load, half_width, radius, mu, k_a=1.0, k_s=1.0) -> Tw
     >>> round(float(res.stick + res.slip - res.traction), 12)
     0.0
     """
-    xi, load, a, r, m = _inputs(creep, normal_load, half_width, radius, mu)
-    ka = check_positive(k_a, "k_a")
-    ks = check_positive(k_s, "k_s")
-    mag = np.abs(xi)
-    # eq. (8): c = max(a - 2 k_a xi R / (3 k_s mu), 0)
-    shift = _ratio_or_inf(2.0 * ka * mag * r, 3.0 * ks * m)
-    c = np.maximum(a - shift, 0.0)
-    u = c / a
-    # eq. (9): Q_A / P = 2 k_a c^2 xi R / a^3
-    stick_frac = 2.0 * ka * u * u * mag * r / a
-    # eq. (11): Q_S / P = 3/2 mu k_s (a - c)/a - 1/4 mu k_s (a^3 - (2c - a)^3)/a^3
-    w = 2.0 * u - 1.0
-    slip_frac = m * ks * (1.5 * (1.0 - u) - 0.25 * (1.0 - w * w * w))
-    scale = np.sign(-xi) * load
-    stick = scale * stick_frac
-    slip = scale * slip_frac
-    traction = stick + slip  # eq. (12)
-    c = c * np.ones_like(traction)
-    _PLAUSIBLE((xi, a, r))  # implausible inputs warn (docs/checks.md)
-    return TwoDTraction(_scalar(traction), _scalar(stick), _scalar(slip), _scalar(c))
+    return _evaluate(True, creep, normal_load, half_width, radius, mu, k_a, k_s)
 
 
 @labelled(units=TWOD_UNITS)
@@ -367,7 +422,7 @@ def creep_from_surface_speeds(v1, v2):
     total = s1 + s2
     if not np.all(total > 0):
         raise ValueError("v1 + v2 must be in (0, inf): at least one surface must move")
-    return _scalar(np.asarray(2.0 * (s1 - s2) / total))
+    return np.asarray(2.0 * (s1 - s2) / total)[()]
 
 
 # ---------------------------------------------------------------------------------------------

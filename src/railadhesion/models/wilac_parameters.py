@@ -21,12 +21,12 @@ from numbers import Real
 from typing import NamedTuple
 
 import numpy as np
-from scipy.special import erf
 
 from railadhesion._labelled import labelled
 from railadhesion._validate import check_choice, check_nonnegative, check_positive
 from railadhesion.models.parameters import PARAMETER_RANGES
 from railadhesion.models.regression import ParameterRegression
+from railadhesion.numerics import exp, flatten, jitable, kernel, read_only
 from railadhesion.plausibility import check_calibrated
 
 __all__ = [
@@ -40,6 +40,16 @@ __all__ = [
     "wilac_weights",
     "WilacCondition",
     "WilacParameters",
+    "PACKED_HEADER",
+    "pack_wilac",
+    "wilac_blend_weights",
+    "wilac_clip",
+    "wilac_factors",
+    "wilac_normalise",
+    "wilac_regression",
+    "wilac_term",
+    "wilac_terms",
+    "wilac_transition",
 ]
 
 #: The four representative conditions, from dry to wet (seed 000, section 5.3). Weights and
@@ -128,8 +138,7 @@ def check_transitions(transitions, where: str = "transitions") -> tuple[WaterTra
     # transition overtakes an earlier, wider one; reject sets where that is more than a rounding.
     lo = min(0.0, out[0].midpoint - 10 * out[0].width)
     hi = out[2].midpoint + 10 * max(t.width for t in out)
-    w = np.linspace(lo, hi, 4001)
-    e = _erf_transitions(w, np.array([t.midpoint for t in out]), np.array([t.width for t in out]))
+    e = _transitions(np.linspace(lo, hi, 4001), out)
     worst = float(np.min(e[:-1] - e[1:]))
     if worst < -1e-6:
         raise ValueError(
@@ -139,18 +148,45 @@ def check_transitions(transitions, where: str = "transitions") -> tuple[WaterTra
     return tuple(out)
 
 
-@functools.lru_cache(maxsize=32)
-def _transition_arrays(transitions: tuple) -> tuple[np.ndarray, np.ndarray]:
-    checked = check_transitions(transitions)
-    return (
-        np.array([t.midpoint for t in checked]),
-        np.array([t.width for t in checked]),
-    )
+@jitable
+def wilac_transition(w, midpoint, width):
+    """e(w) = ½ (erf((w − m)/s) + 1), one transition between two conditions (Trummer et al.,
+    seed 000, section 5.3, with the (m, s) of Table 1)."""
+    return 0.5 * (math.erf((w - midpoint) / width) + 1.0)
 
 
-def _erf_transitions(w: np.ndarray, m: np.ndarray, s: np.ndarray) -> np.ndarray:
-    shape = (3,) + (1,) * w.ndim
-    return 0.5 * (erf((w - m.reshape(shape)) / s.reshape(shape)) + 1.0)
+@jitable
+def wilac_blend_weights(w, m1, s1, m2, s2, m3, s3):
+    """The blending weights (f_Dry, f_Damp2, f_Damp1, f_Wet) at the water flow ``w`` [µl/s]
+    from the three transitions (m_i, s_i): f_Dry = 1 − e_1, f_Damp2 = e_1 − e_2,
+    f_Damp1 = e_2 − e_3, f_Wet = e_3 (seed 000, section 5.3)."""
+    e1 = wilac_transition(w, m1, s1)
+    e2 = wilac_transition(w, m2, s2)
+    e3 = wilac_transition(w, m3, s3)
+    return 1.0 - e1, e1 - e2, e2 - e3, e3
+
+
+@kernel(nogil=True)
+def _transitions_into(w, m1, s1, m2, s2, m3, s3, out):
+    """e_1, e_2, e_3 (out rows 0-2) or, if out has 4 rows, the four weights of water flows w."""
+    for k in range(w.size):
+        if out.shape[0] == 4:
+            out[0, k], out[1, k], out[2, k], out[3, k] = wilac_blend_weights(w[k], m1, s1, m2,
+                                                                             s2, m3, s3)
+        else:
+            out[0, k] = wilac_transition(w[k], m1, s1)
+            out[1, k] = wilac_transition(w[k], m2, s2)
+            out[2, k] = wilac_transition(w[k], m3, s3)
+
+
+def _transitions(w: np.ndarray, transitions, rows: int = 3) -> np.ndarray:
+    """e_1, e_2, e_3 (``rows`` 3) or the four weights (4) of valid water flows ``w`` (any
+    shape): (rows, *w.shape)."""
+    w = np.asarray(w, dtype=float)
+    flat = read_only(np.ascontiguousarray(w).reshape(-1))
+    out = np.empty((rows, flat.size))
+    _transitions_into(flat, *(float(x) for t in transitions for x in t), out)
+    return out.reshape((rows, *w.shape))
 
 
 def _as_transition_key(transitions) -> tuple:
@@ -194,12 +230,7 @@ def wilac_transitions(water_flow, transitions=PAPER_TRANSITIONS) -> np.ndarray:
     >>> [round(float(x), 4) for x in wilac_transitions(30.0)]
     [1.0, 0.5, 0.0]
     """
-    w = check_nonnegative(water_flow, "water_flow")
-    if transitions is PAPER_TRANSITIONS:
-        m, s = _PAPER_M, _PAPER_S
-    else:
-        m, s = _transition_arrays(_as_transition_key(transitions))
-    return _erf_transitions(w, m, s)
+    return _water_flow_laws(water_flow, transitions, 3)
 
 
 @labelled(units="1", leading={"condition": WILAC_CONDITIONS})
@@ -223,13 +254,7 @@ def wilac_weights(water_flow, transitions=PAPER_TRANSITIONS) -> np.ndarray:
     -----
     Trummer et al. (seed 000), section 5.3, the equations for f_i: f_Dry = 1 − e_1,
     f_Damp2 = e_1 − e_2, f_Damp1 = e_2 − e_3, f_Wet = e_3, with e_i from
-    :func:`wilac_transitions`.
-
-    References
-    ----------
-    G. Trummer, L.E. Buckley-Johnstone, P. Voltr, A. Meierhofer, R. Lewis, K. Six.
-    Wheel-rail creep force model for predicting water induced low adhesion phenomena.
-    Tribology International 109 (2017) 409–415.
+    :func:`wilac_transitions` (reference there); evaluated by :func:`wilac_blend_weights`.
 
     Examples
     --------
@@ -238,12 +263,20 @@ def wilac_weights(water_flow, transitions=PAPER_TRANSITIONS) -> np.ndarray:
     >>> [round(float(f), 4) for f in wilac_weights(350.0)]
     [0.0, 0.0, 0.0, 1.0]
     """
-    e = wilac_transitions(water_flow, transitions)
-    one = np.ones_like(e[0])
-    return np.stack((one - e[0], e[0] - e[1], e[1] - e[2], e[2]))
+    return _water_flow_laws(water_flow, transitions, 4)
 
 
-_PAPER_M, _PAPER_S = _transition_arrays(_as_transition_key(PAPER_TRANSITIONS))
+@functools.lru_cache(maxsize=32)
+def _checked_transitions(transitions: tuple) -> tuple:
+    return check_transitions(transitions)
+
+
+def _water_flow_laws(water_flow, transitions, rows: int) -> np.ndarray:
+    """The transitions (``rows`` 3) or the weights (4) of the validated water flows."""
+    w = check_nonnegative(water_flow, "water_flow")
+    if transitions is not PAPER_TRANSITIONS:
+        transitions = _checked_transitions(_as_transition_key(transitions))
+    return _transitions(w, transitions, rows)
 
 
 def _as_regression(value, where: str) -> ParameterRegression:
@@ -527,15 +560,10 @@ class WilacParameters:
         what = f"the WILAC set {self.name or '(unnamed)'!r}"
         check_calibrated(q, "normal_force", *self.normal_force_range, unit="N", what=what)
         check_calibrated(v, "speed", *self.speed_range, unit="m/s", what=what)
-        qn, vn = self._normalise(q, v)
-        return _evaluate_condition(self, condition, qn, vn)
-
-    def _normalise(self, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        qlo, qhi = self.normal_force_range
-        vlo, vhi = self.speed_range
-        qn = np.minimum(np.maximum(q, qlo), qhi) / self.normal_force_ref
-        vn = np.minimum(np.maximum(v, vlo), vhi) / self.speed_ref
-        return qn, vn
+        shape, n, (qf, vf) = flatten([q, v])
+        out = np.empty((5, n))
+        _parameters_into(qf, vf, pack_wilac(self), WILAC_CONDITIONS.index(condition), out)
+        return {name: out[j].reshape(shape) for j, name in enumerate(POLACH_PARAMETER_NAMES)}
 
     def replace(self, **changes) -> WilacParameters:
         """A copy with some fields changed (validated again)."""
@@ -574,56 +602,140 @@ def _compile_condition(cond: WilacCondition) -> tuple:
     return tuple(plan)
 
 
-def _scalar_factors(qn: float, vn: float) -> tuple:
-    """Scalar twin of :func:`_factor_arrays` (computed once per call, shared by the conditions)."""
-    return (
-        qn,
-        vn,
-        1.0 / qn,
-        1.0 / vn,
-        math.exp(qn) if qn < 700.0 else math.inf,
-        math.exp(vn) if vn < 700.0 else math.inf,
-    )
+#: Number of header values of a packed WILAC set (:func:`pack_wilac`).
+PACKED_HEADER = 22
+# Offsets of the term counts and of the regressions in a packed set.
+_COUNTS = PACKED_HEADER + 1
+_TERMS = _COUNTS + 20
 
 
-def _scalar_condition(plan: tuple, fac: tuple) -> list[float]:
-    """Scalar twin of :func:`_array_condition` with Python floats: k_A, k_S, mu0, A, B."""
-    out = []
-    for terms, lo, hi in plan:
-        total = 0.0
-        for idx, coef in terms:
-            value = coef
-            for i in idx:
-                value *= fac[i]
-            total += value
-        out.append(min(max(total, lo), hi))
-    return out
+def pack_wilac(params: WilacParameters) -> np.ndarray:
+    """Pack a :class:`WilacParameters` into one read-only float64 array (for the compiled
+    laws), computed once per set.
+
+    Returns
+    -------
+    numpy.ndarray, shape (43 + 80 T,)
+        ``packed[0:22]``: ``[Q_ref, v_ref, Q_low, Q_high, v_low, v_high, m1, s1, m2, s2,
+        m3, s3, k_A_low, k_A_high, k_S_low, k_S_high, mu0_low, mu0_high, A_low, A_high,
+        B_low, B_high]``, i.e. the normalisation, the calibrated ranges (Q and v are clamped
+        into them), the three erf transitions (midpoint, width) [µl/s] and the clipping bounds
+        of the five Polach parameters; ``packed[22]``: T, the largest number of terms of any
+        regression; ``packed[23:43]``: the number of terms of each regression, (4, 5) in C
+        order; ``packed[43:]``: the regressions, an array of shape (4, 5, T, 4) in C order:
+        for condition i (dry, damp2, damp1, wet), parameter j (k_A, k_S, mu0, A, B) and term
+        k, ``(coefficient, f1, f2, f3)`` with the factor indices f into
+        ``(Q', v', 1/Q', 1/v', exp(Q'), exp(v'), 1)`` stored as floats (6, the factor 1, for
+        none); unused terms are zero.
+
+    Examples
+    --------
+    >>> from railadhesion.models.wilac import default_wilac_parameters
+    >>> packed = pack_wilac(default_wilac_parameters())
+    >>> packed.dtype, (packed.size - 43) % 80, packed[6:12].tolist()
+    (dtype('float64'), 0, [15.0, 5.0, 30.0, 3.0, 50.0, 7.0])
+    """
+    packed = params.__dict__.get("_packed")
+    if packed is not None:
+        return packed
+    plan = params._scalar_plan
+    nterm = max(len(plan[c][j][0]) for c in WILAC_CONDITIONS for j in range(5))
+    regression = np.zeros((4, 5, nterm, 4))
+    counts = np.zeros((4, 5))
+    for i, cond in enumerate(WILAC_CONDITIONS):
+        for j in range(5):
+            counts[i, j] = len(plan[cond][j][0])
+            for k, (idx, coef) in enumerate(plan[cond][j][0]):
+                regression[i, j, k] = (coef, 6.0, 6.0, 6.0)
+                for m, f in enumerate(idx):
+                    regression[i, j, k, 1 + m] = f
+    header = np.empty(PACKED_HEADER + 1)
+    header[0] = params.normal_force_ref
+    header[1] = params.speed_ref
+    header[2:4] = params.normal_force_range
+    header[4:6] = params.speed_range
+    header[6:12] = np.ravel([(t.midpoint, t.width) for t in params.transitions])
+    header[12:22] = np.ravel([PHYSICAL_BOUNDS[p] for p in POLACH_PARAMETER_NAMES])
+    header[22] = nterm
+    packed = np.concatenate([header, counts.ravel(), regression.ravel()])
+    packed.flags.writeable = False  # the compiled code is compiled for read-only arrays
+    object.__setattr__(params, "_packed", packed)
+    return packed
 
 
-def _factor_arrays(qn: np.ndarray, vn: np.ndarray) -> tuple:
-    """The six regression factors in :data:`_FACTOR_INDEX` order (computed once per call)."""
-    with np.errstate(over="ignore"):  # an unused exp factor may overflow; used ones cannot
-        return (qn, vn, 1.0 / qn, 1.0 / vn, np.exp(qn), np.exp(vn))
+@jitable
+def wilac_normalise(q, v, packed):
+    """(Q', v') = (clamp(Q)/Q_ref, clamp(v)/v_ref): Q and v clamped into the calibrated
+    ranges of the packed set (:func:`pack_wilac`), so that the parameters are held at their
+    boundary values outside (:class:`WilacParameters`, Notes), then normalised (seed 000,
+    section 5.2)."""
+    qn = min(max(q, packed[2]), packed[3]) / packed[0]
+    vn = min(max(v, packed[4]), packed[5]) / packed[1]
+    return qn, vn
 
 
-def _array_condition(plan: tuple, fac: tuple, shape: tuple) -> list[np.ndarray]:
-    """Array twin of :func:`_scalar_condition`: k_A, k_S, mu0, A, B, each of ``shape``."""
-    out = []
-    for terms, lo, hi in plan:
-        total = 0.0
-        for idx, coef in terms:
-            value = coef
-            for i in idx:
-                value = value * fac[i]
-            total = total + value
-        total = np.maximum(total, lo)
-        if hi != math.inf:
-            total = np.minimum(total, hi)
-        out.append(np.broadcast_to(total, shape))
-    return out
+@jitable(inline="always")
+def wilac_factors(qn, vn):
+    """The six regression factors (Q', v', 1/Q', 1/v', exp(Q'), exp(v')) (seed 000, section
+    5.2; :mod:`railadhesion.models.regression`), in the order of the packed factor indices."""
+    return qn, vn, 1.0 / qn, 1.0 / vn, exp(qn), exp(vn)
 
 
-def _evaluate_condition(params: WilacParameters, condition: str, qn, vn) -> dict:
-    shape = np.broadcast_shapes(np.shape(qn), np.shape(vn))
-    values = _array_condition(params._scalar_plan[condition], _factor_arrays(qn, vn), shape)
-    return {name: np.array(x) for name, x in zip(POLACH_PARAMETER_NAMES, values, strict=True)}
+@jitable
+def wilac_terms(packed, i, j):
+    """(first, count): where the terms of the regression of parameter j of condition i start
+    in the packed set, and how many there are (each term: coefficient, three factor
+    indices)."""
+    nterm = int(packed[PACKED_HEADER])
+    return _TERMS + (i * 5 + j) * nterm * 4, int(packed[_COUNTS + i * 5 + j])
+
+
+@jitable
+def wilac_term(coefficient, fa, fb, fc):
+    """One term of a regression of seed 000, section 5.2: its coefficient times its factors
+    (up to three; the factor 1 where a term has fewer)."""
+    return coefficient * fa * fb * fc
+
+
+@jitable
+def wilac_clip(total, packed, j):
+    """The sum of a regression's terms clipped to parameter j's :data:`PHYSICAL_BOUNDS`."""
+    return min(max(total, packed[12 + 2 * j]), packed[13 + 2 * j])
+
+
+@jitable
+def wilac_regression(packed, i, j, f0, f1, f2, f3, f4, f5):
+    """Polach parameter j (k_A, k_S, mu0, A, B) of condition i (dry, damp2, damp1, wet): the
+    linear regression of seed 000, section 5.2 (:func:`wilac_term` summed over the terms,
+    :func:`wilac_clip`); f0-f5 are the factors of :func:`wilac_factors`, indexed by the
+    packed factor indices (6 for the factor 1)."""
+    first, count = wilac_terms(packed, i, j)
+    total = 0.0
+    for t in range(count):
+        p = first + 4 * t
+        total = total + wilac_term(packed[p], _factor(packed[p + 1], f0, f1, f2, f3, f4, f5),
+                                   _factor(packed[p + 2], f0, f1, f2, f3, f4, f5),
+                                   _factor(packed[p + 3], f0, f1, f2, f3, f4, f5))  # fmt: skip
+    return wilac_clip(total, packed, j)
+
+
+@jitable
+def _factor(index, f0, f1, f2, f3, f4, f5):
+    """Factor ``index`` (a packed factor index, a float: 0-5, 6 for the factor 1) of
+    :func:`wilac_factors`; selects, so that no indexing can raise (the native FMUs compile the
+    laws without numba's runtime)."""
+    low = f0 if index == 0.0 else (f1 if index == 1.0 else f2)
+    high = f3 if index == 3.0 else (f4 if index == 4.0 else (f5 if index == 5.0 else 1.0))
+    return low if index < 3.0 else high
+
+
+@kernel(nogil=True)
+def _parameters_into(q, v, packed, i, out):
+    """The five parameters of condition i at (Q, v) (arrays of length n or 1) into out."""
+    sq = 1 if q.size > 1 else 0
+    sv = 1 if v.size > 1 else 0
+    for k in range(out.shape[1]):
+        qn, vn = wilac_normalise(q[k * sq], v[k * sv], packed)
+        f0, f1, f2, f3, f4, f5 = wilac_factors(qn, vn)
+        for j in range(5):
+            out[j, k] = wilac_regression(packed, i, j, f0, f1, f2, f3, f4, f5)

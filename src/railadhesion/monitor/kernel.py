@@ -65,6 +65,8 @@ from numba import njit
 
 from railadhesion import _jit
 from railadhesion.models import kernels as _models_kernels
+from railadhesion.models import polach as _polach
+from railadhesion.models import twod as _twod
 from railadhesion.models.kernels import fletcher_scalar, polach_curve_scalar
 from railadhesion.monitor import layout
 
@@ -97,10 +99,11 @@ _C_MEMORY = 10.0  # s: memory of the causal eq. 14 mean
 _DOF = 4.0  # degrees of freedom of the Student-t residuals of the estimator (our choice)
 _C_MIN_PRESSURE = 0.5e5  # Pa: braking for eq. 14 (as identify_adhesion's window)
 
-# The kernels inline fletcher_scalar from railadhesion.models.kernels, which numba's cache of
-# this file does not track: a checksum of that module and of the layout is compiled in, and a
-# mismatch drops this module's cached code (railadhesion._jit.guard_cache).
-KERNEL_FINGERPRINT = _jit.source_checksum(_models_kernels, layout)
+# The kernels inline fletcher_scalar and polach_curve_scalar of railadhesion.models.kernels
+# (the laws of models/twod.py and models/polach.py), which numba's cache of this file does not
+# track: a checksum of those modules and of the layout is compiled in, and a mismatch drops
+# this module's cached code (railadhesion._jit.guard_cache).
+KERNEL_FINGERPRINT = _jit.source_checksum(_models_kernels, _polach, _twod, layout)
 
 
 @njit(cache=True, error_model="numpy")
