@@ -1204,3 +1204,101 @@ def flatten_args(arrays):
         x.flags.writeable = False  # a view: the caller's array is untouched
         flat.append(x)
     return shape, n, flat
+
+
+# --- for implicit integrators (the braking step) ----------------------------------------------
+#
+# An implicit integrator of a braking wheelset (railadhesion.braking.step) needs, for one
+# contact whose geometry and load are fixed over a step, Polach's adhesion coefficient as a
+# function of the longitudinal creepage and of the speed, with both slopes (Newton's method),
+# for many (axle, blended set) lanes in one loop that the compiler vectorises. polach_scalar
+# cannot serve: forces only, every contact term recomputed, and the slopes by differences
+# would take three calls of it per lane (about 15 times the cost; measured for the report of
+# this change).
+# A libm call in the loop stops its vectorisation: the exponential is exp_scalar, the scalar
+# form of the batch kernels' call-free exponential.
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def exp_scalar(x):
+    """exp(x) for one value, call-free (vectorises when inlined in a loop): the reduction,
+    polynomial and exponent assembly of :func:`_exp_parts` and :func:`_exp_into` (same
+    constants), x clamped to [-700, 700]; within an ulp of libm's exp."""
+    x = min(max(x, -700.0), 700.0)
+    nn = np.floor(x * _LOG2E + 0.5)
+    r = (x - nn * _LN2_HI) - nn * _LN2_LO
+    e = _E13 * r + _E12
+    e = e * r + _E11
+    e = e * r + _E10
+    e = e * r + _E9
+    e = e * r + _E8
+    e = e * r + _E7
+    e = e * r + _E6
+    e = e * r + _E5
+    e = e * r + _E4
+    e = e * r + _E3
+    e = e * r + _E2
+    e = e * r + 1.0
+    e = e * r + 1.0
+    t = nn + _ROUND_SHIFT  # n in the low bits (see _exp_into)
+    bits = (np.float64(t).view(np.int64) - _ROUND_SHIFT_BITS + 1023) << 52
+    return e * np.int64(bits).view(np.float64)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def polach_longitudinal(creep, speed, stiffness, k_A, k_S, mu0, A, B):  # noqa: N803
+    """Polach's adhesion coefficient for pure longitudinal creepage, with its slopes.
+
+    Polach (2005, Wear 258, eqs. 11-13 with the reduction factors and the falling friction
+    of section 2), the same model as :func:`polach_scalar` with no lateral creepage and no
+    spin, for a contact whose geometry and load are fixed: with s = ``creep`` >= 0 and
+    V = ``speed``,
+
+    * friction falling with the slip velocity, ``mu_k = mu0 [(1 - A) exp(-B s V) + A]``;
+    * gradient of the tangential stress, ``eps = K s / mu_k`` with ``stiffness`` K =
+      (pi/4) G a b C11 / Q [-] (per unit creepage);
+    * ``mu = (2/pi) mu_k [k_A eps / (1 + (k_A eps)^2) + arctan(k_S eps)]`` = -F_x/Q.
+
+    Returns ``(mu, dmu/ds, dmu/dV)``, the slopes analytic. A contact with no friction left
+    (A = 0 and exp(-B s V) underflowed) gives (0, 0, 0), as :func:`polach_scalar` gives no
+    force. Scalars in and out, no allocation, no branch, no call (exp and arctan call-free):
+    vectorises when inlined in a loop over contacts.
+    """
+    decay = exp_scalar(-B * (creep * speed))
+    mu_k = mu0 * ((1.0 - A) * decay + A)
+    friction = mu_k > 0.0
+    mu_k = mu_k if friction else 1.0  # no friction left: zeros below
+    dmu_k = -mu0 * (1.0 - A) * B * decay  # d mu_k / d(s V)
+    inv = 1.0 / mu_k
+    eps = min(stiffness * creep * inv, _EPS_MAX)
+    x = k_A * eps
+    y = k_S * eps
+    ix = 1.0 / (1.0 + x * x)
+    bracket = x * ix + _atan_nonneg(y)
+    dbracket = k_A * (1.0 - x * x) * ix * ix + k_S / (1.0 + y * y)  # d bracket / d eps
+    deps = (stiffness - eps * dmu_k * speed) * inv  # d eps / d s
+    mu = _TWO_OVER_PI * mu_k * bracket
+    dmu_ds = _TWO_OVER_PI * (dmu_k * speed * bracket + mu_k * dbracket * deps)
+    dmu_dv = _TWO_OVER_PI * (bracket - eps * dbracket) * dmu_k * creep
+    if not friction:
+        mu = dmu_ds = dmu_dv = 0.0
+    return mu, dmu_ds, dmu_dv
+
+
+@njit(cache=True, error_model="numpy")
+def wilac_weights(water_flow, packed):
+    """WILAC's blending weights (dry, damp 2, damp 1, wet) at a water flow [ul/s] (the erf
+    transitions of Trummer et al. 2017, section 5.3; the function the WILAC kernel uses)."""
+    return _weights(water_flow, packed)
+
+
+@njit(cache=True, error_model="numpy")
+def wilac_condition_parameters(normal_force, speed, packed, factors, out):
+    """WILAC's Polach parameters (k_A, k_S, mu0, A, B) of the four conditions at a wheel load
+    [N] and speed [m/s] into ``out`` (20 values, condition by condition): the regressions of
+    Trummer et al. 2017 section 5.2 with Q' and v' clamped into the calibrated ranges and the
+    results into their physical bounds, by the WILAC kernel's own functions. ``factors``:
+    scratch of 7 values."""
+    _factors(normal_force, speed, packed, factors)
+    for i in range(4):
+        _condition_parameters(packed, i, factors, out)
