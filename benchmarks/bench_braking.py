@@ -11,7 +11,7 @@
    driver writing into those arrays would. Real-time factor = simulated time / wall time.
    The same loop is also timed with all 8 inputs copied in every call, and with recording.
 2. The per-call cost broken into components: the Python loop, the Python side of the call
-   (the closure and the numba entry point, measured on a stopped simulator, which returns at
+   (the method and numba's dispatcher, measured on a stopped simulator, which returns at
    once), the compiled step itself (the same steps run inside one compiled loop), its
    refresh share, and the rest (the cost of entering compiled code from the interpreter:
    cold caches and branch predictors).
@@ -41,7 +41,6 @@ from railadhesion.braking import (
     WilacAdhesion,
     simulate,
 )
-from railadhesion.braking import _layout as L
 
 VEHICLE = Vehicle()
 PROFILE = WaterFlowProfile.sections([(50.0, 5000.0, 25.0)])
@@ -115,9 +114,9 @@ def empty_loop(steps):
 
 
 def python_side(steps):
-    """advance() on a stopped simulator: the closure and the numba entry, no step."""
+    """advance() on a stopped simulator: the method and numba's dispatcher, no step."""
     sim = new_sim()
-    sim._buf[L.STOPPED_] = 1.0
+    sim._machine[0]["state"]["stopped"] = 1
     advance = sim.advance
     t0 = time.perf_counter()
     for _ in range(steps):
@@ -128,25 +127,25 @@ def python_side(steps):
 def compiled_loop_kernel():
     from numba import njit
 
-    from railadhesion.braking import _kernels as kern
+    from railadhesion.braking import step
 
     @njit
-    def loop(buf, work, steps, dt):
+    def loop(machine, tables, steps, dt):
+        valves = machine[0].inputs.valves
         for k in range(steps):
             if k % PERIOD == 0:
                 v = 2.0 if (k // PERIOD) % 4 == 3 else 0.0
-                for i in range(work.shape[1] if work.shape[1] < 4 else 4):
-                    work[L.R_VIN, i] = v
-            kern.step_free(buf, work, dt)
+                for i in range(4):
+                    valves[i] = v
+            step.advance_unrecorded(machine, tables, dt, 0)
 
     return loop
 
 
 def compiled_steps(loop, steps, refresh_period=0.01):
     sim = new_sim(refresh_period=refresh_period)
-    buf, work = sim._buf, sim._work
     t0 = time.perf_counter()
-    loop(buf, work, steps, DT)
+    loop(sim._machine, sim._tables, steps, DT)
     return (time.perf_counter() - t0) / steps, sim
 
 
@@ -154,23 +153,24 @@ def refresh_cost(repeats):
     """One refresh of the adhesion inputs (loads, water, WILAC parameters, lanes) [s]."""
     from numba import njit
 
-    from railadhesion.braking import _kernels as kern
+    from railadhesion.braking import step
 
     @njit
-    def loop(buf, work, n):
+    def loop(machine, tables, n):
+        m = machine[0]
         for _ in range(n):
-            buf[L.V_] += 1e-9
-            kern._refresh(buf, work)
+            m.state.speed += 1e-9
+            step._refresh(m.state, m.settings, tables, 0)
 
     sim = new_sim()
     for _ in range(1000):  # into the damp section: all four WILAC conditions active
         sim.advance(DT)
-    buf, work = sim._buf.copy(), sim._work.copy()
-    loop(buf, work, 10)
+    machine, tables = sim._machine.copy(), sim._tables
+    loop(machine, tables, 10)
     best = math.inf
     for _ in range(repeats):
         t0 = time.perf_counter()
-        loop(buf, work, 5000)
+        loop(machine, tables, 5000)
         best = min(best, (time.perf_counter() - t0) / 5000)
     return best
 
@@ -219,7 +219,7 @@ def main() -> None:
     rest = headline - empty - side - compiled
     print("  components of one advance() call:")
     print(f"    Python loop (for, if)                     {empty * 1e9:6.0f} ns")
-    print(f"    Python side of the call (closure + numba entry point, 2 arrays + dt) "
+    print(f"    Python side of the call (method + numba dispatcher, 2 arrays, dt, aux) "
           f"{side * 1e9:6.0f} ns")
     print(f"    compiled step (same steps in one compiled loop) {compiled * 1e9:6.0f} ns, of "
           f"which the 10 ms refresh {refresh * 1e9 / 10:.0f} ns "

@@ -17,7 +17,6 @@ from railadhesion.braking import (
     WilacAdhesion,
     simulate,
 )
-from railadhesion.braking.adhesion import polach_family_curve
 from railadhesion.models import polach_forces, wilac_forces
 from railadhesion.models.wilac import default_wilac_parameters
 
@@ -81,8 +80,9 @@ def test_energy_balance_from_histories_damp_with_wsp():
     assert abs(res.summary["energy"]["balance_error"]) < 5e-3
 
 
-def test_python_path_matches_compiled_path():
-    # the same Polach curve through the generic (NumPy) path and the compiled kernel
+def test_python_path_matches_compiled_path(polach_curve):
+    # the same Polach curve as a model in Python (an independent NumPy oracle, called back
+    # by the step) and as the step's compiled law
     family = PolachAdhesion("polach2005_wet")
 
     class Wrapped(CallableAdhesion):
@@ -90,8 +90,8 @@ def test_python_path_matches_compiled_path():
             family.prepare(speed, normal_loads, positions, time, dissipation)
 
         def evaluate(self, creep, speed):
-            return polach_family_curve(creep, speed, family.weights, family.params,
-                                       family.stiffness)
+            return polach_curve(creep, speed, family.weights, family.params,
+                                family.stiffness)
 
         def available(self, speed):
             return family.available(speed)
@@ -205,7 +205,7 @@ def test_stepping_api_compiled_matches_python():
         return sim, state
 
     (fast, a), (slow, b) = run(True), run(False)
-    assert fast.compiled and fast._use_compiled and not slow._use_compiled
+    assert fast.compiled and fast.runs_compiled and not slow.runs_compiled
     np.testing.assert_allclose(a.wheel_speeds, b.wheel_speeds, rtol=1e-10)
     assert a.distance == pytest.approx(b.distance, rel=1e-12)
     np.testing.assert_allclose(fast.histories().to_numpy(), slow.histories().to_numpy(),
@@ -229,3 +229,42 @@ def test_fletcher_condition_as_user_callable_and_xarray_result():
     np.testing.assert_allclose(ds["train_speed"].values, res.histories["train_speed"])
     # the slip adhesion used never exceeds the friction coefficient of the condition
     assert ds["adhesion_used"].max() <= water.mu + 1e-9
+
+
+# --- standstill (issue 18) -------------------------------------------------------------------
+
+COACH_DAMP = WaterFlowProfile.sections([(50.0, 900.0, 25.0)])
+
+
+@pytest.mark.parametrize("wsp", [False, True])
+def test_speed_never_goes_negative_at_standstill(wsp):
+    # the issue's case: stop_speed 1e-6 made the train speed -1.7 mm/s and a creep of -1657
+    from railadhesion.braking import WheelSlideProtection
+
+    kwargs = dict(cylinders=BrakeCylinders(max_pressure=6e5), dt=2.5e-3,
+                  wsp=WheelSlideProtection() if wsp else None)
+    res = simulate(VEHICLE, WilacAdhesion(COACH_DAMP), 20.0, 5.5e5, stop_speed=1e-6, **kwargs)
+    ref = simulate(VEHICLE, WilacAdhesion(COACH_DAMP), 20.0, 5.5e5, **kwargs)
+    h = res.histories
+    omega = h[[f"wheel_speed_{i}" for i in range(1, 5)]].to_numpy()
+    creep = h[[f"creep_{i}" for i in range(1, 5)]].to_numpy()
+    assert res.success
+    assert h["train_speed"].min() >= 0.0 and omega.min() >= 0.0
+    assert np.all(np.abs(creep) <= 1.0)  # braking creep in [0, 1]; never beyond
+    last = h.iloc[-1]
+    if last["train_speed"] == 0.0:  # at rest: the creepage is defined as 0, wheels at rest
+        assert np.all(creep[-1] == 0.0) and np.all(omega[-1] == 0.0)
+    # the last 5 cm/s add v²/(2d) to the default stop: the two stops agree to a few cm
+    assert res.stopping_distance == pytest.approx(ref.stopping_distance, abs=0.05)
+    assert res.stopping_time >= ref.stopping_time - 0.01
+
+
+def test_train_at_rest_within_a_step_stops_where_friction_stops_it():
+    # large steps, locked wheels, the train comes to rest inside a step: v = 0, not below
+    res = simulate(VEHICLE, PolachAdhesion("polach2005_wet"), 3.0, 6e5,
+                   cylinders=BrakeCylinders(max_pressure=6e5), dt=0.05, stop_speed=1e-9)
+    h = res.histories
+    assert h["train_speed"].iloc[-1] == 0.0 and h["train_speed"].min() == 0.0
+    assert res.stopping_time <= h["time"].iloc[-1] + 1e-12
+    assert res.stopping_time > h["time"].iloc[-2]
+    assert np.all(np.isfinite(h.to_numpy()[1:]))

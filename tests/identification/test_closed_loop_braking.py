@@ -13,7 +13,7 @@ import pytest
 from typer.testing import CliRunner
 
 from railadhesion.braking import BrakingFileError, Vehicle, write_braking_log
-from railadhesion.braking.adhesion import CallableAdhesion, PolachAdhesion, polach_family_curve
+from railadhesion.braking.adhesion import CallableAdhesion, PolachAdhesion
 from railadhesion.braking.run import simulate
 from railadhesion.braking.scenario import load_scenario
 from railadhesion.cli import app
@@ -23,10 +23,14 @@ from railadhesion.identification import (
     load_adhesion_law,
     read_braking_log,
 )
+from railadhesion.models import polach_forces
 from railadhesion.models.parameters import PolachParameters
 
 LOW = dict(k_A=0.3, k_S=0.1, mu0=0.13, A=0.4, B=0.3)
 NOISE = {"train_speed": 0.01, "wheel_speed": 0.02, "brake_pressure": 0.01}
+# the logs are the first seconds of a stop (max_time): an unfinished stop, knowingly
+pytestmark = pytest.mark.filterwarnings(
+    "ignore:the train did not stop:railadhesion.plausibility.UntrustedResultWarning")
 
 
 @pytest.fixture(scope="module")
@@ -44,11 +48,10 @@ def _true_mu(adhesion, ident):
     rows, axles = np.nonzero(ident.use)
     v = ident.speed[rows]
     dv = ident.slip[rows, axles]
-    stiff = adhesion.contact.stiffness_over_load(ident.normal_load[rows, axles] / 2)
-    params = np.broadcast_to(np.array([[LOW[k] for k in ("k_A", "k_S", "mu0", "A", "B")]]),
-                             (rows.size, 1, 5))
-    mu, _ = polach_family_curve(dv / v, v[:, None], np.ones((rows.size, 1)), params, stiff)
-    return v, dv, mu
+    q = ident.normal_load[rows, axles] / 2  # one wheel
+    a, b = adhesion.contact.semi_axes(q)
+    fx, _ = polach_forces(dv / v, 0.0, 0.0, q, v, a, b, **LOW)
+    return v, dv, -fx / q
 
 
 def test_brake_coefficient_within_two_percent(loop):

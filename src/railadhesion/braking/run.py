@@ -9,10 +9,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from railadhesion.braking.adhesion import (
-    AxleAdhesion,
-)
+from railadhesion.braking.adhesion import AxleAdhesion
 from railadhesion.braking.cylinders import ATMOSPHERIC_PRESSURE, BrakeCylinders
+from railadhesion.braking.demand import BrakeDemand
 from railadhesion.braking.simulator import BrakingSimulator
 from railadhesion.braking.vehicle import Vehicle
 from railadhesion.braking.wsp import WheelSlideProtection, as_controller
@@ -21,29 +20,6 @@ __all__ = ["BrakeDemand", "BrakingResult", "simulate", "LOCK_CREEP", "summarise"
 
 #: An axle counts as locked while its creepage is at least this (wheel below 5 % of v).
 LOCK_CREEP = 0.95
-
-
-@dataclass(frozen=True)
-class BrakeDemand:
-    """Commanded brake-cylinder pressure over time: 0 before ``start_time``, then a linear
-    ramp over ``ramp_time`` [s] up to ``pressure`` [Pa] (a step when ``ramp_time`` is 0)."""
-
-    pressure: float = 3.0e5
-    start_time: float = 0.0
-    ramp_time: float = 0.0
-
-    def __post_init__(self):
-        for name in ("pressure", "start_time", "ramp_time"):
-            x = getattr(self, name)
-            if not (isinstance(x, int | float) and math.isfinite(x) and x >= 0):
-                raise ValueError(f"{name} must be a finite number >= 0, got {x!r}")
-
-    def __call__(self, time: float) -> float:
-        if time < self.start_time:
-            return 0.0
-        if self.ramp_time <= 0:
-            return self.pressure
-        return self.pressure * min(1.0, (time - self.start_time) / self.ramp_time)
 
 
 @dataclass
@@ -222,40 +198,46 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
     progress : callable, optional
         Called now and then with the fraction of the initial speed lost (0 … 1).
     compiled : bool
-        Use the compiled whole-run loop when possible (Polach, WILAC with a
+        Evaluate the adhesion model in compiled code when it can be (Polach, WILAC with a
         :class:`WaterFlowProfile` or a :class:`CallableAdhesion` of a numba ``@njit``
-        function; a :class:`BrakeDemand`; no WSP or the default
-        :class:`WheelSlideProtection`); with another demand or controller the compiled step
-        runs inside a Python loop; with ``False`` the same steps run in Python (any adhesion
-        model, any controller). All give the same results.
+        function). The whole stop runs in one compiled loop with a :class:`BrakeDemand` and
+        no WSP or the default :class:`WheelSlideProtection` (which then runs inside the
+        step); with another demand or controller (or ``compiled=False``) a Python loop calls
+        the demand and the controller between compiled steps. All give the same results.
 
     Returns
     -------
     BrakingResult
     """
-    sim = BrakingSimulator(vehicle, adhesion, initial_speed, cylinders=cylinders,
-                           gradient=gradient, refresh_period=refresh_period,
-                           stop_speed=stop_speed, max_step=dt, record=True,
-                           compiled=compiled)
     demand = BrakeDemand(float(brake)) if isinstance(brake, int | float) else brake
     if not callable(demand):
         raise ValueError(f"brake must be a pressure [Pa] or a function of time, got {brake!r}")
     if wsp is True:
         wsp = WheelSlideProtection()
     controller = as_controller(wsp, control_period)
+    if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
+        raise ValueError(f"dt must be in (0, inf) s, got {dt!r}")
     ratio = 1
     if controller is not None:
         ratio = int(round(controller.period / dt))
         if ratio < 1 or abs(ratio * dt - controller.period) > 1e-9 * controller.period:
             raise ValueError(f"the control period ({controller.period} s) must be a whole "
                              f"multiple of dt ({dt} s)")
-        controller.reset(vehicle.n_axles, vehicle.wheel_radius)
     if not (math.isfinite(max_time) and max_time > 0):
         raise ValueError(f"max_time must be in (0, inf) s, got {max_time!r}")
+    builtin_wsp = controller is None or type(controller) is WheelSlideProtection
+    compiled_loop = compiled and type(demand) is BrakeDemand and builtin_wsp
+    sim = BrakingSimulator(vehicle, adhesion, initial_speed, cylinders=cylinders,
+                           gradient=gradient, refresh_period=refresh_period,
+                           stop_speed=stop_speed, max_step=dt, record=True,
+                           compiled=compiled, wsp=controller if compiled_loop else None)
     nmax = int(math.ceil(max_time / dt))
-    if compiled and sim._use_compiled and _fast_path_possible(demand, controller):
-        _run_compiled(sim, demand, controller, ratio, nmax, dt, progress, initial_speed)
+    if compiled_loop:
+        sim.configure_run(demand)
+        sim.run_compiled(nmax, dt, progress)
     else:
+        if controller is not None:
+            controller.reset(vehicle.n_axles, vehicle.wheel_radius)
         _run_python(sim, demand, controller, ratio, nmax, dt, progress, initial_speed)
     h = sim.histories()
     status = 0 if sim.stopped else 1
@@ -271,6 +253,7 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
 
 
 def _run_python(sim, demand, controller, ratio, nmax, dt, progress, initial_speed):
+    """The loop of a whole stop in Python: demand and controller called between steps."""
     n = sim.vehicle.n_axles
     report_every = max(1, int(round(1.0 / dt)))
     command = sim.inputs.pressure_command
@@ -292,15 +275,3 @@ def _run_python(sim, demand, controller, ratio, nmax, dt, progress, initial_spee
             progress(1.0 - sim.speed / initial_speed)
         if sim.stopped:
             break
-
-
-def _fast_path_possible(demand, controller) -> bool:
-    """The compiled loop runs the brake demand and the default WSP itself."""
-    return type(demand) is BrakeDemand and (
-        controller is None or type(controller) is WheelSlideProtection)
-
-
-def _run_compiled(sim, demand, controller, ratio, nmax, dt, progress, initial_speed):
-    """The loop of _run_python in one compiled kernel (same operations, same results)."""
-    sim._configure_run(controller, demand, ratio)
-    sim._run_compiled(nmax, dt, progress, initial_speed)

@@ -48,6 +48,23 @@ deceleration thresholds, the three valve states and a watchdog.
   together with all the others find the train speed again (and lift the reference).
 * Watchdog: a valve group may not stay out of APPLY (hold or vent) longer than
   ``watchdog_time``; it is then forced to APPLY (refilled) for ``watchdog_refill_time``.
+
+Compiled form (what the braking step runs)
+------------------------------------------
+The logic is written once, :func:`wsp_update`, a numba function on two one-element record
+arrays, the controller's settings (:meth:`WheelSlideProtection.settings_record`) and state
+(:meth:`WheelSlideProtection.state_record`)::
+
+    wsp_update(settings, state, t, omega_meas, pressure_meas, command, external_speed,
+               valves_out)
+
+``omega_meas`` [rad/s] and ``pressure_meas`` [Pa] are the measured wheelset speeds and
+cylinder pressures (from :func:`railadhesion.braking.sensors.measure`), ``command`` the
+commanded pressure per axle [Pa], ``external_speed`` a measured train speed [m/s] or NaN
+(none; this controller does not use it), ``valves_out`` the new valve state per axle (int64:
+0 apply, 1 hold, 2 vent). It raises nothing and allocates nothing. The built-in WSP of the
+braking step calls it every control period; :meth:`WheelSlideProtection.__call__` calls it
+for Python loops.
 """
 
 from __future__ import annotations
@@ -56,10 +73,12 @@ import math
 from dataclasses import dataclass, fields
 
 import numpy as np
+from numba import njit
 
 from railadhesion.braking.cylinders import APPLY, HOLD, VENT
+from railadhesion.braking.records import MAX_AXLES
 
-__all__ = ["WSPSettings", "WheelSlideProtection", "as_controller"]
+__all__ = ["WSPSettings", "WheelSlideProtection", "as_controller", "wsp_update"]
 
 
 @dataclass(frozen=True)
@@ -95,8 +114,90 @@ class WSPSettings:
             raise ValueError("slip ratios must satisfy reapply <= hold <= vent")
 
 
+#: The controller's settings record: the thresholds of WSPSettings and the wheel radius.
+SETTINGS_DTYPE = np.dtype([(f.name, "f8") for f in fields(WSPSettings)]
+                          + [("wheel_radius", "f8")], align=True)
+#: The controller's state record (per-axle fields: the first n_axles values are used).
+STATE_DTYPE = np.dtype([
+    ("started", "i8"), ("reference_speed", "f8"), ("previous_speed", "f8", (MAX_AXLES,)),
+    ("deceleration", "f8", (MAX_AXLES,)), ("valve", "i8", (MAX_AXLES,)),
+    ("released_since", "f8", (MAX_AXLES,)), ("forced_until", "f8", (MAX_AXLES,)),
+    ("vent_actions", "i8"),
+], align=True)
+
+
+@njit(cache=True, error_model="numpy")
+def wsp_update(settings, state, t, omega_meas, pressure_meas, command, external_speed,
+               valves_out):
+    """One control period of the default WSP (see the module docstring)."""
+    p = settings[0]
+    s = state[0]
+    n = omega_meas.shape[0]
+    radius = p.wheel_radius
+    period = p.period
+    fastest = -math.inf
+    for i in range(n):
+        fastest = max(fastest, omega_meas[i] * radius)
+    if s.started == 0:
+        for i in range(n):
+            s.previous_speed[i] = omega_meas[i] * radius
+        s.reference_speed = fastest
+        s.started = 1
+    alpha = period / (p.deceleration_filter + period)
+    for i in range(n):  # wheel deceleration, low-pass filtered
+        u = omega_meas[i] * radius
+        raw = (s.previous_speed[i] - u) / period
+        s.deceleration[i] += alpha * (raw - s.deceleration[i])
+        s.previous_speed[i] = u
+    ref = s.reference_speed
+    rate = p.reference_deceleration
+    if fastest < ref - max(p.hold_slip_ratio * ref, p.hold_slip_min):  # every axle sliding
+        rate = p.sliding_reference_deceleration
+    v_ref = max(fastest, ref - rate * period)
+    s.reference_speed = v_ref
+    hold = max(p.hold_slip_ratio * v_ref, p.hold_slip_min)
+    vent = max(p.vent_slip_ratio * v_ref, p.vent_slip_min)
+    reapply = max(p.reapply_slip_ratio * v_ref, p.reapply_slip_min)
+    for i in range(n):
+        slip = v_ref - omega_meas[i] * radius
+        a = s.deceleration[i]
+        old = s.valve[i]
+        new = old
+        want_vent = slip > vent or a > p.vent_deceleration
+        want_hold = slip > hold or a > p.hold_deceleration
+        accelerating = -a > p.recovery_acceleration
+        if old == APPLY:
+            new = VENT if want_vent else (HOLD if want_hold else APPLY)
+        elif old == VENT:
+            if accelerating:
+                new = HOLD
+        elif want_vent and not accelerating:
+            new = VENT
+        elif slip < reapply and not accelerating and a < p.hold_deceleration:
+            new = APPLY
+        # watchdog
+        if t < s.forced_until[i]:
+            new = APPLY
+        elif new != APPLY:
+            if math.isnan(s.released_since[i]):
+                s.released_since[i] = t
+            elif t - s.released_since[i] >= p.watchdog_time - 1e-12:
+                new = APPLY
+                s.forced_until[i] = t + p.watchdog_refill_time
+        if new == APPLY:
+            s.released_since[i] = math.nan
+        if new == VENT and old != VENT:
+            s.vent_actions += 1
+        s.valve[i] = new
+        valves_out[i] = new
+
+
 class WheelSlideProtection:
-    """Generic per-axle WSP controller (see the module docstring). State kept between calls."""
+    """Generic per-axle WSP controller (see the module docstring). State kept between calls.
+
+    The logic is :func:`wsp_update`; this object holds its settings and state records
+    (:meth:`settings_record`, :meth:`state_record`), built by :meth:`reset`.
+    """
 
     def __init__(self, settings: WSPSettings | None = None, **changes):
         if settings is None:
@@ -106,70 +207,52 @@ class WheelSlideProtection:
         self.settings = settings
         self.period = settings.period
         self.n_axles = 0
+        self.radius = math.nan
 
     def reset(self, n_axles: int, wheel_radius: float) -> None:
-        self.n_axles = n_axles
+        """Start afresh for a vehicle of ``n_axles`` wheelsets of radius ``wheel_radius``."""
+        if not 1 <= n_axles <= MAX_AXLES:
+            raise ValueError(f"n_axles must be in [1, {MAX_AXLES}], got {n_axles!r}")
+        self.n_axles = int(n_axles)
         self.radius = float(wheel_radius)
-        self.state = np.full(n_axles, APPLY, dtype=np.int64)
-        self.released_since = np.full(n_axles, np.nan)
-        self.forced_until = np.full(n_axles, -np.inf)
-        self.previous = None
-        self.deceleration = np.zeros(n_axles)
-        self.reference_speed = None
-        self.vent_actions = 0
+        self._settings = self.settings_record()
+        self._state = self.state_record(n_axles)
+        self._valves = np.zeros(n_axles, dtype=np.int64)
+
+    def settings_record(self) -> np.ndarray:
+        """The settings as a one-element record array (after :meth:`reset`: it holds the
+        wheel radius)."""
+        rec = np.zeros(1, SETTINGS_DTYPE)
+        for f in fields(WSPSettings):
+            rec[0][f.name] = getattr(self.settings, f.name)
+        rec[0]["wheel_radius"] = self.radius
+        return rec
+
+    def state_record(self, n_axles: int) -> np.ndarray:
+        """A fresh state as a one-element record array (all valves APPLY)."""
+        rec = np.zeros(1, STATE_DTYPE)
+        rec[0]["released_since"] = np.nan
+        rec[0]["forced_until"] = -np.inf
+        return rec
+
+    @property
+    def reference_speed(self):
+        """The reference speed [m/s] (None before the first call)."""
+        s = self._state[0]
+        return float(s["reference_speed"]) if s["started"] else None
+
+    @property
+    def vent_actions(self) -> int:
+        return int(self._state[0]["vent_actions"])
 
     def __call__(self, time, wheel_speeds, pressure_command):
-        s = self.settings
-        u = np.asarray(wheel_speeds, float) * self.radius
-        if self.previous is None:
-            self.previous = u.copy()
-            self.reference_speed = float(u.max())
-        raw = (self.previous - u) / s.period
-        alpha = s.period / (s.deceleration_filter + s.period)
-        self.deceleration += alpha * (raw - self.deceleration)
-        self.previous = u.copy()
-        ref = self.reference_speed
-        hold = max(s.hold_slip_ratio * ref, s.hold_slip_min)
-        rate = (s.sliding_reference_deceleration if float(u.max()) < ref - hold
-                else s.reference_deceleration)
-        v_ref = max(float(u.max()), ref - rate * s.period)
-        self.reference_speed = v_ref
-        slip = v_ref - u
-        hold = max(s.hold_slip_ratio * v_ref, s.hold_slip_min)
-        vent = max(s.vent_slip_ratio * v_ref, s.vent_slip_min)
-        reapply = max(s.reapply_slip_ratio * v_ref, s.reapply_slip_min)
-        a = self.deceleration
-        new = self.state.copy()
-        for i in range(self.n_axles):
-            st = self.state[i]
-            want_vent = slip[i] > vent or a[i] > s.vent_deceleration
-            want_hold = slip[i] > hold or a[i] > s.hold_deceleration
-            if st == APPLY:
-                new[i] = VENT if want_vent else (HOLD if want_hold else APPLY)
-            elif st == VENT:
-                if -a[i] > s.recovery_acceleration:
-                    new[i] = HOLD
-            else:  # HOLD
-                accelerating = -a[i] > s.recovery_acceleration
-                if want_vent and not accelerating:
-                    new[i] = VENT
-                elif slip[i] < reapply and not accelerating and a[i] < s.hold_deceleration:
-                    new[i] = APPLY
-            # watchdog
-            if time < self.forced_until[i]:
-                new[i] = APPLY
-            elif new[i] != APPLY:
-                if np.isnan(self.released_since[i]):
-                    self.released_since[i] = time
-                elif time - self.released_since[i] >= s.watchdog_time - 1e-12:
-                    new[i] = APPLY
-                    self.forced_until[i] = time + s.watchdog_refill_time
-            if new[i] == APPLY:
-                self.released_since[i] = np.nan
-            if new[i] == VENT and st != VENT:
-                self.vent_actions += 1
-        self.state = new
-        return new.copy()
+        omega = np.ascontiguousarray(wheel_speeds, dtype=float)
+        n = self.n_axles
+        command = np.broadcast_to(np.asarray(pressure_command, float), (n,)).copy()
+        pressures = np.full(n, np.nan)  # not given to a controller called from Python
+        wsp_update(self._settings, self._state, float(time), omega, pressures, command,
+                   math.nan, self._valves)
+        return self._valves.copy()
 
 
 def as_controller(controller, period: float | None):
