@@ -231,7 +231,7 @@ def test_fletcher_condition_as_user_callable_and_xarray_result():
     assert ds["adhesion_used"].max() <= water.mu + 1e-9
 
 
-# --- standstill (issue 18) -------------------------------------------------------------------
+# --- careless inputs (issue 18): standstill, step size ----------------------------------------
 
 COACH_DAMP = WaterFlowProfile.sections([(50.0, 900.0, 25.0)])
 
@@ -268,3 +268,27 @@ def test_train_at_rest_within_a_step_stops_where_friction_stops_it():
     assert res.stopping_time <= h["time"].iloc[-1] + 1e-12
     assert res.stopping_time > h["time"].iloc[-2]
     assert np.all(np.isfinite(h.to_numpy()[1:]))
+
+
+def test_a_step_too_large_for_the_wheel_dynamics_is_refused_with_the_largest_stable_step():
+    from railadhesion.braking.simulator import largest_stable_step
+
+    coach = Vehicle(name="coach")
+    tau, where = largest_stable_step(coach, WilacAdhesion(COACH_DAMP), 44.44)
+    # the reported step is the slide time constant J v / (R² N |dμ/dξ|) at the reported point
+    expected = coach.wheelset_inertia * where["speed_m_s"] / (
+        coach.wheel_radius**2 * where["axle_load_N"] * abs(where["slope"]))
+    assert tau == pytest.approx(expected, rel=1e-12)
+    assert 0.005 < tau < 0.03 and where["condition"] == "WILAC at 25 µl/s"
+    for dt in (0.04, 0.05):  # the issue's steps: now refused up front, the cause named
+        with pytest.raises(ValueError, match=rf"largest stable step is {tau:.3g} s"):
+            simulate(coach, WilacAdhesion(COACH_DAMP), 44.44, 5.5e5, dt=dt)
+    # just below it the stop is computed, and close to the 1 ms stop
+    step = math.floor(tau * 1e3) / 1e3
+    a = simulate(coach, WilacAdhesion(COACH_DAMP), 44.44, 5.5e5, dt=step,
+                 cylinders=BrakeCylinders(max_pressure=6e5))
+    b = simulate(coach, WilacAdhesion(COACH_DAMP), 44.44, 5.5e5, dt=1e-3,
+                 cylinders=BrakeCylinders(max_pressure=6e5))
+    assert a.stopping_distance == pytest.approx(b.stopping_distance, rel=2e-3)
+    # a curve that never falls allows any step
+    assert largest_stable_step(coach, CallableAdhesion(ample), 44.44)[0] == math.inf

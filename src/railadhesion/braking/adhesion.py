@@ -268,6 +268,17 @@ class _PolachFamily(AxleAdhesion):
         mu, dmu, _ = self.slopes(creep, speed)
         return mu, dmu
 
+    def slope_table(self, creeps, speed):
+        """dμ/dξ of every axle (columns) at each of ``creeps`` (rows), at the prepared
+        conditions."""
+        from railadhesion.braking.curves import family_slope_table
+
+        creeps = np.ascontiguousarray(creeps, dtype=float)
+        weights, params, stiffness, workspace = self._tables()
+        out = np.empty((creeps.size, weights.shape[0]))
+        family_slope_table(creeps, float(speed), weights, params, stiffness, workspace, out)
+        return out
+
     def available(self, speed):
         from railadhesion.braking.curves import family_peak
 

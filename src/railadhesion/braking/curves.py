@@ -53,7 +53,8 @@ from railadhesion.models.kernels import (
 )
 
 __all__ = ["new_workspace", "build_lanes", "evaluate_lanes", "peak_lanes", "water_flow_at",
-           "wilac_axle_parameters", "family_slopes", "family_peak", "register_python_model",
+           "wilac_axle_parameters", "family_slopes", "family_slope_table", "family_peak",
+           "register_python_model",
            "refresh_adhesion", "evaluate_adhesion", "peak_adhesion"]
 
 _GOLDEN = 0.6180339887498949
@@ -565,6 +566,20 @@ def family_slopes(creep, speed, weights, params, stiffness, workspace, mu, dmu, 
         mu[i] = c.mu[i]
         dmu[i] = c.dmu[i]
         dmv[i] = c.dmv[i]
+
+
+@njit(cache=True, error_model="numpy")
+def family_slope_table(creeps, speed, weights, params, stiffness, workspace, out):
+    """dμ/dξ of every axle (columns of ``out``) at each of ``creeps`` (rows)."""
+    c = workspace[0]
+    n = weights.shape[0]
+    build_lanes(c, n, weights.shape[1], weights, params, stiffness)
+    for j in range(creeps.shape[0]):
+        for i in range(n):
+            c.creep[i] = creeps[j]
+        evaluate_lanes(c, n, speed)
+        for i in range(n):
+            out[j, i] = c.dmu[i]
 
 
 @njit(cache=True, error_model="numpy")

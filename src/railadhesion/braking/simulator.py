@@ -40,9 +40,11 @@ Integration (stiff wheels: the creep-force slope gives wheel time constants
    rest the creepage, (v − ωR)/v, is defined as 0 (wheel and rail at rest);
 5. distance by the trapezoidal rule.
 
-The scheme is L-stable for the wheel modes at any step, deterministic (no randomness, fixed
-iteration order), and first-order accurate; results converge as the step halves (tested).
-Stop: when v falls below ``stop_speed`` (default 0.05 m/s) the
+The scheme is L-stable for the wheel modes on the rising branch of the creep curve at any
+step, deterministic (no randomness, fixed iteration order), and first-order accurate; results
+converge as the step halves (tested). On the falling branch a wheel's slide grows with the
+time constant ``J v / (R² N |dμ/dξ|)``; a step longer than it is refused (see
+:func:`largest_stable_step`). Stop: when v falls below ``stop_speed`` (default 0.05 m/s) the
 run ends; the remaining distance ``v²/(2d)`` and time ``v/d`` at the current deceleration are
 added.
 
@@ -86,7 +88,8 @@ from railadhesion.braking.records import (
 )
 from railadhesion.braking.vehicle import GRAVITY, Vehicle
 
-__all__ = ["BrakingSimulator", "BrakingState", "LiveState", "StepInputs", "SimulationError"]
+__all__ = ["BrakingSimulator", "BrakingState", "LiveState", "StepInputs", "SimulationError",
+           "largest_stable_step"]
 
 NEWTON_TOL = 5e-6  # a Newton update below this fraction of v (in v and every ω R) is accepted
 _ROWS_BLOCK = 4096  # history rows per block
@@ -282,6 +285,73 @@ def _user_entries(adhesion):
     return entries
 
 
+def largest_stable_step(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float):
+    """The longest step [s] the integrator accepts for this vehicle and adhesion model.
+
+    On the falling branch of a creep curve (dμ/dξ < 0) a braked wheel's slide grows with the
+    time constant ``τ = J v / (R² N |dμ/dξ|)`` (the linearised wheel equation
+    ``J dω/dt = R N μ(ξ) − c p`` with ``ξ = (v − ωR)/v``; for friction falling with the slip
+    velocity Δv = ξ v it is ``J / (R² N |dμ/dΔv|)``, nearly the same at every speed).
+    Backward Euler with a step longer than τ turns that growth into a decay and its implicit
+    wheel equation loses its unique root (its pivot ``J/dt − R² N |dμ/dξ|/v`` changes sign):
+    the steps no longer follow a slide, nor a WSP's release of it. The largest stable step is
+    the smallest τ over the axle loads (static, and under a deceleration of 3 m/s²), speeds
+    from ``initial_speed`` down to 1 m/s and creepages from 1e-4 to 1, for every adhesion
+    condition the model holds (each Polach set; WILAC dry and at the water flows of its
+    profile; a :class:`CallableAdhesion` law). It is inf when no curve falls, and for models
+    defined in Python otherwise (not examined).
+
+    Returns ``(tau, where)``: the step [s] and a dict saying where it is reached (condition,
+    speed, creepage, slope, axle load).
+    """
+    import warnings
+
+    from railadhesion.braking.adhesion import PolachAdhesion, WaterFlowProfile, WilacAdhesion
+
+    radius, inertia = vehicle.wheel_radius, vehicle.wheelset_inertia
+    loads = np.unique(np.concatenate([vehicle.axle_normal_loads(0.0),
+                                      vehicle.axle_normal_loads(3.0)]))
+    loads = loads[loads > 0]
+    m = loads.size
+    speeds = np.geomspace(max(float(initial_speed), 1.0), 1.0, 12)
+    creeps = np.geomspace(1e-4, 1.0, 161)
+    if type(adhesion) is PolachAdhesion:
+        probes = [(p.name, PolachAdhesion(p, contact=adhesion.contact)) for p in adhesion.sets]
+    elif type(adhesion) is WilacAdhesion and isinstance(adhesion.water_flow, WaterFlowProfile):
+        probes = [(f"WILAC at {w:g} µl/s", WilacAdhesion(w, adhesion.parameters,
+                                                         contact=adhesion.contact))
+                  for w in sorted({0.0, *map(float, adhesion.water_flow.values)})]
+    elif isinstance(adhesion, CallableAdhesion) and (
+            type(adhesion).evaluate is CallableAdhesion.evaluate):
+        probes = [(adhesion.label, CallableAdhesion(adhesion.function, adhesion.needs_load,
+                                                    adhesion.h, adhesion.label))]
+    else:
+        return math.inf, {}
+    best, where = math.inf, {}
+    for label, model in probes:
+        model.bind(m, radius)
+        for v in speeds:
+            model.prepare(float(v), 0.5 * loads, np.zeros(m), 0.0)
+            if isinstance(model, CallableAdhesion):
+                try:  # the user's law on every (creepage, load) at once
+                    with warnings.catch_warnings(), np.errstate(all="ignore"):
+                        warnings.simplefilter("ignore")
+                        _, slope = model.evaluate(np.repeat(creeps, m), float(v))
+                    slope = np.asarray(slope, float).reshape(creeps.size, m)
+                except Exception:  # the law rejects these arrays: the run will tell
+                    return math.inf, {}
+            else:
+                slope = model.slope_table(creeps, float(v))
+            rate = np.where(slope < 0.0, -slope, 0.0) * (radius**2 * loads) / float(v)
+            rate = np.where(np.isfinite(rate), rate, 0.0)
+            j, a = np.unravel_index(np.argmax(rate), rate.shape)
+            if rate[j, a] > 0 and inertia / rate[j, a] < best:
+                best = inertia / rate[j, a]
+                where = {"condition": label, "speed_m_s": float(v), "creep": float(creeps[j]),
+                         "slope": float(slope[j, a]), "axle_load_N": float(loads[a])}
+    return best, where
+
+
 class BrakingSimulator:
     """A vehicle braking on a track, advanced step by step (FMI-like co-simulation slave).
 
@@ -313,7 +383,7 @@ class BrakingSimulator:
         Speed [m/s] at which the run ends (default 0.05 m/s).
     max_step : float
         Longest internal step [s]; a longer step is split into equal sub-steps (default
-        2e-3 s).
+        2e-3 s). A step longer than :func:`largest_stable_step` is refused (ValueError).
     record : bool
         Keep the history of every step (for :meth:`histories`); with recording the adhesion
         available (peak of each axle's curve) is computed at every refresh, without it on
@@ -378,6 +448,7 @@ class BrakingSimulator:
         from railadhesion.braking.sensors import IdealSensors
         from railadhesion.braking.wsp import WheelSlideProtection
 
+        self._check_step()
         d = self.__dict__
         veh = self.vehicle
         n = veh.n_axles
@@ -508,6 +579,17 @@ class BrakingSimulator:
             entries = entries[:4] + (step.advance_python, step.advance_python_recorded)
         tables = np.concatenate(parts) if parts else np.zeros(1)
         return model, aux, entries, tables
+
+    def _check_step(self):
+        tau, where = largest_stable_step(self.vehicle, self.adhesion, self.initial_speed)
+        if self.max_step > tau:
+            raise ValueError(
+                f"max_step (the time step) {self.max_step:g} s is too large for the wheel "
+                f"dynamics: the largest stable step is {tau:.3g} s. On the falling branch of "
+                f"the creep curve ({where['condition']}: dμ/dξ = {where['slope']:.3g} at "
+                f"creepage {where['creep']:.3g}, speed {where['speed_m_s']:.3g} m/s, axle load "
+                f"{where['axle_load_N']:.4g} N) a wheel's slide grows with the time constant "
+                f"J v/(R² N |dμ/dξ|) = {tau:.3g} s; use a step of at most {tau:.3g} s")
 
     @property
     def compiled(self) -> bool:
