@@ -231,7 +231,7 @@ def test_fletcher_condition_as_user_callable_and_xarray_result():
     assert ds["adhesion_used"].max() <= water.mu + 1e-9
 
 
-# --- careless inputs (issue 18): standstill, step size ----------------------------------------
+# --- careless inputs (issue 18): standstill, step size, pressure cap, unfinished stops --------
 
 COACH_DAMP = WaterFlowProfile.sections([(50.0, 900.0, 25.0)])
 
@@ -248,7 +248,7 @@ def test_speed_never_goes_negative_at_standstill(wsp):
     h = res.histories
     omega = h[[f"wheel_speed_{i}" for i in range(1, 5)]].to_numpy()
     creep = h[[f"creep_{i}" for i in range(1, 5)]].to_numpy()
-    assert res.success
+    assert res.success and res.trusted
     assert h["train_speed"].min() >= 0.0 and omega.min() >= 0.0
     assert np.all(np.abs(creep) <= 1.0)  # braking creep in [0, 1]; never beyond
     last = h.iloc[-1]
@@ -292,3 +292,38 @@ def test_a_step_too_large_for_the_wheel_dynamics_is_refused_with_the_largest_sta
     assert a.stopping_distance == pytest.approx(b.stopping_distance, rel=2e-3)
     # a curve that never falls allows any step
     assert largest_stable_step(coach, CallableAdhesion(ample), 44.44)[0] == math.inf
+
+
+def test_demand_above_the_cylinder_limit_is_reported_not_silently_clipped():
+    import warnings
+
+    from railadhesion.braking import WheelSlideProtection, load_vehicle
+    from railadhesion.plausibility import AlteredResultWarning
+
+    coach = load_vehicle("coach_default")
+    with pytest.warns(AlteredResultWarning, match=r"550000 Pa \(5.5 bar\).*380000 Pa"):
+        res = simulate(coach, WilacAdhesion(COACH_DAMP), 44.44, 5.5e5,
+                       wsp=WheelSlideProtection())
+    assert res.summary["pressure_clipped"] and res.summary["max_pressure_Pa"] == 3.8e5
+    assert res.warnings and "5.5 bar" in res.warnings[0] and res.summary["warnings"]
+    assert res.trusted  # altered, not untrusted: the stop at 3.8 bar is computed correctly
+    assert res.stopping_distance == pytest.approx(728.3, abs=0.05)  # the issue's number
+    # a function of time above the limit: reported after the run
+    with pytest.warns(AlteredResultWarning, match="clipped to it in"):
+        simulate(VEHICLE, PolachAdhesion(), 5.0, lambda t: 4e5 if t > 0.5 else 1e5,
+                 dt=4e-3)
+    with warnings.catch_warnings():  # within the limit: no warning, no flag
+        warnings.simplefilter("error")
+        res = simulate(coach, WilacAdhesion(COACH_DAMP), 44.44, 5.5e5,
+                       cylinders=BrakeCylinders(max_pressure=6e5), wsp=WheelSlideProtection())
+    assert not res.summary["pressure_clipped"] and res.warnings == []
+
+
+def test_a_stop_that_does_not_end_is_untrusted():
+    from railadhesion.plausibility import UntrustedResultWarning
+
+    with pytest.warns(UntrustedResultWarning, match="did not stop within max_time"):
+        res = simulate(VEHICLE, PolachAdhesion(), 20.0, 2e5, dt=4e-3, max_time=2.0)
+    assert not res.trusted and not res.summary["trusted"] and res.status == 1
+    assert math.isnan(res.stopping_distance)
+    assert res.summary["warnings"] == res.warnings

@@ -15,6 +15,7 @@ from railadhesion.braking.demand import BrakeDemand
 from railadhesion.braking.simulator import BrakingSimulator
 from railadhesion.braking.vehicle import Vehicle
 from railadhesion.braking.wsp import WheelSlideProtection, as_controller
+from railadhesion.plausibility import AlteredResultWarning, UntrustedResultWarning, warn
 
 __all__ = ["BrakeDemand", "BrakingResult", "simulate", "LOCK_CREEP", "summarise"]
 
@@ -40,9 +41,17 @@ class BrakingResult:
     success : bool
     summary : dict
         Stopping distance and time, per-axle maximum slip and longest lock, adhesion
-        utilisation, air consumption, energy balance (see :func:`summarise`).
+        utilisation, air consumption, energy balance (see :func:`summarise`); the flags
+        ``pressure_clipped`` (a command above the cylinders' ``max_pressure`` was clipped to
+        it), ``trusted`` and ``warnings``.
     settings : dict
         What was simulated (vehicle, adhesion model, step, WSP).
+    warnings : list of str
+        What was altered or cannot be trusted (each also issued as a warning:
+        :class:`~railadhesion.plausibility.AlteredResultWarning`,
+        :class:`~railadhesion.plausibility.UntrustedResultWarning`).
+    trusted : bool
+        False when the train did not stop within ``max_time`` or a result is NaN.
     """
 
     histories: pd.DataFrame
@@ -50,6 +59,8 @@ class BrakingResult:
     message: str
     summary: dict
     settings: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
+    trusted: bool = True
 
     @property
     def success(self) -> bool:
@@ -185,7 +196,10 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
         [m/s].
     brake : float or callable
         Commanded brake-cylinder pressure [Pa]: a constant applied at t = 0, a
-        :class:`BrakeDemand`, or a function of time.
+        :class:`BrakeDemand`, or a function of time. A command above the cylinders'
+        ``max_pressure`` is clipped to it: an
+        :class:`~railadhesion.plausibility.AlteredResultWarning` says so, and the summary
+        flags it (``pressure_clipped``).
     cylinders : BrakeCylinders, optional
     wsp : None, True, WheelSlideProtection, or controller
         ``None``: no WSP (valves always apply); ``True``: the default
@@ -194,7 +208,9 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
     control_period : float, optional
         Period of a plain-function controller [s] (objects carry their own ``period``).
     dt : float
-        Simulation step [s]; the control period must be a whole multiple of it.
+        Simulation step [s]; the control period must be a whole multiple of it. A step too
+        large for the wheel dynamics is refused (``ValueError`` naming the largest stable
+        step, :func:`~railadhesion.braking.simulator.largest_stable_step`).
     progress : callable, optional
         Called now and then with the fraction of the initial speed lost (0 … 1).
     compiled : bool
@@ -208,6 +224,9 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
     Returns
     -------
     BrakingResult
+        ``trusted`` is False (with an
+        :class:`~railadhesion.plausibility.UntrustedResultWarning`) when the train did not
+        stop within ``max_time`` or a result is NaN.
     """
     demand = BrakeDemand(float(brake)) if isinstance(brake, int | float) else brake
     if not callable(demand):
@@ -231,6 +250,14 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
                            gradient=gradient, refresh_period=refresh_period,
                            stop_speed=stop_speed, max_step=dt, record=True,
                            compiled=compiled, wsp=controller if compiled_loop else None)
+    notes = []
+    cap = sim.cylinders.max_pressure
+    if isinstance(demand, BrakeDemand) and demand.pressure > cap:
+        notes.append(warn(
+            f"the brake demand {demand.pressure:.6g} Pa ({demand.pressure / 1e5:.3g} bar) is "
+            f"above the brake cylinders' max_pressure {cap:.6g} Pa ({cap / 1e5:.3g} bar): the "
+            f"cylinders brake at {cap / 1e5:.3g} bar (raise BrakeCylinders(max_pressure=...) "
+            "if the demand is meant)", AlteredResultWarning))
     nmax = int(math.ceil(max_time / dt))
     if compiled_loop:
         sim.configure_run(demand)
@@ -239,6 +266,12 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
         if controller is not None:
             controller.reset(vehicle.n_axles, vehicle.wheel_radius)
         _run_python(sim, demand, controller, ratio, nmax, dt, progress, initial_speed)
+    report = sim.command_report
+    if report["clipped_steps"] and not notes:
+        notes.append(warn(
+            f"the brake demand reached {report['highest_command_Pa']:.6g} Pa, above the brake "
+            f"cylinders' max_pressure {cap:.6g} Pa: clipped to it in "
+            f"{report['clipped_steps']} steps", AlteredResultWarning))
     h = sim.histories()
     status = 0 if sim.stopped else 1
     message = ("the train stopped" if sim.stopped
@@ -249,7 +282,23 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
                 else type(controller).__name__, "initial_speed_m_s": initial_speed}
     if progress is not None:
         progress(1.0)
-    return BrakingResult(h, status, message, summarise(sim, h), settings)
+    summary = summarise(sim, h)
+    if not sim.stopped:
+        notes.append(warn(
+            f"the train did not stop within max_time = {max_time:g} s (speed {sim.speed:.4g} "
+            f"m/s left): the stopping distance and time are unknown (NaN); the result is "
+            "untrusted", UntrustedResultWarning))
+    elif not (math.isfinite(summary["stopping_distance_m"]) and np.all(np.isfinite(
+            h[["time", "distance", "train_speed"]].to_numpy()))):
+        notes.append(warn("the simulation gave NaN results; the result is untrusted",
+                          UntrustedResultWarning))
+    trusted = not any("untrusted" in note for note in notes)
+    summary["pressure_clipped"] = bool(report["clipped_steps"])
+    summary["highest_command_Pa"] = report["highest_command_Pa"]
+    summary["max_pressure_Pa"] = cap
+    summary["trusted"] = trusted
+    summary["warnings"] = list(notes)
+    return BrakingResult(h, status, message, summary, settings, notes, trusted)
 
 
 def _run_python(sim, demand, controller, ratio, nmax, dt, progress, initial_speed):
