@@ -9,19 +9,31 @@ library directly (wilac_forces / polach_forces with scalars, plus adhesion) for 
 Also timed: fmpy.simulate_fmu with an input table that changes every step (FMPy's own loop,
 input interpolation and recording included). Figures are medians of several repeats; this
 machine is shared, so they vary run to run: compare ratios.
+
+Native FMUs (``--native``, issue 25) are timed in the C host of the tests
+(``tests/export/data/fmi2_host.c``, compiled here), a process with no Python: per step with
+every input changing (setReal of all inputs, doStep, getReal of the three outputs) and doStep
+alone; beside them, in the same run, the Python FMU of the same law in the same C host (with
+libpython preloaded, as docs/fmu.md tells non-Python hosts) and both FMUs under FMPy.
 """
 
 from __future__ import annotations
 
+import os
 import statistics
+import subprocess
+import sys
+import sysconfig
 import tempfile
 import time
+import zipfile
 from pathlib import Path
 
 import numpy as np
 
 import railadhesion
-from railadhesion.export import build_creep_force_fmu
+from railadhesion.export import build_creep_force_fmu, build_native_creep_force_fmu
+from railadhesion.export.native import find_c_compiler
 
 N_STEPS = 2000
 REPEATS = 5
@@ -236,7 +248,60 @@ def bench_braking(tmp: Path, steps: int = 2000) -> tuple[float, float]:
     return fmu_us, direct_us
 
 
+HOST_SOURCE = Path(__file__).resolve().parents[1] / "tests" / "export" / "data" / "fmi2_host.c"
+
+
+def _libpython() -> str | None:
+    if not sysconfig.get_config_var("Py_ENABLE_SHARED"):
+        return None
+    path = Path(sysconfig.get_config_var("LIBDIR")) / sysconfig.get_config_var("LDLIBRARY")
+    return str(path) if path.is_file() else None
+
+
+def bench_c_host(host: Path, fmu: Path, model: str, water: str, repeat: int,
+                 preload: str | None = None) -> tuple[float, ...]:  # fmt: skip
+    """(set + doStep + get, doStep alone) [µs] of ``fmu`` in the C host, wall clock and the
+    host thread's CPU time: N_STEPS rows of inputs changing every step, ``repeat`` passes
+    (medians of REPEATS runs of the host)."""
+    from fmpy import read_model_description
+
+    md = read_model_description(fmu)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    rows = _inputs(model, N_STEPS, water)
+    names = list(rows[0])
+    where = Path(tempfile.mkdtemp(prefix="bench_host_"))
+    with zipfile.ZipFile(fmu) as z:
+        z.extractall(where)
+    binary = where / "binaries" / "linux64" / f"{md.coSimulation.modelIdentifier}.so"
+    table = "\n".join(" ".join(repr(x[k]) for k in names) for x in rows)
+    refs_in = " ".join(str(vr[k]) for k in names)
+    refs_out = " ".join(str(vr[k]) for k in ("Fx", "Fy", "adhesion"))
+    commands = (f"new 0\ninit 0\nbench 0 {len(names)} {refs_in} 3 {refs_out} {N_STEPS} "
+                f"{repeat}\n{table}\nmaps\n")  # fmt: skip
+    env = {k: v for k, v in os.environ.items() if k not in ("LD_PRELOAD", "PYTHONPATH")}
+    if preload:  # the Python FMU: libpython preloaded, the package importable
+        env["LD_PRELOAD"] = preload
+        env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)
+    full, step, cpu_full, cpu_step = [], [], [], []
+    for _ in range(REPEATS):
+        out = subprocess.run([str(host), "--script", str(binary), (where / "resources").as_uri(),
+                              md.guid], input=commands, capture_output=True, text=True,
+                             env=env, timeout=1200)  # fmt: skip
+        lines = out.stdout.split("\n")
+        bench = next(line for line in lines if line.startswith("bench")).split()
+        if bench[4] != "0" or bench[3] != "0":
+            raise RuntimeError(f"the host reported status {bench[4]}, {bench[3]} allocations")
+        if preload is None and "maps 0" not in lines:
+            raise RuntimeError("a Python library was mapped into the host running a native FMU")
+        full.append(float(bench[1]) / 1e3)
+        step.append(float(bench[2]) / 1e3)
+        cpu_full.append(float(bench[5]) / 1e3)
+        cpu_step.append(float(bench[6]) / 1e3)
+    return tuple(statistics.median(x) for x in (full, step, cpu_full, cpu_step))
+
+
 def main() -> None:
+    print(f"load average at the start: {os.getloadavg()[0]:.2f} (2 cores, shared)")
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         t0 = time.perf_counter()
@@ -244,24 +309,60 @@ def main() -> None:
         build_s = time.perf_counter() - t0
         polach = build_creep_force_fmu(tmp / "polach.fmu", "polach")
         print(f"build of one FMU: {build_s * 1e3:.0f} ms")
+        native = {}
+        if find_c_compiler() is not None:
+            t0 = time.perf_counter()
+            native["wilac"] = build_native_creep_force_fmu(tmp / "wilac_native.fmu", "wilac")
+            native_s = time.perf_counter() - t0
+            native["polach"] = build_native_creep_force_fmu(tmp / "polach_native.fmu", "polach")
+            print(f"build of one native FMU (numba compile, LLVM, C compiler): {native_s:.1f} s")
         print(f"per-step cost, median of {REPEATS} x {N_STEPS} steps, every input changing "
               "(µs/step; setReal + doStep + getReal):")
         print(f"{'case':<34}{'FMU (FMU2Slave)':>16}{'direct call':>13}{'ratio':>7}"
               f"{'simulate_fmu':>14}")
-        for label, model, path, water in [
-            ("WILAC, dry (w = 0)", "wilac", wilac, "dry"),
-            ("WILAC, damp (w in 10-60 µl/s)", "wilac", wilac, "damp"),
-            ("Polach polach2005_dry", "polach", polach, "dry"),
-        ]:
-            r = bench(model, path, water)
-            print(f"{label:<34}{r['fmu']:>16.1f}{r['direct']:>13.1f}"
-                  f"{r['fmu'] / r['direct']:>7.1f}{r['simulate']:>14.1f}")
+        cases = [
+            ("WILAC, dry (w = 0)", "wilac", "dry"),
+            ("WILAC, damp (w in 10-60 µl/s)", "wilac", "damp"),
+            ("Polach polach2005_dry", "polach", "dry"),
+        ]
+        python_fmus = {"wilac": wilac, "polach": polach}
+        for label, model, water in cases:
+            for kind, path in (("", python_fmus[model]), (" native", native.get(model))):
+                if path is None:
+                    continue
+                r = bench(model, path, water)
+                print(f"{label + kind:<34}{r['fmu']:>16.2f}{r['direct']:>13.2f}"
+                      f"{r['fmu'] / r['direct']:>7.2f}{r['simulate']:>14.1f}")
         print(f"FMI + pythonfmu + FMPy overhead (FMU that copies its input, 8 values in, 3 out): "
               f"{bench_overhead(tmp):.1f} µs/step")
+        if native:
+            _c_host_table(tmp, native, python_fmus, cases)
         fmu_us, direct_us = bench_braking(tmp)
         print(f"braking-vehicle FMU (4 axles, WILAC damp example, 1 ms steps): {fmu_us:.1f} "
               f"µs/step under FMPy, {direct_us:.1f} µs/step through BrakingSimulator.step "
               f"directly ({1e3 / fmu_us:.1f}x / {1e3 / direct_us:.1f}x real time)")
+    print(f"load average at the end: {os.getloadavg()[0]:.2f}")
+
+
+def _c_host_table(tmp: Path, native: dict, python_fmus: dict, cases) -> None:
+    """Native FMUs and the Python FMUs in the same C host, same inputs, same run."""
+    host = tmp / "fmi2_host"
+    subprocess.run([*find_c_compiler(), "-O2", "-o", str(host), str(HOST_SOURCE), "-ldl"],
+                   check=True, timeout=120)  # fmt: skip
+    libpython = _libpython()
+    print("in a C host (no Python in the process for the native FMU; the Python FMU with "
+          "libpython preloaded), µs/step, wall clock [CPU time of the host thread]:")
+    print(f"{'case':<34}{'native set+step+get':>22}{'native doStep':>18}{'Python FMU':>18}"
+          f"{'ratio':>7}")
+    for label, model, water in cases:
+        full, step, cfull, cstep = bench_c_host(host, native[model], model, water, repeat=50)
+        if libpython is not None:
+            py_full, _, py_cfull, _ = bench_c_host(host, python_fmus[model], model, water,
+                                                   repeat=1, preload=libpython)  # fmt: skip
+            py = f"{py_full:>9.1f} [{py_cfull:5.1f}]{py_full / full:>7.0f}"
+        else:
+            py = f"{'(no libpython)':>25}"
+        print(f"{label:<34}{full:>13.3f} [{cfull:5.3f}]{step:>9.3f} [{cstep:5.3f}]{py}")
 
 
 if __name__ == "__main__":

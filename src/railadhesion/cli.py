@@ -728,9 +728,10 @@ from railadhesion import (  # noqa: E402
     cli_export,
     cli_identification,
     cli_sweeps,
+    cli_wsp,
 )
 
-for _module in (cli_braking, cli_identification, cli_sweeps, cli_export):
+for _module in (cli_braking, cli_identification, cli_sweeps, cli_export, cli_wsp):
     _module.register(app)
 
 if __name__ == "__main__":  # pragma: no cover

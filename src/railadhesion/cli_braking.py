@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import math
 import warnings
 from pathlib import Path
 
@@ -17,28 +16,17 @@ from railadhesion.plausibility import RailadhesionWarning
 console = Console()
 
 
-def _clean(obj):
-    """JSON-safe copy (NaN and inf become null)."""
-    if isinstance(obj, dict):
-        return {str(k): _clean(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_clean(v) for v in obj]
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    if hasattr(obj, "item"):
-        return _clean(obj.item())
-    return obj
-
-
 def write_outputs(result, out: Path, *, figures: bool = True, parquet: bool = True,
                   log: bool = False) -> list[Path]:
     """Write summary.json, histories.csv (+ .parquet), figures and optionally a test log."""
+    from railadhesion.braking.bench import json_safe
+
     out.mkdir(parents=True, exist_ok=True)
     written = []
     summary = {"status": result.status, "message": result.message, **result.summary,
                "settings": result.settings}
     path = out / "summary.json"
-    path.write_text(json.dumps(_clean(summary), indent=2, ensure_ascii=False) + "\n",
+    path.write_text(json.dumps(json_safe(summary), indent=2, ensure_ascii=False) + "\n",
                     encoding="utf-8")
     written.append(path)
     path = out / "histories.csv"
@@ -123,7 +111,10 @@ def register(app: typer.Typer) -> None:
             table.add_row(escape("extension vs dry [m, %]"),
                           f"{s['extension_m']:.1f}  ({s['extension_percent']:.1f} %)")
         table.add_row(escape("max slip [%]"), f"{100 * s['max_slip']:.1f}")
-        table.add_row(escape("longest lock [s]"), f"{s['longest_lock_s']:.2f}")
+        table.add_row(escape("longest lock [s] (wheel < 10 % of train speed)"),
+                      f"{s['longest_lock_s']:.2f}")
+        table.add_row(escape("deep slide [s, m slid] (creepage >= 0.5)"),
+                      f"{s['deep_slide_s']:.2f}, {s['deep_slide_distance_m']:.1f}")
         table.add_row("mean adhesion utilisation", f"{s['mean_adhesion_utilisation']:.3f}")
         table.add_row(escape("WSP vent actions / vented air [l]"),
                       f"{s['vent_actions']} / {s['vented_air_l']:.0f}")

@@ -48,22 +48,39 @@ def export_fmu(
     out: Path = typer.Option(Path("creepforce.fmu"), help="The FMU file to write (.fmu)."),
     shear_modulus: float = typer.Option(8.2e10, help="Start value of parameter G [Pa]."),
     poisson: float = typer.Option(0.28, help="Start value of Poisson's ratio [-]."),
+    native: bool = typer.Option(
+        False, "--native",
+        help="Compile the law into the FMU (linux64 binary and its sources): no Python on "
+             "the host. Needs a C compiler here. Default: the Python FMU (pythonfmu).",
+    ),  # fmt: skip
 ) -> None:
-    """Write an FMI 2.0 co-simulation FMU of a creep-force law (needs Python on the host)."""
-    from railadhesion.export import build_creep_force_fmu, resolve_parameters
+    """Write an FMI 2.0 co-simulation FMU of a creep-force law (the Python FMU needs Python
+    on the host; --native does not)."""
+    from railadhesion.export import (
+        NativeBuildError,
+        build_creep_force_fmu,
+        build_native_creep_force_fmu,
+        resolve_parameters,
+    )
 
+    build = build_native_creep_force_fmu if native else build_creep_force_fmu
     try:
         resolved = resolve_parameters(model, params, parameter_set)
-        path = build_creep_force_fmu(
+        path = build(
             out, model, params, parameter_set=parameter_set,
             shear_modulus=shear_modulus, poisson=poisson,
         )  # fmt: skip
+    except NativeBuildError as exc:
+        _fail(f"no native FMU: {exc}")
     except ValueError as exc:
         _fail(exc)
     except OSError as exc:
         _fail(f"cannot write {out}: {exc.strerror or exc}")
     console.print(f"FMU written to {escape(str(path))}")
     console.print(escape(f"{model}: {resolved.summary()}"))
+    if native:
+        console.print("native FMU: binaries/linux64 needs no Python on the host; sources in "
+                      "sources/ (docs/fmu.md)")  # fmt: skip
     try:
         from fmpy.validation import validate_fmu
     except ImportError:  # pragma: no cover - fmpy is optional at run time

@@ -458,8 +458,10 @@ def plot_wilac_speeds(
 
 
 def plot_fit(result, *, title: str = "", n_points: int = 200, ax=None):
-    """Fitted model against the measured creep curve (from :func:`~railadhesion.calibration.
-    fitting.fit_polach` or :func:`~railadhesion.calibration.fitting.fit_fletcher`).
+    """Fitted model against the measured creep curve (a fit result of Polach or Fletcher).
+
+    ``result`` comes from :func:`~railadhesion.calibration.fitting.fit_polach` or
+    :func:`~railadhesion.calibration.fitting.fit_fletcher`.
 
     Parameters
     ----------

@@ -61,10 +61,43 @@ def damp_runs(tmp_path_factory):
             "without": without}
 
 
-def test_step_halving_converges_on_damp_scenario_with_wsp(damp_runs):
+class _Replay:
+    """Valve states of a recorded run, per control period (open loop)."""
+
+    def __init__(self, histories, period):
+        self.period = period
+        cols = [c for c in histories.columns if c.startswith("valve_")]
+        t = histories["time"].to_numpy()[1:]
+        v = histories[cols].to_numpy()[1:]
+        self.table = {}
+        for k, row in zip(np.floor((t - 1e-9) / period).astype(int), v, strict=True):
+            self.table.setdefault(int(k), row)
+        self.last = v[-1]
+
+    def reset(self, n_axles, wheel_radius):
+        pass
+
+    def __call__(self, time, wheel_speeds, pressure_command):
+        return self.table.get(int(round(time / self.period)), self.last)
+
+
+def test_step_halving_converges_on_damp_scenario_with_wsp(damp_runs, tmp_path):
+    """The integrator converges as the step halves with WSP valve activity: the valve states
+    of the run at dt, replayed at dt/2, give the same stop to 1e-3. In closed loop the WSP's
+    decisions (threshold crossings seen at 5 ms instants) may move by a period when the step
+    changes, and the stop with them (measured 0.1-1.3 % over the default programme's cases,
+    docs/wsp.md): compared at 3 %."""
     a, b = damp_runs["wsp"], damp_runs["halved"]
     assert a.summary["vent_actions"] > 5  # WSP is working hard
-    assert abs(a.stopping_distance - b.stopping_distance) < 1e-3 * b.stopping_distance
+    assert abs(a.stopping_distance - b.stopping_distance) < 0.03 * b.stopping_distance
+    path = tmp_path / "damp.toml"
+    path.write_text(DAMP)
+    sc = load_scenario(path)
+    replay = simulate(sc.vehicle, sc.adhesion(), sc.initial_speed, sc.brake,
+                      cylinders=sc.cylinders, wsp=_Replay(a.histories, sc.wsp.period),
+                      dt=sc.dt / 2, refresh_period=sc.refresh_period)
+    assert replay.summary["vent_actions"] == a.summary["vent_actions"]
+    assert abs(replay.stopping_distance - a.stopping_distance) < 1e-3 * a.stopping_distance
 
 
 def test_damp_rail_without_wsp_axles_lock_and_stay_locked(damp_runs):

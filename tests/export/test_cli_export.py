@@ -93,3 +93,35 @@ def test_export_table_rejects_bad_grids(tmp_path):
     result = runner.invoke(app, ["export", "table", "--speed", "ten"])
     assert result.exit_code == 2
     assert "--speed: expected numbers" in result.output
+
+
+def _native_possible():
+    import sys
+
+    from railadhesion.export.native import find_c_compiler
+
+    return sys.platform.startswith("linux") and find_c_compiler() is not None
+
+
+@pytest.mark.skipif(not _native_possible(), reason="native FMUs need Linux and a C compiler")
+def test_export_fmu_native_writes_a_valid_native_fmu(tmp_path):
+    out = tmp_path / "n.fmu"
+    result = runner.invoke(app, ["export", "fmu", "--native", "--model", "polach", "--out",
+                                 str(out)])  # fmt: skip
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    assert "passes FMPy's validation" in text and "needs no Python on the host" in text
+    with zipfile.ZipFile(out) as z:
+        names = z.namelist()
+    assert "binaries/linux64/railadhesion_polach.so" in names
+    assert "sources/railadhesion_polach.ll" in names and "sources/ra_fmi2.c" in names
+
+
+def test_export_fmu_native_without_a_compiler_says_so(tmp_path, monkeypatch):
+    monkeypatch.setenv("CC", "/nonexistent/cc")
+    out = tmp_path / "n.fmu"
+    result = runner.invoke(app, ["export", "fmu", "--native", "--out", str(out)])
+    assert result.exit_code == 2
+    text = " ".join(result.output.split())
+    assert "no C compiler found" in text and "the Python FMU remains available" in text
+    assert not out.exists()

@@ -14,9 +14,17 @@ from railadhesion.braking.adhesion import (
     WaterFlowProfile,
     WilacAdhesion,
 )
+from railadhesion.braking.bench import (
+    WSPProgrammeResult,
+    adhesion_limited_stop,
+    load_wsp_programme,
+    run_wsp_programme,
+)
 from railadhesion.braking.cylinders import APPLY, HOLD, VENT, BrakeCylinders
 from railadhesion.braking.log import braking_log_frame, write_braking_log
+from railadhesion.braking.metrics import slide_metrics
 from railadhesion.braking.run import BrakeDemand, BrakingResult, simulate
+from railadhesion.braking.sensors import EncoderSettings, ExternalSpeedSettings, SensorModel
 from railadhesion.braking.simulator import BrakingSimulator, BrakingState, SimulationError
 from railadhesion.braking.vehicle import GRAVITY, Vehicle, load_vehicle
 from railadhesion.braking.wsp import WheelSlideProtection, WSPSettings
@@ -36,13 +44,21 @@ __all__ = [
     "BrakingState",
     "CallableAdhesion",
     "ContactGeometry",
+    "EncoderSettings",
+    "ExternalSpeedSettings",
     "PolachAdhesion",
+    "SensorModel",
     "SimulationError",
+    "WSPProgrammeResult",
     "WSPSettings",
     "WaterFlowProfile",
     "WheelSlideProtection",
     "WilacAdhesion",
+    "adhesion_limited_stop",
+    "load_wsp_programme",
+    "run_wsp_programme",
     "simulate",
+    "slide_metrics",
     "Vehicle",
     "braking_log_frame",
     "load_vehicle",

@@ -10,17 +10,15 @@ import numpy as np
 import pandas as pd
 
 from railadhesion.braking.adhesion import AxleAdhesion
-from railadhesion.braking.cylinders import ATMOSPHERIC_PRESSURE, BrakeCylinders
+from railadhesion.braking.cylinders import BrakeCylinders
 from railadhesion.braking.demand import BrakeDemand
+from railadhesion.braking.metrics import slide_metrics
 from railadhesion.braking.simulator import BrakingSimulator
 from railadhesion.braking.vehicle import Vehicle
-from railadhesion.braking.wsp import WheelSlideProtection, as_controller
+from railadhesion.braking.wsp import WheelSlideProtection, as_controller, call_controller
 from railadhesion.plausibility import AlteredResultWarning, UntrustedResultWarning, warn
 
-__all__ = ["BrakeDemand", "BrakingResult", "simulate", "LOCK_CREEP", "summarise"]
-
-#: An axle counts as locked while its creepage is at least this (wheel below 5 % of v).
-LOCK_CREEP = 0.95
+__all__ = ["BrakeDemand", "BrakingResult", "simulate", "summarise"]
 
 
 @dataclass
@@ -111,16 +109,6 @@ class BrakingResult:
                 f"stopping_time={s.get('stopping_time_s'):.6g} s, rows={len(self.histories)})")
 
 
-def _longest_run(mask: np.ndarray, dt: np.ndarray) -> float:
-    """Longest total of ``dt`` over consecutive True entries of ``mask``."""
-    if not np.any(mask):
-        return 0.0
-    csum = np.cumsum(np.where(mask, dt, 0.0))
-    # value of the running sum at the last False before each entry
-    base = np.maximum.accumulate(np.where(mask, 0.0, csum))
-    return float(np.max(csum - base))
-
-
 def summarise(sim: BrakingSimulator, h: pd.DataFrame) -> dict:
     """Summary numbers of a finished run (see :class:`BrakingResult`)."""
     veh = sim.vehicle
@@ -128,6 +116,7 @@ def summarise(sim: BrakingSimulator, h: pd.DataFrame) -> dict:
     dt = np.diff(h["time"].to_numpy(), prepend=0.0)
     moving = h["train_speed"].to_numpy() > sim.stop_speed
     braking = (h["pressure_command"].to_numpy() > 0) & moving
+    slides = slide_metrics(h, veh.wheel_radius, cylinder_volume=sim.cylinders.cylinder_volume)
     axles = []
     used_sum = np.zeros(len(h))
     avail_sum = np.zeros(len(h))
@@ -141,16 +130,8 @@ def summarise(sim: BrakingSimulator, h: pd.DataFrame) -> dict:
             if np.any(ok) else math.nan
         used_sum += np.where(ok, used * load, 0.0)
         avail_sum += np.where(ok, avail * load, 0.0)
-        axles.append({
-            "axle": i,
-            "max_slip": float(np.max(creep)),
-            "longest_lock_s": _longest_run((creep >= LOCK_CREEP) & moving, dt),
-            "total_lock_s": float(np.sum(dt[(creep >= LOCK_CREEP) & moving])),
-            "mean_adhesion_utilisation": util,
-            "vent_actions": int(sim.vent_actions[i - 1]),
-            "vented_air_l": float(sim.vented_pressure[i - 1] * sim.cylinders.cylinder_volume
-                                  / ATMOSPHERIC_PRESSURE * 1e3),
-        })
+        axles.append({**slides["axles"][i - 1], "max_slip": float(np.max(creep)),
+                      "mean_adhesion_utilisation": util})
     ok = avail_sum > 0
     total_util = float(np.sum((used_sum[ok] / avail_sum[ok]) * dt[ok]) / np.sum(dt[ok])) \
         if np.any(ok) else math.nan
@@ -165,9 +146,11 @@ def summarise(sim: BrakingSimulator, h: pd.DataFrame) -> dict:
         "mean_deceleration_m_s2": sim.initial_speed / sim.stop_time if sim.stopped else math.nan,
         "mean_adhesion_utilisation": total_util,
         "max_slip": max(a["max_slip"] for a in axles),
-        "longest_lock_s": max(a["longest_lock_s"] for a in axles),
-        "vent_actions": int(np.sum(sim.vent_actions)),
-        "vented_air_l": float(sum(a["vented_air_l"] for a in axles)),
+        **{k: slides[k] for k in ("longest_lock_s", "time_locked_s", "time_locked_below_floor_s",
+                                  "deep_slide_s", "deep_slide_distance_m", "mean_creep",
+                                  "vent_actions", "vented_air_l")},
+        "slide_definitions": {k: slides[k] for k in ("lock_fraction", "speed_floor_m_s",
+                                                     "deep_creep")},
         "axles": axles,
         "energy": {
             "kinetic_energy_lost_J": ke0 - ke1,
@@ -233,6 +216,8 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
         raise ValueError(f"brake must be a pressure [Pa] or a function of time, got {brake!r}")
     if wsp is True:
         wsp = WheelSlideProtection()
+    if isinstance(wsp, WheelSlideProtection):
+        wsp.configure(vehicle, cylinders if cylinders is not None else BrakeCylinders())
     controller = as_controller(wsp, control_period)
     if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
         raise ValueError(f"dt must be in (0, inf) s, got {dt!r}")
@@ -312,7 +297,8 @@ def _run_python(sim, demand, controller, ratio, nmax, dt, progress, initial_spee
         if not (math.isfinite(cmd) and cmd >= 0):
             raise ValueError(f"brake demand at t = {t:.6g} s must be in [0, inf) Pa, got {cmd!r}")
         if controller is not None and k % ratio == 0:
-            out = np.asarray(controller(t, sim.omega.copy(), cmd), dtype=np.int64)
+            out = np.asarray(call_controller(controller, t, sim.omega.copy(), cmd,
+                                             sim.pressure.copy(), math.nan), dtype=np.int64)
             valves = sim.cylinders.group_valves(out, n)
             if np.any((valves < 0) | (valves > 2)):
                 raise ValueError(f"the controller returned valve states {out} at t = {t:.6g} s;"

@@ -38,31 +38,15 @@ from railadhesion.braking.adhesion import (
 from railadhesion.braking.cylinders import BrakeCylinders
 from railadhesion.braking.run import BrakeDemand, BrakingResult, simulate
 from railadhesion.braking.vehicle import Vehicle, load_vehicle
-from railadhesion.braking.wsp import WheelSlideProtection, WSPSettings
+from railadhesion.braking.wsp import WheelSlideProtection, WSPSettings, settings_file_keys
 from railadhesion.models.parameters import POLACH_PARAMETER_SETS
 
 __all__ = ["BrakeScenario", "load_scenario", "run_scenario", "SCENARIO_FORMAT"]
 
 SCENARIO_FORMAT = "railadhesion-brake-scenario"
 
-# WSP settings: TOML key -> (field, low, high)
-_WSP_KEYS = {
-    "period_s": ("period", 1e-4, 0.1),
-    "reference_deceleration_m_s2": ("reference_deceleration", 0.1, 10.0),
-    "sliding_reference_deceleration_m_s2": ("sliding_reference_deceleration", 0.1, 10.0),
-    "hold_slip_ratio": ("hold_slip_ratio", 0.0, 1.0),
-    "hold_slip_min_m_s": ("hold_slip_min", 0.0, 10.0),
-    "vent_slip_ratio": ("vent_slip_ratio", 0.0, 1.0),
-    "vent_slip_min_m_s": ("vent_slip_min", 0.0, 10.0),
-    "reapply_slip_ratio": ("reapply_slip_ratio", 0.0, 1.0),
-    "reapply_slip_min_m_s": ("reapply_slip_min", 0.0, 10.0),
-    "hold_deceleration_m_s2": ("hold_deceleration", 0.0, 100.0),
-    "vent_deceleration_m_s2": ("vent_deceleration", 0.0, 100.0),
-    "recovery_acceleration_m_s2": ("recovery_acceleration", 0.0, 100.0),
-    "deceleration_filter_s": ("deceleration_filter", 0.0, 1.0),
-    "watchdog_time_s": ("watchdog_time", 0.01, 60.0),
-    "watchdog_refill_time_s": ("watchdog_refill_time", 0.0, 60.0),
-}
+# WSP settings: TOML key -> (field, low, high) (railadhesion.braking.wsp.settings_file_keys)
+_WSP_KEYS = settings_file_keys()
 
 
 @dataclass
@@ -301,7 +285,10 @@ def _scenario_from_document(doc: Mapping, base: Path) -> BrakeScenario:
             kwargs = {}
             for key, (attr, lo, hi) in _WSP_KEYS.items():
                 if key in wt:
-                    kwargs[attr] = number(wt[key], f"wsp.{key}", lo, hi)
+                    if attr == "watchdog_cutout_trips":
+                        kwargs[attr] = integer(wt[key], f"wsp.{key}", int(lo), int(hi))
+                    else:
+                        kwargs[attr] = number(wt[key], f"wsp.{key}", lo, hi)
             try:
                 wsp = WSPSettings(**kwargs)
             except ValueError as exc:

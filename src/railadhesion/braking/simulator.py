@@ -395,11 +395,13 @@ class BrakingSimulator:
         with ``False`` (or any other model) the step calls the model's Python methods.
     wsp : WheelSlideProtection, optional
         Run this (built-in) WSP controller inside the step, every ``wsp.period``, on the
-        wheel speeds and pressures of the sensor model: the valve inputs are then ignored.
-        Default: none (the valves come from :attr:`inputs`).
-    sensors : optional
+        wheel speeds and pressures of the sensor model: the valve inputs are then ignored
+        (its settings left at None are taken from the vehicle and cylinders:
+        :meth:`~railadhesion.braking.wsp.WheelSlideProtection.configure`). Default: none
+        (the valves come from :attr:`inputs`).
+    sensors : SensorModel, optional
         The sensor model between the vehicle and the built-in WSP (default
-        :class:`~railadhesion.braking.sensors.IdealSensors`).
+        :func:`~railadhesion.braking.sensors.ideal_sensors`).
     """
 
     def __init__(self, vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float, *,
@@ -445,7 +447,7 @@ class BrakingSimulator:
     def _build(self):
         """(Re)build the records from the parameters (at construction, or when a parameter
         changes before the first step)."""
-        from railadhesion.braking.sensors import IdealSensors
+        from railadhesion.braking.sensors import ideal_sensors
         from railadhesion.braking.wsp import WheelSlideProtection
 
         self._check_step()
@@ -455,10 +457,13 @@ class BrakingSimulator:
         a = self.adhesion
         cyl = self.cylinders
         a.bind(n, veh.wheel_radius)
-        wsp = self.wsp if self.wsp is not None else WheelSlideProtection()
+        if self.wsp is not None:  # the settings left at None come from the vehicle
+            wsp = self.wsp.configure(veh, cyl)
+        else:  # records of the right layout; the WSP does not run
+            wsp = WheelSlideProtection()
         wsp.reset(n, veh.wheel_radius)
-        sensors = self.sensors if self.sensors is not None else IdealSensors()
-        records = (wsp.settings_record(), wsp.state_record(n), sensors.settings_record(),
+        sensors = self.sensors if self.sensors is not None else ideal_sensors()
+        records = (wsp.settings_record(), wsp.state_record(n), sensors.settings_record(n),
                    sensors.state_record(n))
         from railadhesion.braking.step import FINGERPRINT, MACHINE
 

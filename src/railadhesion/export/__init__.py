@@ -1,6 +1,8 @@
 """Use the models from other tools: FMI 2.0 co-simulation FMUs and creep-force tables.
 
 * :func:`build_creep_force_fmu`: a WILAC or Polach creep-force law as an FMU (pythonfmu);
+* :func:`build_native_creep_force_fmu`: the same law as a native FMU, compiled ahead of time
+  (no Python at run time; :mod:`railadhesion.export.native` builds any step model so);
 * :func:`build_braking_fmu`: the braking simulator's stepping API as an FMU (inputs: commanded
   pressure and WSP valve per axle);
 * :func:`creep_force_table`: a model evaluated on a grid, written as NetCDF
@@ -19,6 +21,8 @@ from railadhesion.export.fmu import (
     creep_force_variables,
     resolve_parameters,
 )
+from railadhesion.export.native import NativeBuildError
+from railadhesion.export.native_creepforce import build_native_creep_force_fmu
 from railadhesion.export.tables import (
     DEFAULT_GRID,
     InterpolationError,
@@ -34,10 +38,12 @@ __all__ = [
     "FMU_MODELS",
     "FmuVariable",
     "InterpolationError",
+    "NativeBuildError",
     "braking_fmu_variables",
     "build_braking_fmu",
     "build_creep_force_fmu",
     "build_fmu",
+    "build_native_creep_force_fmu",
     "creep_force_table",
     "creep_force_variables",
     "interpolation_error",

@@ -21,6 +21,7 @@ import contextlib
 import hashlib
 import html
 import json
+import math
 import shutil
 import sys
 import tempfile
@@ -37,8 +38,10 @@ __all__ = [
     "ResolvedParameters",
     "build_creep_force_fmu",
     "build_fmu",
+    "creep_force_documentation",
     "creep_force_variables",
     "resolve_parameters",
+    "unit_definitions",
 ]
 
 #: Models the creep-force FMU can wrap.
@@ -257,11 +260,17 @@ def _add_units(root: ET.Element, variables: Sequence[FmuVariable]) -> None:
             real.set("max", repr(float(var.max)))
         if var.unit not in used:
             used.append(var.unit)
-    units = ET.Element("UnitDefinitions")
-    for unit in sorted(used):
-        node = ET.SubElement(units, "Unit", {"name": unit})
-        ET.SubElement(node, "BaseUnit", UNIT_DEFINITIONS[unit])
-    root.insert(_child_index(root, ("ModelExchange", "CoSimulation")), units)
+    root.insert(_child_index(root, ("ModelExchange", "CoSimulation")), unit_definitions(used))
+
+
+def unit_definitions(units: Iterable[str]) -> ET.Element:
+    """The ``UnitDefinitions`` element of a model description for ``units`` (keys of
+    :data:`UNIT_DEFINITIONS`), sorted by name."""
+    node = ET.Element("UnitDefinitions")
+    for unit in sorted(set(units)):
+        ET.SubElement(ET.SubElement(node, "Unit", {"name": unit}), "BaseUnit",
+                      UNIT_DEFINITIONS[unit])  # fmt: skip
+    return node
 
 
 def _add_vendor_annotation(root: ET.Element, metadata: ET.Element) -> None:
@@ -288,13 +297,20 @@ def _add_initial_unknowns(root: ET.Element) -> None:
 # Creep-force FMU
 
 
-def creep_force_variables(model: str) -> list[FmuVariable]:
+def creep_force_variables(model: str, *, shear_modulus: float = 8.2e10,
+                          poisson: float = 0.28) -> list[FmuVariable]:  # fmt: skip
     """The variables of the creep-force FMU of ``model`` (``"wilac"`` or ``"polach"``).
 
     Inputs: creepages, spin, normal force, speed, semi-axes and (WILAC) water flow; fixed
-    parameters: elastic constants; outputs: Fx, Fy, adhesion. Signs: ``docs/CONVENTIONS.md``.
+    parameters: elastic constants, with start values ``shear_modulus`` [Pa] in (0, inf) and
+    ``poisson`` [-] in [0, 0.5]; outputs: Fx, Fy, adhesion. Signs: ``docs/CONVENTIONS.md``.
     """
     _check_model(model)
+    g, nu = float(shear_modulus), float(poisson)
+    if not (0.0 < g < math.inf):
+        raise ValueError(f"shear_modulus must be in (0, inf), got {shear_modulus!r}")
+    if not (0.0 <= nu <= 0.5):
+        raise ValueError(f"poisson must be in [0, 0.5], got {poisson!r}")
     inputs = [
         FmuVariable("creep_long", "input", "1",
                     "Longitudinal creepage xi = (V - omega R)/V; braking > 0, traction < 0", 0.0),
@@ -315,9 +331,9 @@ def creep_force_variables(model: str) -> list[FmuVariable]:
                         min=0.0)
         )  # fmt: skip
     parameters = [
-        FmuVariable("shear_modulus", "parameter", "Pa", "Combined shear modulus G", 8.2e10,
+        FmuVariable("shear_modulus", "parameter", "Pa", "Combined shear modulus G", g,
                     min=0.0),
-        FmuVariable("poisson", "parameter", "1", "Combined Poisson's ratio nu", 0.28,
+        FmuVariable("poisson", "parameter", "1", "Combined Poisson's ratio nu", nu,
                     min=0.0, max=0.5),
     ]  # fmt: skip
     outputs = [
@@ -352,6 +368,37 @@ class ResolvedParameters:
     @property
     def sha256(self) -> str:
         return hashlib.sha256(self.toml.encode("utf-8")).hexdigest()
+
+    @property
+    def label(self) -> str:
+        """The law's name as printed: WILAC or Polach."""
+        return "WILAC" if self.model == "wilac" else "Polach"
+
+    def describe(self, where: str) -> str:
+        """The ``description`` of a creep-force FMU of this set: the law, the set, its
+        provenance, then ``where`` (where the FMU holds the set)."""
+        import railadhesion
+
+        summary = self.summary()
+        return (
+            f"railadhesion {railadhesion.__version__}: {self.label} wheel-rail creep-force law "
+            f"(forces of the rail on the wheel, Kalker's signs). {summary[0].upper()}"
+            f"{summary[1:]}. {where}"
+        )
+
+    def metadata(self, file: str) -> ET.Element:
+        """``ParameterSet`` element for the FMU's ``VendorAnnotations``: name, model, origin,
+        the SHA-256 of ``file`` (the set's text, where the FMU holds it) and the provenance."""
+        import railadhesion
+
+        meta = ET.Element("ParameterSet", {
+            "model": self.model, "name": self.name, "origin": self.origin, "file": file,
+            "sha256": self.sha256, "railadhesionVersion": railadhesion.__version__,
+        })  # fmt: skip
+        prov = ET.SubElement(meta, "Provenance")
+        for key, value in self.provenance.items():
+            prov.set(key, str(value).lower() if isinstance(value, bool) else str(value))
+        return meta
 
     def summary(self) -> str:
         """One paragraph: the set, where it comes from, whether it is a reconstruction."""
@@ -493,25 +540,8 @@ def build_creep_force_fmu(
     import railadhesion
 
     resolved = resolve_parameters(model, params, parameter_set)
-    variables = creep_force_variables(model)
-    starts = {"shear_modulus": float(shear_modulus), "poisson": float(poisson)}
-    if not (starts["shear_modulus"] > 0):
-        raise ValueError(f"shear_modulus must be > 0, got {shear_modulus!r}")
-    if not (0.0 <= starts["poisson"] <= 0.5):
-        raise ValueError(f"poisson must be in [0, 0.5], got {poisson!r}")
-    variables = [
-        FmuVariable(v.name, v.causality, v.unit, v.description, starts[v.name], v.min, v.max)
-        if v.name in starts
-        else v
-        for v in variables
-    ]
-    label = "WILAC" if model == "wilac" else "Polach"
-    summary = resolved.summary()
-    description = (
-        f"railadhesion {railadhesion.__version__}: {label} wheel-rail creep-force law "
-        f"(forces of the rail on the wheel, Kalker's signs). {summary[0].upper()}{summary[1:]}. "
-        f"Embedded as resources/{_PARAMETER_FILE}."
-    )
+    variables = creep_force_variables(model, shear_modulus=shear_modulus, poisson=poisson)
+    description = resolved.describe(f"Embedded as resources/{_PARAMETER_FILE}.")
     config = {
         "model": model,
         "parameter_file": _PARAMETER_FILE,
@@ -521,20 +551,7 @@ def build_creep_force_fmu(
         "license": resolved.provenance.get("licence", ""),
         "variables": [v.to_config() for v in variables],
     }
-    meta = ET.Element(
-        "ParameterSet",
-        {
-            "model": model,
-            "name": resolved.name,
-            "origin": resolved.origin,
-            "file": f"resources/{_PARAMETER_FILE}",
-            "sha256": resolved.sha256,
-            "railadhesionVersion": railadhesion.__version__,
-        },
-    )
-    prov = ET.SubElement(meta, "Provenance")
-    for key, value in resolved.provenance.items():
-        prov.set(key, str(value).lower() if isinstance(value, bool) else str(value))
+    meta = resolved.metadata(f"resources/{_PARAMETER_FILE}")
     return build_fmu(
         Path(__file__).with_name("railadhesion_creepforce.py"),
         variables,
@@ -543,13 +560,23 @@ def build_creep_force_fmu(
             _CONFIG_FILE: json.dumps(config, indent=2),
             _PARAMETER_FILE: resolved.toml,
         },
-        documentation=_documentation(label, description, resolved, variables),
+        documentation=creep_force_documentation(
+            description, resolved, variables, runs=_RUNS_PYTHON,
+            file=f"resources/{_PARAMETER_FILE}",
+        ),  # fmt: skip
         metadata=meta,
     )
 
 
-def _documentation(label, description, resolved, variables) -> str:
+_RUNS_PYTHON = ("Runs Python: the host needs a Python interpreter with the railadhesion "
+                "package installed.")
+
+
+def creep_force_documentation(description, resolved, variables, *, runs: str, file: str) -> str:
+    """``documentation/index.html`` of a creep-force FMU: description, what the host needs
+    (``runs``), the variables, the parameter set (held in ``file``) and its provenance."""
     esc = html.escape
+    label = resolved.label
     rows = "".join(
         f"<tr><td>{esc(v.name)}</td><td>{v.causality}</td><td>{esc(v.unit)}</td>"
         f"<td>{esc(v.description)}</td></tr>"
@@ -562,11 +589,10 @@ def _documentation(label, description, resolved, variables) -> str:
         "<!DOCTYPE html>\n<html><head><meta charset='utf-8'>"
         f"<title>{label} creep-force FMU</title></head><body>\n"
         f"<h1>{label} creep-force FMU (railadhesion)</h1>\n<p>{esc(description)}</p>\n"
-        "<p>Runs Python: the host needs a Python interpreter with the railadhesion package "
-        "installed. Sign convention: Kalker's (creepage (V - omega R)/V, braking positive; "
-        "forces of the rail on the wheel oppose the creepages).</p>\n"
+        f"<p>{esc(runs)} Sign convention: Kalker's (creepage (V - omega R)/V, braking "
+        "positive; forces of the rail on the wheel oppose the creepages).</p>\n"
         f"<h2>Variables</h2>\n<table border='1'><tr><th>name</th><th>causality</th>"
         f"<th>unit</th><th>description</th></tr>{rows}</table>\n"
-        f"<h2>Parameter set '{esc(resolved.name)}'</h2>\n<p>File: resources/{_PARAMETER_FILE} "
+        f"<h2>Parameter set '{esc(resolved.name)}'</h2>\n<p>File: {esc(file)} "
         f"(sha256 {resolved.sha256}).</p>\n<table border='1'>{prov}</table>\n</body></html>\n"
     )

@@ -526,7 +526,7 @@ def read_creep_curves(folder, pattern: str = "*.csv") -> list[CreepCurve]:
     ----------
     folder : str or path-like
         Directory holding the files (not searched recursively).
-    pattern : str, default "*.csv"
+    pattern : str, default ``"*.csv"``
         Glob pattern of the files to read.
 
     Returns

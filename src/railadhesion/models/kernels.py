@@ -63,7 +63,9 @@ import os
 
 import numba
 import numpy as np
-from numba import njit, prange
+from numba import carray, njit, prange
+from numba.core import cgutils, types
+from numba.extending import intrinsic
 
 from railadhesion.contact.kalker import _AOB_MAX, _AOB_MIN, _C33_GT_ROWS, _G_MIN, _NROW, _ROWS
 
@@ -846,6 +848,21 @@ def _wilac_blend(sx, sy, q, v, t, weights, pars):
     return fx, fy
 
 
+@intrinsic
+def _stack_doubles(typingctx, n):
+    """A pointer to ``n`` float64 (a compile-time constant) on the calling function's stack:
+    scratch space without a heap allocation, so that the scalar laws need no numba runtime and
+    can be compiled ahead of time (:mod:`railadhesion.export.native`)."""
+    if not isinstance(n, types.IntegerLiteral):
+        return None
+    size = n.literal_value
+
+    def codegen(context, builder, signature, args):
+        return cgutils.alloca_once(builder, context.get_value_type(types.float64), size=size)
+
+    return types.CPointer(types.float64)(n), codegen
+
+
 @njit(cache=True, error_model="numpy")
 def wilac_scalar(creep_x, creep_y, spin, normal_force, speed, a, b, water_flow, G, nu, c11, c22,
                  c23, packed):  # fmt: skip
@@ -857,7 +874,7 @@ def wilac_scalar(creep_x, creep_y, spin, normal_force, speed, a, b, water_flow, 
     if not c11 > 0.0:
         c11, c22, c23 = _kalker3(a / b, nu)
     weights = _weights(water_flow, packed)
-    scratch = np.empty(27)  # one allocation: the factors, then the parameters
+    scratch = carray(_stack_doubles(27), 27)  # on the stack: the factors, then the parameters
     fac = scratch[:7]
     pars = scratch[7:]
     _factors(normal_force, speed, packed, fac)

@@ -55,7 +55,8 @@ STUDY_OUTPUTS: dict[str, tuple[str, str]] = {
     "dry_stopping_distance": ("m", "stopping distance of the same stop on a dry rail (w = 0)"),
     "extension": ("m", "stopping-distance extension against the dry stop"),
     "extension_percent": ("%", "stopping-distance extension against the dry stop"),
-    "longest_lock": ("s", "longest continuous lock of any axle (creepage >= 0.95)"),
+    "longest_lock": ("s", "longest continuous lock of any axle (wheel below 10 % of the "
+                     "train speed, train above 0.5 m/s)"),
     "max_slip": ("1", "largest creepage of any axle"),
     "stopped": ("1", "1 if the train stopped before max_time, else 0"),
 }

@@ -1,0 +1,80 @@
+"""Every task guide's code runs, and prints what the page says it prints.
+
+A guide is a Markdown page in ``docs/guides/`` (``index.md`` aside). Its ```` ```python ````
+blocks run in order, in one namespace per page, in a temporary working directory. A
+```` ```text ```` block right after a python block (blank lines between allowed) is that
+block's expected output: the test compares it with what the block printed (trailing spaces
+ignored). After a change that alters the output on purpose, rewrite the text blocks with
+``RAILADHESION_UPDATE_GUIDES=1 python3 -m pytest tests/docs/test_guides.py`` and review the
+diff. See docs/contributing-docs.md.
+"""
+
+import contextlib
+import io
+import os
+import re
+from pathlib import Path
+
+import pytest
+
+GUIDES = Path(__file__).resolve().parents[2] / "docs" / "guides"
+FENCE = re.compile(r"^```(\w*)[^\n]*\n(.*?)^```[ \t]*$", re.M | re.S)
+UPDATE = os.environ.get("RAILADHESION_UPDATE_GUIDES") == "1"
+
+
+def blocks(text: str):
+    """[(code, expected output or None, (start, end) of the output block's body)]."""
+    fences = list(FENCE.finditer(text))
+    out = []
+    for i, fence in enumerate(fences):
+        if fence.group(1) != "python":
+            continue
+        expected, span = None, None
+        if i + 1 < len(fences):
+            nxt = fences[i + 1]
+            between = text[fence.end():nxt.start()]
+            if nxt.group(1) == "text" and not between.strip():
+                expected, span = nxt.group(2), nxt.span(2)
+        out.append((fence.group(2), expected, span))
+    return out
+
+
+def _clean(text: str) -> str:
+    return "\n".join(line.rstrip() for line in text.strip("\n").splitlines())
+
+
+PAGES = sorted(p for p in GUIDES.glob("*.md") if p.name != "index.md")
+
+
+@pytest.mark.parametrize("page", PAGES, ids=[p.stem for p in PAGES])
+def test_guide_runs_and_prints_what_it_shows(page, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    text = page.read_text(encoding="utf-8")
+    found = blocks(text)
+    assert found, f"{page.name} has no python block"
+    namespace = {"__name__": f"guide_{page.stem}"}
+    replacements = []
+    for n, (code, expected, span) in enumerate(found, start=1):
+        stdout = io.StringIO()
+        with contextlib.redirect_stdout(stdout):
+            exec(compile(code, f"{page.name}, python block {n}", "exec"), namespace)
+        if expected is None:
+            continue
+        if UPDATE:
+            printed = "\n".join(line.rstrip() for line in stdout.getvalue().splitlines())
+            replacements.append((span, printed))
+            continue
+        assert _clean(stdout.getvalue()) == _clean(expected), (
+            f"{page.name}, python block {n}: the output differs from the page's text block")
+    if UPDATE and replacements:
+        for (start, end), output in sorted(replacements, reverse=True):
+            text = text[:start] + output.rstrip("\n") + "\n" + text[end:]
+        page.write_text(text, encoding="utf-8")
+
+
+def test_the_parser_pairs_code_and_output():
+    text = "```python\nprint(1)\n```\n\n```text\n1\n```\n```python\nx = 2\n```\n```bash\nls\n```\n"
+    (code1, out1, _), (code2, out2, _) = blocks(text)
+    assert (code1, out1) == ("print(1)\n", "1\n")
+    assert (code2, out2) == ("x = 2\n", None)
