@@ -25,7 +25,12 @@ from railadhesion.braking.log import braking_log_frame, write_braking_log
 from railadhesion.braking.metrics import slide_metrics
 from railadhesion.braking.run import BrakeDemand, BrakingResult, simulate
 from railadhesion.braking.sensors import EncoderSettings, ExternalSpeedSettings, SensorModel
-from railadhesion.braking.simulator import BrakingSimulator, BrakingState, SimulationError
+from railadhesion.braking.simulator import (
+    BrakingSimulator,
+    BrakingState,
+    SimulationError,
+    largest_stable_step,
+)
 from railadhesion.braking.vehicle import GRAVITY, Vehicle, load_vehicle
 from railadhesion.braking.wsp import WheelSlideProtection, WSPSettings
 
@@ -61,6 +66,7 @@ __all__ = [
     "slide_metrics",
     "Vehicle",
     "braking_log_frame",
+    "largest_stable_step",
     "load_vehicle",
     "write_braking_log",
 ]

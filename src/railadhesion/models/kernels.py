@@ -71,11 +71,15 @@ from railadhesion.contact.kalker import _AOB_MAX, _AOB_MIN, _C33_GT_ROWS, _G_MIN
 
 __all__ = [
     "HEADER_SIZE",
+    "exp_scalar",
     "kalker_scalar",
     "pack_wilac",
     "polach_checked",
+    "polach_longitudinal",
     "polach_scalar",
+    "wilac_condition_parameters",
     "wilac_scalar",
+    "wilac_weights",
 ]
 
 # Kalker's table as compile-time constants (numba freezes global arrays into the code).
