@@ -535,28 +535,34 @@ def _kalker_rows(ratio, nus, c11, c22, c23, kpsi, tmp, tmp2, m):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def _exp_reduced(x):
+    """exp(x) = 2^n exp(r), x clamped to [-700, 700]: (exp(r) by its Taylor series to r^13,
+    n + 1.5 2^52) (see :func:`_exp_into` and :func:`exp_scalar`)."""
+    x = min(max(x, -700.0), 700.0)
+    nn = np.floor(x * _LOG2E + 0.5)
+    r = (x - nn * _LN2_HI) - nn * _LN2_LO
+    e = _E13 * r + _E12
+    e = e * r + _E11
+    e = e * r + _E10
+    e = e * r + _E9
+    e = e * r + _E8
+    e = e * r + _E7
+    e = e * r + _E6
+    e = e * r + _E5
+    e = e * r + _E4
+    e = e * r + _E3
+    e = e * r + _E2
+    e = e * r + 1.0
+    e = e * r + 1.0
+    return e, nn + _ROUND_SHIFT
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def _exp_parts(x, e, t, m):
-    """exp(x) = 2^n exp(r), x clamped to [-700, 700]: e = exp(r) (Taylor series to r^13) and
-    t = n + 1.5 2^52 (see :func:`_exp_into`)."""
+    """exp(x) = 2^n exp(r), x clamped to [-700, 700]: e = exp(r) and t = n + 1.5 2^52, for
+    m values (:func:`_exp_reduced`; see :func:`_exp_into`)."""
     for k in range(m):
-        xk = min(max(x[k], -700.0), 700.0)
-        nn = np.floor(xk * _LOG2E + 0.5)
-        r = (xk - nn * _LN2_HI) - nn * _LN2_LO
-        ek = _E13 * r + _E12
-        ek = ek * r + _E11
-        ek = ek * r + _E10
-        ek = ek * r + _E9
-        ek = ek * r + _E8
-        ek = ek * r + _E7
-        ek = ek * r + _E6
-        ek = ek * r + _E5
-        ek = ek * r + _E4
-        ek = ek * r + _E3
-        ek = ek * r + _E2
-        ek = ek * r + 1.0
-        ek = ek * r + 1.0
-        e[k] = ek
-        t[k] = nn + _ROUND_SHIFT
+        e[k], t[k] = _exp_reduced(x[k])
 
 
 @njit(cache=True, error_model="numpy")
@@ -1242,26 +1248,10 @@ def flatten_args(arrays):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def exp_scalar(x):
-    """exp(x) for one value, call-free (vectorises when inlined in a loop): the reduction,
-    polynomial and exponent assembly of :func:`_exp_parts` and :func:`_exp_into` (same
-    constants), x clamped to [-700, 700]; within an ulp of libm's exp."""
-    x = min(max(x, -700.0), 700.0)
-    nn = np.floor(x * _LOG2E + 0.5)
-    r = (x - nn * _LN2_HI) - nn * _LN2_LO
-    e = _E13 * r + _E12
-    e = e * r + _E11
-    e = e * r + _E10
-    e = e * r + _E9
-    e = e * r + _E8
-    e = e * r + _E7
-    e = e * r + _E6
-    e = e * r + _E5
-    e = e * r + _E4
-    e = e * r + _E3
-    e = e * r + _E2
-    e = e * r + 1.0
-    e = e * r + 1.0
-    t = nn + _ROUND_SHIFT  # n in the low bits (see _exp_into)
+    """exp(x) for one value, call-free (vectorises when inlined in a loop): the reduction and
+    polynomial of the batch kernels' exponential (:func:`_exp_reduced`) and its exponent
+    assembly, x clamped to [-700, 700]; within an ulp of libm's exp."""
+    e, t = _exp_reduced(x)
     bits = (np.float64(t).view(np.int64) - _ROUND_SHIFT_BITS + 1023) << 52
     return e * np.int64(bits).view(np.float64)
 
