@@ -4,6 +4,8 @@ hardware-in-the-loop stepping API (``advance``, in-place inputs, live state)."""
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from railadhesion.braking import (
     BrakeCylinders,
@@ -302,3 +304,63 @@ def test_records_name_every_input_of_the_c_interface():
         assert dtype.isalignedstruct and dtype.itemsize % 8 == 0
     assert records.INPUTS.names == ("pressure_command", "valves")
     assert records.STATE["omega"].shape == (records.MAX_AXLES,)
+
+
+@pytest.mark.parametrize("n_axles", [2, 6, 12])
+def test_every_axle_count_up_to_the_record_size(n_axles):
+    """12 axles under WILAC's four conditions fill every lane of the records."""
+    from railadhesion.braking import simulate
+
+    veh = Vehicle(name=f"{n_axles} axles", n_axles=n_axles)
+    cyl = BrakeCylinders(max_pressure=6e5, valves="bogie" if n_axles == 2 else "axle")
+    res = simulate(veh, WilacAdhesion(WaterFlowProfile.constant(18.0)), 12.0, 5.5e5,
+                   cylinders=cyl, wsp=WheelSlideProtection(period=4e-3), dt=2e-3)
+    assert res.success and len(res.summary["axles"]) == n_axles
+    h = res.histories
+    assert np.all(np.isfinite(h.to_numpy()[1:]))
+    assert abs(res.summary["energy"]["balance_error"]) < 5e-3
+    # the stepping API and its Python-model path give the same stop
+    sims = [BrakingSimulator(veh, WilacAdhesion(WaterFlowProfile.constant(18.0)), 12.0,
+                             cylinders=cyl, max_step=2e-3, compiled=flag, record=False)
+            for flag in (True, False)]
+    for sim in sims:
+        sim.inputs.pressure_command[:] = 5.5e5
+        for _ in range(300):
+            sim.advance(2e-3)
+    np.testing.assert_allclose(sims[0].omega, sims[1].omega, rtol=1e-9)
+    assert sims[0].speed == pytest.approx(sims[1].speed, rel=1e-12)
+
+
+@settings(max_examples=25, deadline=None)
+@given(n_axles=st.sampled_from([2, 4, 8]), mu0=st.floats(0.05, 0.6),
+       big_a=st.floats(0.2, 1.0), big_b=st.floats(0.0, 1.0),
+       commands=st.lists(st.tuples(st.floats(0.0, 8e5), st.integers(0, 2)), min_size=4,
+                         max_size=12),
+       dt=st.sampled_from([5e-4, 1e-3, 2.5e-3]), v0=st.floats(1.0, 40.0))  # fmt: skip
+def test_step_invariants_under_any_valve_and_command_sequence(n_axles, mu0, big_a, big_b,
+                                                              commands, dt, v0):
+    """Speeds never negative, distance never decreasing, and the kinetic energy of train and
+    wheels never rising (brakes and creep only dissipate on a level track), whatever the
+    inputs; a long call equals the same sub-steps called one by one."""
+    from railadhesion.models.parameters import PolachParameters
+
+    veh = Vehicle(name="v", n_axles=n_axles)
+    law = PolachParameters(mu0=mu0, A=big_a, B=big_b, k_A=0.6, k_S=0.3, name="random")
+    make = lambda: BrakingSimulator(veh, PolachAdhesion(law), v0, max_step=dt,  # noqa: E731
+                                    cylinders=BrakeCylinders(max_pressure=9e5), record=False)
+    a, b = make(), make()
+    ke = a.kinetic_energy
+    distance = 0.0
+    for command, valve in commands:
+        for sim in (a, b):
+            sim.inputs.pressure_command[:] = command
+            sim.inputs.valves[:] = valve
+        a.advance(25 * dt)
+        for _ in range(25):
+            b.advance(dt)
+        assert a.speed >= 0.0 and np.all(a.omega >= 0.0)
+        assert a.distance >= distance
+        assert a.kinetic_energy <= ke * (1 + 1e-12) + 1e-9
+        ke, distance = a.kinetic_energy, a.distance
+        assert a.distance == b.distance and a.speed == b.speed
+        np.testing.assert_array_equal(a.omega, b.omega)
