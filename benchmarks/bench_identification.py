@@ -42,7 +42,7 @@ from railadhesion.identification import (
     identify_adhesion,
     read_braking_log,
 )
-from railadhesion.identification.braking import _worker_count
+from railadhesion.identification.brake_tests import worker_count
 from railadhesion.identification.pipeline import run_identification
 
 PERIOD = 2.4e-3
@@ -195,7 +195,7 @@ def main() -> None:
         print(f"log: {n} samples x 4 axles ({n * PERIOD / 3600:g} h at 2.4 ms), ready in "
               f"{time.perf_counter() - t0:.1f} s")
         out = Path(tmp) / "out"
-        cores = _worker_count(None)
+        cores = worker_count(None)
         print(f"cores available: {cores}; {_load()}")
         warm, wall, _, _ = _timed(lambda: run_identification(base.with_suffix(".parquet"),
                                                               VEH, out))

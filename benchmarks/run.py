@@ -1,7 +1,9 @@
 """Benchmark runner: throughput and latency of the hot paths, each beside a baseline.
 
 Run with ``python3 benchmarks/run.py`` (``--quick`` for small sizes, ``--kernels-only`` to skip
-the other ``benchmarks/bench_*.py`` scripts, ``--no-big`` to skip the 10^7-contact cases).
+the other ``benchmarks/bench_*.py`` scripts, ``--no-big`` to skip the 10^7-contact cases,
+``--write-docs`` to write the figures to ``docs/performance.md``, the one place where benchmark
+figures are kept).
 
 Every figure is printed beside a baseline measured in the same run on the same inputs, and
 their ratio:
@@ -37,6 +39,7 @@ from functools import partial
 from pathlib import Path
 
 import numpy as np
+from performance_page import DOCS_PAGE, Run, write_page
 
 HERE = Path(__file__).resolve().parent
 SRC = HERE.parent / "src"
@@ -171,7 +174,11 @@ def main(argv=None) -> None:
     parser.add_argument("--kernels-only", action="store_true",
                         help="only these kernel benchmarks, not the other bench_*.py scripts")
     parser.add_argument("--no-big", action="store_true", help="skip the 10^7-contact cases")
+    parser.add_argument("--write-docs", nargs="?", type=Path, const=DOCS_PAGE, default=None,
+                        metavar="PAGE", help=f"write the figures to PAGE (default {DOCS_PAGE})")
     args = parser.parse_args(argv)
+    run = Run(command="benchmarks/run.py " + " ".join(argv if argv is not None else
+                                                      sys.argv[1:]))
     sys.path.insert(0, str(SRC))
 
     import numba
@@ -192,6 +199,8 @@ def main(argv=None) -> None:
           f"{os.cpu_count()} CPUs, Python {platform.python_version()}, NumPy {np.__version__}, "
           f"numba {numba.__version__}; load average {os.getloadavg()[0]:.1f} at start")  # fmt: skip
     threads = numba.get_num_threads()
+    run.versions = {"Python": platform.python_version(), "NumPy": np.__version__,
+                    "numba": numba.__version__, "threads": str(threads)}
     table = Table()
     imp, cold, warm, cold_par, warm_par = compile_times()
     table.add("import railadhesion", f"{imp * 1e3:.0f} ms", note="numba not imported")
@@ -343,6 +352,11 @@ def main(argv=None) -> None:
             print(proc.stdout, end="")
             if proc.returncode != 0:
                 print(f"{script.name} failed (exit {proc.returncode}):\n{proc.stderr}")
+            run.scripts.append((script.name, proc.stdout, proc.returncode))
+    if args.write_docs is not None:
+        run.rows = table.rows
+        run.load_end = os.getloadavg()
+        print(f"\nwritten: {write_page(run, args.write_docs)}")
 
 
 if __name__ == "__main__":

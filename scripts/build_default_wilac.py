@@ -44,6 +44,7 @@ import numpy as np
 
 from railadhesion.calibration.fitting import fit_polach
 from railadhesion.calibration.regression import build_regression
+from railadhesion.contact.geometry import NAMED_GEOMETRIES as WILAC_GEOMETRIES
 from railadhesion.contact.hertz import hertz_3d
 from railadhesion.io.paramfiles import load_wilac_parameters, save_wilac_parameters
 from railadhesion.models.polach import polach_forces
@@ -54,7 +55,6 @@ from railadhesion.models.wilac import (
     WilacCondition,
     WilacParameters,
 )
-from railadhesion.plotting import WILAC_GEOMETRIES
 
 REPO = Path(__file__).resolve().parents[1]
 DEFAULT_OUT = REPO / "src" / "railadhesion" / "data" / "wilac_default.toml"

@@ -291,7 +291,7 @@ def _write_curve_with_bad_row(path):
 def test_warnings_are_plain_lines_without_source_location(tmp_path):
     csv_path = tmp_path / "curve.csv"
     _write_curve_with_bad_row(csv_path)
-    result = _run("fit", "polach", str(csv_path), "--fit", "mu0,k_A")
+    result = _run("fit", "polach", str(csv_path), "--fit", "mu0,k_A", "--allow-untrusted")
     assert result.exit_code == 0, result.output
     assert "warning:" in result.output
     assert ".py:" not in result.output and "warnings.warn" not in result.output
@@ -372,6 +372,11 @@ def test_fit_polach_states_fixed_values_sets_them_and_writes_figure(tmp_path):
     _write_synthetic_curve(csv_path, params, 4200.0, 5.0, 0.0)
     fig = tmp_path / "fit.png"
     result = _run("fit", "polach", str(csv_path), "--fit", "k_A,k_S,mu0", "--figure", str(fig))
+    # constant friction (A = 1, B = 0 held) cannot follow the falling curve: not trusted
+    assert result.exit_code == 3, result.output
+    assert "Polach fit not trusted" in result.output
+    result = _run("fit", "polach", str(csv_path), "--fit", "k_A,k_S,mu0", "--figure", str(fig),
+                  "--allow-untrusted")  # fmt: skip
     assert result.exit_code == 0, result.output
     text = " ".join(result.output.split())
     assert "not fitted, held at A = 1, B = 0 (model defaults" in text

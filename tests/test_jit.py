@@ -81,3 +81,16 @@ def test_source_checksum_changes_with_the_source(tmp_path):
     before = _jit.source_checksum(module)
     mod.write_text(textwrap.dedent("x = 2\n"))
     assert _jit.source_checksum(module) != before
+
+
+def test_kernel_entry_calls_the_compiled_code():
+    from numba import njit
+
+    from railadhesion._jit import kernel_entry
+
+    @njit
+    def add(a, b):
+        return a + b
+
+    entry = kernel_entry(add, (1.0, 2.0))
+    assert entry(3.0, 4.0) == 7.0

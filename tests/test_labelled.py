@@ -192,3 +192,117 @@ def test_creep_curve_and_fit_as_dataframe_and_dataset():
     np.testing.assert_allclose(fdf["model"], fit.predict(), atol=1e-12)
     np.testing.assert_allclose(fdf["model"] - fdf["adhesion"], fdf["residual"])
     assert fdf.attrs["params"]["mu0"] == pytest.approx(0.4, rel=1e-6)
+
+
+# ---- units in attrs: one table over every labelled output of every public function (issue 18)
+
+_TWOD = {"traction": "N/m", "stick": "N/m", "slip": "N/m", "stick_half_width": "m"}
+_HERTZ = {"a": "m", "b": "m", "max_pressure": "Pa", "approach": "m", "curvature_A": "1/m",
+          "curvature_B": "1/m", "mean_radius": "m", "c": "m", "normal_force": "N",
+          "effective_modulus": "Pa"}  # fmt: skip
+_LINE = {"half_width": "m", "max_pressure": "Pa", "load_per_length": "N/m",
+         "reduced_radius": "m", "effective_modulus": "Pa"}  # fmt: skip
+W1 = ra.fletcher_condition("W1")
+
+# qualified name -> (call with the varying labelled argument x, x, expected units by field:
+# "" for a single result, the index for plain tuples, the field name otherwise)
+UNITS = {
+    "railadhesion.adhesion": (CASES["adhesion"][0], CASES["adhesion"][1], {"": "1"}),
+    "railadhesion.models.polach.polach_forces": (*CASES["polach_forces"], {"0": "N", "1": "N"}),
+    "railadhesion.models.polach.Polach.forces": (*CASES["Polach.forces"], {"0": "N", "1": "N"}),
+    "railadhesion.models.polach.Polach.adhesion": (
+        lambda x: ra.Polach("polach2005_dry").adhesion(x, 0, 0, 1e5, 10.0, A, B), CREEP,
+        {"": "1"}),
+    "railadhesion.models.wilac.wilac_forces": (*CASES["wilac_forces"], {"0": "N", "1": "N"}),
+    "railadhesion.models.wilac.Wilac.forces": (
+        lambda x: ra.Wilac().forces(x, 0, 0, 4200.0, 5.0, A, B, 25.0), CREEP,
+        {"0": "N", "1": "N"}),
+    "railadhesion.models.wilac.Wilac.adhesion": (*CASES["Wilac.adhesion"], {"": "1"}),
+    "railadhesion.models.wilac.Wilac.weights": (
+        lambda x: ra.Wilac().weights(x), np.array([0.0, 25.0, 35.0, 350.0]), {"": "1"}),
+    "railadhesion.models.wilac_parameters.wilac_weights": (*CASES["wilac_weights"], {"": "1"}),
+    "railadhesion.models.wilac_parameters.wilac_transitions": (*CASES["wilac_transitions"],
+                                                               {"": "1"}),
+    "railadhesion.models.twod.carter": (*CASES["carter"], _TWOD),
+    "railadhesion.models.twod.fletcher": (*CASES["fletcher"], _TWOD),
+    "railadhesion.models.twod.elastic_foundation": (*CASES["elastic_foundation"], _TWOD),
+    "railadhesion.models.twod.creep_from_surface_speeds": (*CASES["creep_from_surface_speeds"],
+                                                           {"": "1"}),
+    "railadhesion.models.twod.FletcherCondition.traction": (lambda x: W1.traction(x),
+                                                            CREEP / 10, _TWOD),
+    "railadhesion.models.twod.FletcherCondition.adhesion": (lambda x: W1.adhesion(x),
+                                                            CREEP / 10, {"": "1"}),
+    "railadhesion.models.twod.FletcherCondition.elastic_foundation_adhesion": (
+        lambda x: W1.elastic_foundation_adhesion(x), CREEP / 10, {"": "1"}),
+    "railadhesion.contact.kalker.kalker_coefficients": (
+        *CASES["kalker_coefficients"], {"c11": "1", "c22": "1", "c23": "1", "c33": "1"}),
+    "railadhesion.contact.kalker.linear_creep_forces": (
+        *CASES["linear_creep_forces"], {"0": "N", "1": "N", "2": "N m"}),
+    "railadhesion.contact.hertz.hertz_3d": (*CASES["hertz_3d"], _HERTZ),
+    "railadhesion.contact.hertz.hertz_3d_from_curvatures": (*CASES["hertz_3d_from_curvatures"],
+                                                            _HERTZ),
+    "railadhesion.contact.hertz.line_contact": (*CASES["line_contact"], _LINE),
+    "railadhesion.contact.hertz.line_contact_from_pressure": (
+        *CASES["line_contact_from_pressure"], _LINE),
+    "railadhesion.contact.hertz.combined_elastic_constants": (
+        *CASES["combined_elastic_constants"], {"0": "Pa", "1": "Pa", "2": "1"}),
+    "railadhesion.contact.fastsim.fastsim": (
+        *CASES["fastsim"], {"fx": "N", "fy": "N", "mz": "N m", "slip_fraction": "1"}),
+}  # fmt: skip
+
+
+def _labelled_outputs(result):
+    """(field, value) of every labelled part of a result."""
+    out = []
+    for name, value in _leaves(result):
+        if isinstance(value, pd.Series | pd.DataFrame | xr.DataArray):
+            out.append(("" if name == "" else name, value))
+    return out
+
+
+@pytest.mark.parametrize("kind", ["pandas", "xarray"])
+@pytest.mark.parametrize("name", sorted(UNITS))
+def test_units_in_attrs_of_every_labelled_output(name, kind):
+    """Every labelled output of every public function carries the right units, on the pandas
+    path as on the xarray one (the fields a call does not label, e.g. grids, are skipped)."""
+    func, x, units = UNITS[name]
+    if kind == "pandas":
+        arg = pd.Series(x, index=INDEX)
+    else:
+        arg = xr.DataArray(x, dims="sample", coords={"sample": ["p", "q", "r", "s"]})
+    outputs = _labelled_outputs(func(arg))
+    assert outputs, name
+    for field, value in outputs:
+        assert value.attrs.get("units") == units[field], (name, kind, field, value.attrs)
+
+
+def _labelled_functions():
+    """Qualified names of every function and method that the ``labelled`` decorator wraps,
+    found by walking the package (the wrappers' code is generated as ``<labelled ...>``)."""
+    import importlib
+    import inspect
+    import pkgutil
+
+    found = set()
+    for info in pkgutil.walk_packages(ra.__path__, "railadhesion."):
+        if info.name.rsplit(".", 1)[-1].startswith("_") or "export.railadhesion_" in info.name:
+            continue
+        module = importlib.import_module(info.name)
+        for obj_name, obj in vars(module).items():
+            if getattr(obj, "__module__", None) != module.__name__ or obj_name.startswith("_"):
+                continue
+            members = [(obj_name, obj)]
+            if inspect.isclass(obj):
+                members = [(f"{obj_name}.{k}", v) for k, v in vars(obj).items()
+                           if callable(v) and not k.startswith("_")]  # fmt: skip
+            for qual, fn in members:
+                code = getattr(fn, "__code__", None)
+                if code is not None and code.co_filename.startswith("<labelled "):
+                    found.add(f"{module.__name__}.{qual}")
+    found.add("railadhesion.adhesion")
+    return found
+
+
+def test_the_units_table_covers_every_labelled_function():
+    missing = _labelled_functions() - set(UNITS)
+    assert not missing, f"add these to UNITS with their units: {sorted(missing)}"

@@ -5,43 +5,8 @@ xi = (V - omega R)/V (braking positive); forces are exerted by the rail on the w
 oppose the creepage (Kalker's convention, as in CONTACT).
 """
 
-import math as _math
-
-import numpy as _np
-
-from railadhesion._labelled import labelled as _labelled
-
-__version__ = "0.1.0"
-
-
-@_labelled(units="1")
-def adhesion(fx, fy, normal_force):
-    """Adhesion coefficient |T|/Q = sqrt(Fx^2 + Fy^2)/Q (dimensionless, >= 0).
-
-    Parameters
-    ----------
-    fx, fy : array_like
-        Tangential forces [N].
-    normal_force : array_like
-        Normal force Q [N], > 0.
-
-    Examples
-    --------
-    >>> float(adhesion(3.0, 4.0, 20.0))
-    0.25
-    """
-    if isinstance(fx, float) and isinstance(fy, float) and isinstance(normal_force, float):
-        # scalar fast path (FMU steps, ODE right-hand sides): same result and error
-        if 0.0 < normal_force < _math.inf:
-            return _np.float64(_math.hypot(fx, fy) / normal_force)
-    from railadhesion._validate import check_positive
-
-    q = check_positive(normal_force, "normal_force")
-    return _np.hypot(fx, fy) / q
-
-
-# The public API at the top level (imported after ``adhesion``, which the models use).
-from railadhesion.contact import (  # noqa: E402
+# The public API at the top level.
+from railadhesion.contact import (
     contact_semi_axes,
     fastsim,
     hertz_3d,
@@ -49,7 +14,8 @@ from railadhesion.contact import (  # noqa: E402
     line_contact,
     linear_creep_forces,
 )
-from railadhesion.models import (  # noqa: E402
+from railadhesion.contact.traction import adhesion
+from railadhesion.models import (
     Polach,
     PolachParameters,
     Wilac,
@@ -64,6 +30,8 @@ from railadhesion.models import (  # noqa: E402
     wilac_forces,
     wilac_weights,
 )
+
+__version__ = "0.1.0"
 
 __all__ = [
     "Polach",

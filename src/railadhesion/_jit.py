@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import types
 
-__all__ = ["serial_and_parallel"]
+__all__ = ["serial_and_parallel", "kernel_entry"]
 
 
 def _renamed(py_func, suffix: str):
@@ -78,3 +78,18 @@ def guard_cache(fingerprint_dispatcher, module_file: str, current: int) -> list:
     if gone:
         fingerprint_dispatcher.recompile()
     return gone
+
+
+def kernel_entry(dispatcher, args):
+    """The compiled entry point of the numba ``dispatcher`` for the types of ``args``: calling
+    it skips the dispatcher's type resolution (a few hundred ns a call). ``args`` must make a
+    call without harm (it compiles the kernel, or loads it from the cache); falls back to the
+    dispatcher if numba's internals do not give the entry point."""
+    dispatcher(*args)
+    try:
+        from numba import typeof
+
+        entry = dispatcher.overloads[tuple(typeof(a) for a in args)].entry_point
+    except Exception:  # pragma: no cover - numba internals changed: use the dispatcher
+        entry = None
+    return entry if callable(entry) else dispatcher

@@ -15,8 +15,8 @@ does with its "numeric" inputs:
 * Results that are tuples, named tuples or dataclass instances are converted field by field.
 
 The fast path, for plain floats and NumPy arrays, is one set-membership test per argument on
-top of the call (measured well under 1 µs, ``benchmarks/bench_labelled.py``): model functions
-are called millions of times inside ODE right-hand sides.
+top of the call (its cost: ``benchmarks/bench_labelled.py``, docs/performance.md): model
+functions are called millions of times inside ODE right-hand sides.
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 Each helper converts its argument with :func:`numpy.asarray` (float64), checks it and
 raises ``ValueError`` naming the argument and the allowed range. They are cheap on
-scalars: a model called inside an ODE right-hand side pays a few microseconds.
+scalars, for models called inside ODE right-hand sides.
 """
 
 from __future__ import annotations

@@ -20,6 +20,8 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
+from railadhesion.cli_checks import allow_untrusted_option, finish
+
 # rich_markup_mode=None: help texts are plain text, so units such as "[m]" and "[m/s]" are
 # shown as written (Rich markup would take them for tags and drop them).
 app = typer.Typer(
@@ -573,8 +575,12 @@ def fit_polach_cmd(
     figure: Path | None = typer.Option(None, help="Write the fit-vs-data figure here."),
     fmt: str = _format_option(),
     table: Path | None = typer.Option(None, help="Write the parameter table here."),
+    allow_untrusted: bool = allow_untrusted_option(),
 ) -> None:
-    """Fit Polach parameters to one measured creep curve."""
+    """Fit Polach parameters to one measured creep curve.
+
+    Exit code 3 when the quality gate does not trust the fit (docs/checks.md), unless
+    --allow-untrusted."""
     from railadhesion.calibration.fitting import POLACH_NAMES, fit_polach
     from railadhesion.io.creepcurves import read_creep_curve
     from railadhesion.io.paramfiles import save_polach_parameters
@@ -599,7 +605,7 @@ def fit_polach_cmd(
     try:
         result = fit_polach(
             curve.creep, curve.adhesion, normal_force=curve.normal_force, speed=curve.speed,
-            a=curve.a, b=curve.b, fit=names, initial=initial or None,
+            a=curve.a, b=curve.b, fit=names, initial=initial or None, warn_untrusted=False,
         )  # fmt: skip
     except ValueError as exc:
         _fail(f"{csv_file}: {exc}")
@@ -642,7 +648,9 @@ def fit_polach_cmd(
             save_polach_parameters(result.as_polach_parameters(), out)
         except (OSError, ValueError) as exc:
             _fail(f"cannot write the parameter file {out}: {exc}")
-        console.print(f"parameters written to {escape(str(out))}")
+        console.print(f"parameters written to {escape(str(out))}"
+                      + (" (its notes say it is not trusted)" if result.warnings else ""))
+    finish(console, result.warnings, allow=allow_untrusted, what="Polach fit")
 
 
 @fit_app.command("wilac")
@@ -673,8 +681,12 @@ def fit_wilac_cmd(
     ),
     fmt: str = _format_option(),
     table: Path | None = typer.Option(None, help="Write the per-curve table here."),
+    allow_untrusted: bool = allow_untrusted_option(),
 ) -> None:
-    """Calibrate a complete WILAC parameter file from a folder of creep curves."""
+    """Calibrate a complete WILAC parameter file from a folder of creep curves.
+
+    Exit code 3 when the calibrated set cannot be trusted (docs/checks.md), unless
+    --allow-untrusted."""
     from rich.progress import BarColumn, Progress, TextColumn
 
     from railadhesion.calibration.pipeline import calibrate_wilac_to_toml
@@ -707,19 +719,15 @@ def fit_wilac_cmd(
         _fail(exc)
     except OSError as exc:  # the output file cannot be written
         _fail(f"cannot write the parameter file {out}: {exc}")
-    if fmt == "table" and table is None:
+    if fmt == "table":  # the per-curve report, also when --table writes the table to a file
         console.print(calibration.summary(), highlight=False, markup=False, soft_wrap=True)
-    else:
+    if fmt != "table" or table is not None:
         rows = calibration.curve_table()
         keys = list(rows[0]) if rows else []
         _emit("WILAC calibration per curve", [(k, k, ".4g") for k in keys],
               [[r[k] for k in keys] for r in rows], fmt, table)  # fmt: skip
-    if not calibration.trusted:
-        console.print(
-            f"[bold red]WARNING[/bold red]: {len(calibration.warnings)} problem(s) between the "
-            "data points: do not trust the calibrated set there (see above)."
-        )
     console.print(f"WILAC parameters written to {escape(str(out))}")
+    finish(console, calibration.warnings, allow=allow_untrusted, what="WILAC calibration")
 
 
 # Commands of the other concerns, each in its own module.
@@ -727,11 +735,14 @@ from railadhesion import (  # noqa: E402
     cli_braking,
     cli_export,
     cli_identification,
+    cli_monitor,
+    cli_odometry,
     cli_sweeps,
     cli_wsp,
 )
 
-for _module in (cli_braking, cli_identification, cli_sweeps, cli_export, cli_wsp):
+for _module in (cli_braking, cli_identification, cli_sweeps, cli_export, cli_wsp, cli_odometry,
+                cli_monitor):
     _module.register(app)
 
 if __name__ == "__main__":  # pragma: no cover

@@ -11,20 +11,25 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
+from railadhesion.cli_checks import allow_untrusted_option, braking_findings, finish
 from railadhesion.plausibility import RailadhesionWarning
 
 console = Console()
 
 
 def write_outputs(result, out: Path, *, figures: bool = True, parquet: bool = True,
-                  log: bool = False) -> list[Path]:
-    """Write summary.json, histories.csv (+ .parquet), figures and optionally a test log."""
+                  log: bool = False, findings=None) -> list[Path]:
+    """Write summary.json, histories.csv (+ .parquet), figures and optionally a test log.
+
+    ``summary.json`` records ``trusted`` and ``warnings``: ``findings`` (default: those of
+    the result, :func:`railadhesion.cli_checks.braking_findings`)."""
     from railadhesion.braking.bench import json_safe
 
     out.mkdir(parents=True, exist_ok=True)
     written = []
+    findings = braking_findings(result) if findings is None else list(findings)
     summary = {"status": result.status, "message": result.message, **result.summary,
-               "settings": result.settings}
+               "trusted": not findings, "warnings": findings, "settings": result.settings}
     path = out / "summary.json"
     path.write_text(json.dumps(json_safe(summary), indent=2, ensure_ascii=False) + "\n",
                     encoding="utf-8")
@@ -66,8 +71,12 @@ def register(app: typer.Typer) -> None:
         figures: bool = typer.Option(True, help="Write PNG figures."),
         log: bool = typer.Option(False, help="Also write a braking-test log (2.4 ms, CSV)."),
         quiet: bool = typer.Option(False, help="No progress bar."),
+        allow_untrusted: bool = allow_untrusted_option(),
     ) -> None:
-        """Simulate a braking scenario: summary JSON, CSV/Parquet histories, figures."""
+        """Simulate a braking scenario: summary JSON, CSV/Parquet histories, figures.
+
+        Exit code 3, unless --allow-untrusted, when the result cannot be trusted (the train
+        did not stop, NaN results; docs/checks.md). The outputs are written either way."""
         from rich.progress import Progress
 
         from railadhesion.braking.scenario import load_scenario, run_scenario
@@ -82,13 +91,16 @@ def register(app: typer.Typer) -> None:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", RailadhesionWarning)
                 if quiet:
-                    result, _ = run_scenario(sc, dt=dt)
+                    result, dry = run_scenario(sc, dt=dt)
                 else:
                     with Progress(console=console, transient=True) as bar:
                         task = bar.add_task("braking (speed lost)", total=1.0)
-                        result, _ = run_scenario(
+                        result, dry = run_scenario(
                             sc, dt=dt, progress=lambda f: bar.update(task, completed=f))
-            write_outputs(result, out, figures=figures, log=log)
+            findings = braking_findings(result)
+            if dry is not None:
+                findings += braking_findings(dry, "the dry-rail comparison")
+            write_outputs(result, out, figures=figures, log=log, findings=findings)
         except (SimulationError, ValueError) as exc:
             console.print(f"[red]error:[/red] {escape(str(exc))}")
             raise typer.Exit(code=2) from None
@@ -122,6 +134,7 @@ def register(app: typer.Typer) -> None:
             demand, cap = s["highest_command_Pa"] / 1e5, s["max_pressure_Pa"] / 1e5
             table.add_row(escape("brake demand clipped to max_pressure [bar]"),
                           f"{demand:.3g} -> {cap:.3g}")
-        table.add_row("trusted", "yes" if result.trusted else "[red]no[/red]")
+        table.add_row("trusted", "yes" if not findings else f"NO ({len(findings)} finding(s))")
         console.print(table)
         console.print(f"outputs written to {escape(str(out))}")
+        finish(console, findings, allow=allow_untrusted, what="braking result")

@@ -40,6 +40,16 @@ def _floats(text: str | None, name: str, scale: float = 1.0):
     return values
 
 
+def _creep_percent(text: str | None, name: str):
+    """Creepages given in percent, as fractions: |creep| <= 100 % (a locked wheel is 100 %),
+    as ``railadhesion polach --creep-percent``."""
+    values = _floats(text, name)
+    if values is not None and any(not abs(v) <= 100.0 for v in values):
+        _fail(f"{name}: creepages must be in [-100, 100] % (a locked wheel is 100 %), got "
+              f"{text!r}")  # fmt: skip
+    return None if values is None else [v * 0.01 for v in values]
+
+
 @export_app.command("fmu")
 def export_fmu(
     model: str = typer.Option("wilac", help=_MODEL_HELP),
@@ -148,8 +158,8 @@ def export_table(
     )
 
     grid = {
-        "creep_long": _floats(creep_long_percent, "--creep-long-percent", 0.01),
-        "creep_lat": _floats(creep_lat_percent, "--creep-lat-percent", 0.01),
+        "creep_long": _creep_percent(creep_long_percent, "--creep-long-percent"),
+        "creep_lat": _creep_percent(creep_lat_percent, "--creep-lat-percent"),
         "normal_force": _floats(normal_force, "--normal-force"),
         "speed": _floats(speed, "--speed"),
         "water_flow": _floats(water, "--water"),

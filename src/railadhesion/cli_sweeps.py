@@ -14,12 +14,33 @@ from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
+from railadhesion.cli_checks import allow_untrusted_option, finish
+
 console = Console()
 
 
 def _fail(message) -> None:
     console.print(f"[red]error:[/red] {escape(str(message))}")
     raise typer.Exit(code=2)
+
+
+def _failures(result, what: str) -> tuple[str, list[str]]:
+    """(``failed <what>: N`` with the first reason, findings for the exit code)."""
+    n = int(result.failed_points)
+    if n == 0:
+        return f"failed {what}: 0", []
+    import json
+
+    try:
+        quoted = json.loads(result.dataset.attrs.get("failures", "[]"))
+    except (TypeError, ValueError):
+        quoted = []
+    if quoted:
+        point = ", ".join(f"{k}={v}" for k, v in quoted[0]["point"].items())
+        first = f"{quoted[0]['message']} (at {point})"
+    else:  # in-memory and NetCDF sweeps flag the points (error == 1) without messages
+        first = "see the error variable of the output (1 where a point failed)"
+    return f"failed {what}: {n} (first: {first})", [f"{n} failed {what}; first: {first}"]
 
 
 def sweep(
@@ -30,10 +51,12 @@ def sweep(
         None, help="Dask cluster address (tcp://HOST:PORT), or a local scheduler: threads "
         "(default), processes, synchronous."),
     overwrite: bool = typer.Option(False, "--overwrite", help="Replace an existing output."),
+    allow_untrusted: bool = allow_untrusted_option(),
 ) -> None:
     """Evaluate a model over the grid of SPEC with Dask; write the map chunk by chunk.
 
     A re-run with the same spec and --out resumes: only chunks not yet written are computed.
+    Exit code 3 when points failed (the first reason is printed), unless --allow-untrusted.
     """
     from railadhesion.sweeps import load_sweep_spec
 
@@ -80,12 +103,14 @@ def sweep(
     progress.update(task["id"], completed=result.chunks_computed)
     progress.stop()
     rate = result.points_per_second
+    failed, findings = _failures(result, "points")
     console.print(
         f"{result.chunks_computed} chunks computed, {result.chunks_skipped} already written; "
         f"{result.elapsed:.1f} s" + (f", {rate:,.0f} points/s" if rate == rate else "")
-        + f"; failed points: {result.failed_points}", highlight=False,
+        + f"; {escape(failed)}", highlight=False, soft_wrap=True,
     )  # fmt: skip
     console.print(f"map written to {escape(str(out))}")
+    finish(console, findings, allow=allow_untrusted, what="sweep")
 
 
 def study(
@@ -97,10 +122,13 @@ def study(
         None, help="Dask cluster address (tcp://HOST:PORT), or a local scheduler: threads "
         "(default), processes, synchronous."),
     overwrite: bool = typer.Option(False, "--overwrite", help="Replace an existing study."),
+    allow_untrusted: bool = allow_untrusted_option(),
 ) -> None:
     """Run many braking stops over a scenario design (factorial or Monte Carlo) with Dask.
 
-    Each stop is one task; a re-run with the same spec and --out resumes.
+    Each stop is one task; a re-run with the same spec and --out resumes. A stop that cannot
+    be trusted (the train did not stop, NaN) is a failed stop; exit code 3 when there are
+    any (the first reason is printed), unless --allow-untrusted.
     """
     from rich.table import Table
 
@@ -147,9 +175,11 @@ def study(
             table.add_row(f"{w:g}", *(f"{float(f(e, others)):.2f}" for f in (
                 lambda x, d: x.median(d), lambda x, d: x.min(d), lambda x, d: x.max(d))))
         console.print(table)
+    failed, findings = _failures(result, "stops")
     console.print(f"{result.chunks_computed} chunks computed, {result.chunks_skipped} already "
-                  f"written; failed stops: {result.failed_points}", highlight=False)
+                  f"written; {escape(failed)}", highlight=False, soft_wrap=True)  # fmt: skip
     console.print(f"study written to {escape(str(out))} (study.zarr, study.csv, extension.png)")
+    finish(console, findings, allow=allow_untrusted, what="study")
 
 
 def register(app: typer.Typer) -> None:

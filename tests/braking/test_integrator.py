@@ -302,7 +302,7 @@ def test_records_name_every_input_of_the_c_interface():
     assert step.MACHINE.isalignedstruct
     for dtype in (records.STATE, records.SETTINGS, records.INPUTS, records.CURVE):
         assert dtype.isalignedstruct and dtype.itemsize % 8 == 0
-    assert records.INPUTS.names == ("pressure_command", "valves")
+    assert records.INPUTS.names == ("pressure_command", "valves", "torque")
     assert records.STATE["omega"].shape == (records.MAX_AXLES,)
 
 

@@ -8,13 +8,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from railadhesion.calibration.fitting import FitResult, fit_fletcher, fit_polach
 from railadhesion.models.parameters import PolachParameters
 from railadhesion.models.polach import polach_forces
 from railadhesion.models.twod import fletcher
+from railadhesion.plausibility import UntrustedResultWarning
 
 Q, V, A_SEMI, B_SEMI = 4200.0, 5.0, 4e-3, 3e-3  # tram-rig-like load and speed (seed 000 §4)
 CREEP = -np.geomspace(5e-4, 0.6, 60)  # traction, 0.05 % to 60 %
@@ -95,7 +96,9 @@ def test_polach_subset_and_fixed_values():
     assert (res.params["k_A"], res.params["A"], res.params["B"]) == (0.6, 0.4, 0.5)
     assert res.covariance.shape == (2, 2)
     # A fixed parameter not given takes the model default: here B = 0 (constant friction).
-    res2 = _fit(CREEP, y, fit=("mu0",), initial={"k_A": 0.6, "k_S": 0.2, "A": 0.4})
+    with pytest.warns(UntrustedResultWarning, match=r"R\^2 = 0.4\d+ is below 0.9"):
+        res2 = _fit(CREEP, y, fit=("mu0",), initial={"k_A": 0.6, "k_S": 0.2, "A": 0.4})
+    assert not res2.trusted
     assert res2.params["B"] == 0.0
     assert res2.rmse > 0.01  # the falling friction cannot be represented without B
     with pytest.raises(ValueError, match="mu0 is not fitted"):
@@ -133,7 +136,9 @@ def test_polach_bounds_respected_and_reported():
     true = dict(k_A=0.6, k_S=0.2, mu0=0.4, A=0.4, B=0.5)
     y = _adhesion(CREEP, **true)
     fit = ("k_A", "k_S", "mu0")
-    res = _fit(CREEP, y, fit=fit, initial={"A": 0.4, "B": 0.5}, bounds={"mu0": (0.1, 0.3)})
+    with pytest.warns(UntrustedResultWarning, match="mu0 = 0.3 is on a bound of the search"):
+        res = _fit(CREEP, y, fit=fit, initial={"A": 0.4, "B": 0.5}, bounds={"mu0": (0.1, 0.3)})
+    assert not res.trusted and "NOT TRUSTED" in res.summary()
     assert 0.1 <= res.params["mu0"] <= 0.3
     assert "mu0" in res.at_bound
     assert "at a bound" in res.message
@@ -178,10 +183,14 @@ def test_polach_data_checks():
     A=st.floats(0.2, 0.9),
     B=st.floats(0.1, 2.0),
 )
+# found by hypothesis: k_S an eighth of k_A, a curve still rising at 60 % creep (a local
+# minimum near k_S/k_A = 0.3 caught every start until the (0.05, 0.005) pair was added)
+@example(k_A=0.0625, ratio=0.125, mu0=0.5, A=0.5, B=2.0)
 def test_polach_noise_free_curves_are_reproduced(k_A, ratio, mu0, A, B):
-    """Property: a noise-free Polach curve is fitted to (near) zero residual."""
+    """Property: a noise-free Polach curve is fitted to (near) zero residual (whether the gate
+    trusts it, e.g. with few points before an early peak, is not what this checks)."""
     y = _adhesion(CREEP, k_A=k_A, k_S=ratio * k_A, mu0=mu0, A=A, B=B)
-    res = _fit(CREEP, y)
+    res = _fit(CREEP, y, warn_untrusted=False)
     assert res.rmse < 1e-4 * mu0
 
 

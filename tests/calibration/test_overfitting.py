@@ -27,6 +27,11 @@ from railadhesion.models.wilac import (
     wilac_weights,
 )
 
+#: The synthetic truth is the default WILAC set evaluated at 3 kN, below its calibrated loads
+#: (from 4.2 kN), where it holds its parameters at 4.2 kN with an AlteredResultWarning: that is
+#: the truth the calibration is asked to recover here, not a careless input.
+pytestmark = pytest.mark.filterwarnings("ignore::railadhesion.plausibility.AlteredResultWarning")
+
 FLOWS = (0.0, 25.0, 40.0, 350.0)  # µl/s
 LOADS = (3e3, 4.2e3, 6e3)  # N
 SPEEDS = (2.0, 5.0, 10.0)  # m/s

@@ -11,6 +11,13 @@ from railadhesion.contact import kalker_coefficients
 from railadhesion.contact.exact import exact_rolling
 from railadhesion.contact.table import exact_table_forces
 
+#: Numerics over the whole input domain, implausible inputs included: the policy's warnings
+#: (docs/checks.md) are what tests/test_plausibility.py checks, not these tests.
+ANY_INPUT = pytest.mark.filterwarnings(
+    "ignore::railadhesion.plausibility.PlausibilityWarning",
+    "ignore::railadhesion.plausibility.AlteredResultWarning",
+)
+
 G, MU, FZ = 8.2e10, 0.3, 1e5
 
 
@@ -82,6 +89,7 @@ def test_scalar_broadcast_and_bad_input():
         exact_table_forces(0.001, 0.0, 0.0, FZ, a, b, -1.0)
 
 
+@ANY_INPUT
 @settings(max_examples=60, deadline=None)
 @given(
     xi=st.floats(-0.02, 0.02),
@@ -217,3 +225,16 @@ def test_scalar_path_equals_the_array_path(xi, eta, phi, log_aob, nu, falling):
 def test_scalar_inputs_are_checked_as_arrays_are(args, kw, name):
     with pytest.raises(ValueError, match=name):
         exact_table_forces(*args, **kw)
+
+
+def test_integer_and_mixed_type_inputs_work():
+    """Issue 18: an integer creepage (``exact_table_forces(1e-5, 0, ...)``) crashed with a
+    numba TypingError; ints are floats to the public function, in both paths."""
+    want = exact_table_forces(1e-5, 0.0, 0.0, 1e5, 6e-3, 6e-3, 0.3)
+    assert exact_table_forces(1e-5, 0, 0, 100000, 6e-3, 6e-3, 0.3) == want
+    assert exact_table_forces(1e-5, 0, 0, 1e5, 6e-3, 6e-3, 0.3, speed=10, friction_ratio=1,
+                              friction_decay=0) == want  # fmt: skip
+    fx, _, _ = exact_table_forces(np.array([1e-5, 2e-5]), 0, 0, 100000, 6e-3, 6e-3, 0.3)
+    assert fx[0] == want[0]
+    with pytest.raises(ValueError, match="creep_long"):
+        exact_table_forces("x", 0, 0, 1e5, 6e-3, 6e-3, 0.3)

@@ -7,6 +7,14 @@ import pytest
 from railadhesion.contact import kalker_coefficients
 from railadhesion.contact import table as tm
 
+#: The compiled kernels against their references over the whole input domain, implausible
+#: inputs included: the policy's warnings (docs/checks.md) are what tests/test_plausibility.py
+#: checks, not these tests.
+pytestmark = pytest.mark.filterwarnings(
+    "ignore::railadhesion.plausibility.PlausibilityWarning",
+    "ignore::railadhesion.plausibility.AlteredResultWarning",
+)
+
 G, MU, FZ = 8.2e10, 0.3, 1e5
 
 

@@ -54,7 +54,8 @@ def test_bad_filter_arguments():
         lowpass(np.ones(10), 1.0, FS, "acausal")
 
 
-def test_compiled_kernels_match_scipy():
+def test_filters_match_scipy_transfer_function_form():
+    # the (b, a) form of the same filters, run by lfilter and filtfilt: an independent path
     from scipy import signal
 
     from railadhesion.identification.signals import _zero_phase_cutoff
@@ -77,21 +78,6 @@ def test_derivative_matches_numpy_gradient():
     assert np.allclose(derivative(x, t), np.gradient(x, t, axis=0), rtol=1e-12, atol=1e-9)
 
 
-def test_coefficients_are_scipy_butter_to_the_last_bit():
-    # written out to avoid importing scipy.signal; they must not differ from it
-    from scipy import signal
-
-    from railadhesion.identification.signals import _coefficients, _steady_state
-
-    rng = np.random.default_rng(3)
-    for fs in (FS, 400.0, 1000.0, 100.0):
-        for fc in [0.5, 2.0, 0.777, 10.0, *rng.uniform(1e-3, 0.49 * fs, 50)]:
-            b, a = signal.butter(1, fc, btype="low", fs=fs)
-            b2, a2 = _coefficients(fc, fs)
-            assert np.array_equal(b, b2) and np.array_equal(a, a2)
-            assert _steady_state(b2, a2) == signal.lfilter_zi(b, a)[0]
-
-
 def test_importing_the_identification_does_not_import_scipy_signal():
     import subprocess
     import sys
@@ -101,3 +87,21 @@ def test_importing_the_identification_does_not_import_scipy_signal():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)
     assert out.stdout.strip() == "False"
+
+
+def test_the_paper_filter_choices_are_the_defaults():
+    # seed 002 §5: the train acceleration through a first-order filter of 2 s rise time
+    # (0.5 Hz), the angular accelerations at 2 Hz
+    import inspect
+
+    from railadhesion.identification import identify_adhesion
+    from railadhesion.identification.pipeline import run_identification
+    from railadhesion.identification.signals import VEHICLE_CUTOFF, WHEEL_CUTOFF
+
+    assert (VEHICLE_CUTOFF, WHEEL_CUTOFF) == (1 / 2.0, 2.0)
+    for fn in (identify_adhesion, run_identification):
+        sig = inspect.signature(fn).parameters
+        assert sig["vehicle_cutoff"].default == VEHICLE_CUTOFF
+        assert sig["wheel_cutoff"].default == WHEEL_CUTOFF
+    # first order: -20 dB/decade well above the cut-off (one pass)
+    assert lowpass_gain(10.0, 0.5, FS, "causal") == pytest.approx(0.05, rel=0.01)

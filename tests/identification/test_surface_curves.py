@@ -142,6 +142,39 @@ def test_variable_projection_solves_the_linear_pair_exactly():
         assert np.allclose([c1, c2], ref.x, atol=1e-7)
 
 
+def test_variable_projection_with_the_bound_on_mu_s_active():
+    # c1 + c2 = mu_s <= top: data whose best nonnegative pair sums to more than top, so the
+    # optimum lies on the edge c1 + c2 = top (or at a corner of it). Checked by the
+    # optimality (KKT) conditions of the convex problem, and against random feasible points
+    from railadhesion.identification.curves import _linear_part
+
+    rng = np.random.default_rng(11)
+    on_edge = 0
+    for _ in range(300):
+        u, v = rng.uniform(0.0, 1.0, size=(2, 30))
+        a, b = rng.uniform(0.0, 2.0, size=2)
+        t = a * u + b * v + rng.normal(0.0, 0.05, 30)
+        top = rng.uniform(0.2, 0.9) * (a + b)
+        m = np.column_stack([u, v])
+        cost, c1, c2 = _linear_part(u @ u, u @ v, v @ v, u @ t, v @ t, t @ t, top)
+        c = np.array([c1, c2])
+        assert c1 >= 0.0 and c2 >= 0.0 and c1 + c2 <= top * (1 + 1e-12)
+        assert cost == pytest.approx(np.sum((t - m @ c) ** 2), rel=1e-9, abs=1e-12)
+        g = -2.0 * m.T @ (t - m @ c)  # gradient of the cost
+        tol = 1e-9 * np.abs(2.0 * m.T @ t).max()
+        lam = 0.0
+        if c1 + c2 > top * (1 - 1e-12):  # on the edge: multiplier lam >= 0
+            on_edge += 1
+            lam = -g[c > 0].max() if np.any(c > 0) else 0.0
+            assert lam >= -tol
+        for gi, ci in zip(g + lam, c, strict=True):
+            assert (abs(gi) <= tol) if ci > 0 else (gi >= -tol)
+        feasible = rng.dirichlet([1, 1, 1], 50)[:, :2] * top
+        costs = np.sum((t[None] - feasible @ m.T) ** 2, axis=1)
+        assert cost <= costs.min() * (1 + 1e-12)
+    assert on_edge > 200  # the branch under test was taken
+
+
 @pytest.mark.parametrize("kind", ["absolute", "relative"])
 def test_fit_finds_the_true_curve_anywhere_in_the_box(kind):
     # exact data of the form, random parameters over the box where the form peaks and falls
@@ -163,7 +196,7 @@ def test_fit_finds_the_true_curve_anywhere_in_the_box(kind):
         y = falling_adhesion(x, *truth)
         stats = np.zeros((4, _FINE))
         stats[:, ::_GROUP] = [np.ones_like(x), x, y, y * y]
-        params, _, r2, _, _ = _fit_one(stats, x.size, kind)
+        params, _, r2, _, _, _ = _fit_one(stats, x.size, kind)
         errors.append(np.max(np.abs(falling_adhesion(x, *params.values()) - y)) / truth[0])
         assert r2 > 1 - 1e-5
     assert max(errors) < 5e-3

@@ -29,6 +29,14 @@ from railadhesion.models.wilac import (
     wilac_forces,
 )
 
+#: The compiled kernels against their references over the whole input domain, implausible
+#: inputs included: the policy's warnings (docs/checks.md) are what tests/test_plausibility.py
+#: checks, not these tests.
+pytestmark = pytest.mark.filterwarnings(
+    "ignore::railadhesion.plausibility.PlausibilityWarning",
+    "ignore::railadhesion.plausibility.AlteredResultWarning",
+)
+
 RTOL = 1e-12
 SETTINGS = settings(max_examples=60, deadline=None)
 
@@ -430,3 +438,86 @@ def test_polach_contact_recomputes_everything_when_an_input_changes():
         c.mu0 = -1.0
     with pytest.raises(AttributeError, match="c11"):
         c.c11 = 1.0
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.floats(0.0, 0.05), st.floats(0.05, 1.0), st.floats(0.01, 0.8),
+       st.floats(1e-3, 0.03), st.floats(5e-3, 0.5))
+def test_fletcher_scalar_is_twod_fletcher(xi, k_a, mu, a, radius):
+    """fletcher_scalar(xi, 2 k_a R/a, 1/mu) is Fletcher's eqs. (8)-(12) (twod.fletcher, k_s = 1)
+    at every creep, before and beyond full slip."""
+    from railadhesion.models.twod import fletcher
+
+    ref = abs(float(fletcher(xi, 1.0, a, radius, mu, k_a=k_a).traction))
+    got, _, _, _ = kernels.fletcher_scalar(xi, 2.0 * k_a * radius / a, 1.0 / mu)
+    assert got == pytest.approx(ref, rel=1e-11, abs=1e-15)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.floats(1e-5, 0.02), st.floats(2.0, 400.0), st.floats(0.0, 40.0))
+def test_fletcher_scalar_derivatives(xi, slope, q):
+    """The three partial derivatives against central differences (away from the kink at full
+    slip, where the curve is continuous with its first derivative in xi)."""
+    mu, d_xi, d_slope, d_q = kernels.fletcher_scalar(xi, slope, q)
+    x = slope * xi / 3.0
+    if abs(1.0 - x * q) < 1e-3:
+        return  # at the kink of full slip the second derivative jumps
+    steps = ((1e-7 * xi, 0, d_xi), (1e-6 * slope, 1, d_slope), (1e-6 * max(q, 1.0), 2, d_q))
+    for h, arg, d in steps:
+        if arg == 2 and q < 1e-3:
+            continue  # q >= 0: one-sided near the straight line
+        args = [xi, slope, q]
+        up = list(args)
+        dn = list(args)
+        up[arg] += h
+        dn[arg] -= h
+        num = (kernels.fletcher_scalar(*up)[0] - kernels.fletcher_scalar(*dn)[0]) / (2 * h)
+        assert d == pytest.approx(num, rel=2e-5, abs=1e-9 * max(1.0, abs(mu)))
+
+
+def test_fletcher_scalar_limits():
+    """q = 0 is the straight line; full slip returns mu exactly; the curve is continuous there."""
+    mu, d_xi, _, _ = kernels.fletcher_scalar(0.004, 50.0, 0.0)
+    assert mu == pytest.approx(0.2) and d_xi == 50.0
+    q = 1.0 / 0.1
+    sat = 3.0 / (50.0 * q)  # creep of full slip: x q = 1
+    assert kernels.fletcher_scalar(2.0 * sat, 50.0, q)[0] == pytest.approx(0.1, rel=1e-15)
+    below = kernels.fletcher_scalar(sat * (1 - 1e-9), 50.0, q)
+    assert below[0] == pytest.approx(0.1, rel=1e-12) and below[1] == pytest.approx(0.0, abs=1e-12)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.floats(0.0, 0.2), st.floats(0.05, 1.0), st.floats(0.05, 1.0), st.floats(0.02, 0.8),
+       st.floats(2e-3, 1.5e-2), st.floats(0.3, 3.0), st.floats(2e4, 1.5e5))
+def test_polach_curve_scalar_is_polach_forces(xi, k_a, k_s, mu, a, ratio_ab, q):
+    """polach_curve_scalar(xi, (2/pi)(k_A + k_S) K, 1/mu, k_S/k_A) is polach_forces' |Fx|/Q for
+    pure longitudinal creepage with constant friction (A = 1, B = 0)."""
+    b = a / ratio_ab
+    g = 8.2e10
+    ref = abs(float(polach_forces(xi, 0.0, 0.0, q, 10.0, a, b, k_A=k_a, k_S=k_s, mu0=mu,
+                                  A=1.0, B=0.0, shear_modulus=g, poisson=0.28)[0])) / q
+    c11 = float(kalker_coefficients(a / b, 0.28)[0])
+    big_k = math.pi / 4.0 * g * a * b * c11 / q
+    slope = 2.0 / math.pi * (k_a + k_s) * big_k
+    got, _, _ = kernels.polach_curve_scalar(xi, slope, 1.0 / mu, k_s / k_a)
+    assert got == pytest.approx(ref, rel=1e-9, abs=1e-14)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.floats(1e-5, 0.05), st.floats(2.0, 400.0), st.floats(0.0, 40.0), st.floats(0.05, 1.0))
+def test_polach_curve_scalar_derivatives_and_line(xi, slope, q, ratio):
+    """Derivatives against central differences; q = 0 is the straight line slope * creep; with
+    k_S <= k_A (Polach's intended range) the curve stays below its asymptote mu."""
+    mu, d_xi, d_slope = kernels.polach_curve_scalar(xi, slope, q, ratio)
+    h = 1e-6 * xi
+    num = (kernels.polach_curve_scalar(xi + h, slope, q, ratio)[0]
+           - kernels.polach_curve_scalar(xi - h, slope, q, ratio)[0]) / (2 * h)
+    assert d_xi == pytest.approx(num, rel=1e-5, abs=1e-9)
+    h = 1e-6 * slope
+    num = (kernels.polach_curve_scalar(xi, slope + h, q, ratio)[0]
+           - kernels.polach_curve_scalar(xi, slope - h, q, ratio)[0]) / (2 * h)
+    assert d_slope == pytest.approx(num, rel=1e-5, abs=1e-12)
+    line = kernels.polach_curve_scalar(xi, slope, 0.0, ratio)
+    assert line[0] == pytest.approx(slope * xi, rel=1e-14) and line[1] == pytest.approx(slope)
+    if q > 0:
+        assert mu < 1.0 / q  # the asymptote is never reached

@@ -22,7 +22,9 @@ FAST = {"dt": 5e-3, "max_time": 60.0}  # the WSP period (5 ms) is a multiple of 
 def _direct(speed, water, pressure=5.5e5, wsp=True):
     veh = braking.load_vehicle("coach_default")
     ctrl = braking.WheelSlideProtection() if wsp else None
-    res = braking.simulate(veh, braking.WilacAdhesion(water), speed, pressure, wsp=ctrl, **FAST)
+    res = braking.simulate(veh, braking.WilacAdhesion(water), speed, pressure, wsp=ctrl,
+                           cylinders=braking.BrakeCylinders(max_pressure=6e5),  # the study's
+                           **FAST)  # fmt: skip
     return res.stopping_distance, res.summary["longest_lock_s"]
 
 

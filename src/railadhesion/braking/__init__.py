@@ -23,8 +23,20 @@ from railadhesion.braking.bench import (
 from railadhesion.braking.cylinders import APPLY, HOLD, VENT, BrakeCylinders
 from railadhesion.braking.log import braking_log_frame, write_braking_log
 from railadhesion.braking.metrics import slide_metrics
+from railadhesion.braking.odometry import OdometrySettings, ReferenceOdometry
+from railadhesion.braking.odometry_bench import (
+    OdometryProgrammeResult,
+    load_odometry_programme,
+    run_odometry_programme,
+)
 from railadhesion.braking.run import BrakeDemand, BrakingResult, simulate
-from railadhesion.braking.sensors import EncoderSettings, ExternalSpeedSettings, SensorModel
+from railadhesion.braking.sensors import (
+    AccelerometerSettings,
+    EncoderFault,
+    EncoderSettings,
+    ExternalSpeedSettings,
+    SensorModel,
+)
 from railadhesion.braking.simulator import (
     BrakingSimulator,
     BrakingState,
@@ -39,6 +51,7 @@ __all__ = [
     "HOLD",
     "VENT",
     "GRAVITY",
+    "AccelerometerSettings",
     "AdhesionRecovery",
     "AxleAdhesion",
     "BrakeCylinders",
@@ -49,9 +62,13 @@ __all__ = [
     "BrakingState",
     "CallableAdhesion",
     "ContactGeometry",
+    "EncoderFault",
     "EncoderSettings",
     "ExternalSpeedSettings",
+    "OdometryProgrammeResult",
+    "OdometrySettings",
     "PolachAdhesion",
+    "ReferenceOdometry",
     "SensorModel",
     "SimulationError",
     "WSPProgrammeResult",
@@ -60,7 +77,9 @@ __all__ = [
     "WheelSlideProtection",
     "WilacAdhesion",
     "adhesion_limited_stop",
+    "load_odometry_programme",
     "load_wsp_programme",
+    "run_odometry_programme",
     "run_wsp_programme",
     "simulate",
     "slide_metrics",

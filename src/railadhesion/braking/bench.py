@@ -82,6 +82,9 @@ __all__ = [
     "load_wsp_programme",
     "load_controller",
     "adhesion_limited_stop",
+    "load_attribute",
+    "programme_from_document",
+    "read_cosim_fmu",
     "run_wsp_case",
     "run_wsp_programme",
     "write_programme_outputs",
@@ -360,6 +363,16 @@ def _programme_from_document(doc, base: Path) -> WSPProgramme:
     return WSPProgramme(name, out, description, wsp)
 
 
+def programme_from_document(doc, base=".") -> WSPProgramme:
+    """A programme from a parsed TOML document (``base``: the folder vehicle files are relative
+    to). Errors are :class:`~railadhesion.braking.BrakingFileError` naming the field (the
+    odometry bench reads its vehicle runs this way)."""
+    try:
+        return _programme_from_document(doc, Path(os.fspath(base)))
+    except FieldError as exc:
+        raise BrakingFileError(str(exc)) from None
+
+
 def load_wsp_programme(path="default") -> WSPProgramme:
     """Read and check a programme file (``"default"``: the shipped 30-case programme).
     Errors are :class:`~railadhesion.braking.BrakingFileError` naming the file and field."""
@@ -449,6 +462,51 @@ class _PythonController:
         return d() if callable(d) else {}
 
 
+def read_cosim_fmu(path, period: float | None = None, what: str = "FMU"):
+    """Open an FMI 2.0 co-simulation FMU with FMPy: ``(path, model description, variables by
+    name, period)``; the period is ``period``, else the FMU's DefaultExperiment step size, else
+    5 ms. ``what`` names the FMU in the ImportError without FMPy."""
+    try:
+        from fmpy import read_model_description
+    except ImportError as exc:  # pragma: no cover - fmpy is in the fmu extra
+        raise ImportError(f"{what} needs FMPy: pip install 'railadhesion[fmu]'") from exc
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"FMU file not found: {path}")
+    try:
+        md = read_model_description(str(path))
+    except Exception as exc:  # FMPy raises several kinds for a broken archive
+        raise ValueError(f"{path}: not a readable FMU: {exc}") from None
+    if md.coSimulation is None:
+        raise ValueError(f"{path}: not a co-simulation FMU (FMI 2.0 CS needed)")
+    variables = {v.name: v for v in md.modelVariables}
+    step = getattr(md.defaultExperiment, "stepSize", None) if (
+        md.defaultExperiment is not None) else None
+    if period is None:
+        period = float(step) if step else 5e-3
+    if not (math.isfinite(period) and period > 0):
+        raise ValueError(f"period must be in (0, inf) s, got {period!r}")
+    return path, md, variables, float(period)
+
+
+def load_attribute(text: str, what: str, prefix: str):
+    """The object ``"module:name"`` or ``"file.py:name"`` names (a file is imported as module
+    ``prefix + its stem``); errors name ``what`` and the specification."""
+    where, name = text.rsplit(":", 1)
+    if where.endswith(".py"):
+        path = Path(where)
+        if not path.is_file():
+            raise ValueError(f"{what} file not found: {path}")
+        mspec = importlib.util.spec_from_file_location(f"{prefix}{path.stem}", path)
+        module = importlib.util.module_from_spec(mspec)
+        mspec.loader.exec_module(module)
+    else:
+        module = importlib.import_module(where)
+    if not hasattr(module, name):
+        raise ValueError(f"{what} {text!r}: {where} has no attribute {name!r}")
+    return getattr(module, name)
+
+
 class FmuController:
     """A WSP unit delivered as an FMI 2.0 co-simulation FMU, run with FMPy.
 
@@ -464,28 +522,10 @@ class FmuController:
     """
 
     def __init__(self, path, period: float | None = None):
-        try:
-            from fmpy import extract, read_model_description
-        except ImportError as exc:  # pragma: no cover - fmpy is in the fmu extra
-            raise ImportError("FMU controllers need FMPy: pip install 'railadhesion[fmu]'") \
-                from exc
-        self.path = Path(path)
-        if not self.path.is_file():
-            raise ValueError(f"FMU file not found: {self.path}")
-        try:
-            self.md = read_model_description(str(self.path))
-        except Exception as exc:  # FMPy raises several kinds for a broken archive
-            raise ValueError(f"{self.path}: not a readable FMU: {exc}") from None
-        if self.md.coSimulation is None:
-            raise ValueError(f"{self.path}: not a co-simulation FMU (FMI 2.0 CS needed)")
-        self.vars = {v.name: v for v in self.md.modelVariables}
-        step = getattr(self.md.defaultExperiment, "stepSize", None) if (
-            self.md.defaultExperiment is not None) else None
-        if period is None:
-            period = float(step) if step else 5e-3
-        if not (math.isfinite(period) and period > 0):
-            raise ValueError(f"period must be in (0, inf) s, got {period!r}")
-        self.period = float(period)
+        self.path, self.md, self.vars, self.period = read_cosim_fmu(path, period,
+                                                                    "FMU controllers")
+        from fmpy import extract
+
         self.label = f"FMU {self.path.name}"
         self._extract = extract
         self.fmu = None
@@ -595,19 +635,7 @@ def load_controller(spec=None, *, control_period: float | None = None, wsp_setti
         if ":" not in text:
             raise ValueError(f"controller {text!r}: give 'default', a .fmu file, or "
                              "'module:name' / 'file.py:name'")
-        where, name = text.rsplit(":", 1)
-        if where.endswith(".py"):
-            path = Path(where)
-            if not path.is_file():
-                raise ValueError(f"controller file not found: {path}")
-            mspec = importlib.util.spec_from_file_location(f"wsp_controller_{path.stem}", path)
-            module = importlib.util.module_from_spec(mspec)
-            mspec.loader.exec_module(module)
-        else:
-            module = importlib.import_module(where)
-        if not hasattr(module, name):
-            raise ValueError(f"controller {text!r}: {where} has no attribute {name!r}")
-        obj = getattr(module, name)
+        obj = load_attribute(text, "controller", "wsp_controller_")
         if isinstance(obj, WheelSlideProtection):
             return _DefaultController(obj)
         return _PythonController(obj, control_period)

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-__all__ = ["braking_figures", "wsp_case_figure", "wsp_summary_figure"]
+__all__ = ["braking_figures", "wsp_case_figure", "wsp_summary_figure", "odometry_case_figure",
+           "odometry_summary_figure"]
 
 
 def _axle_columns(h, name):
@@ -140,6 +141,100 @@ def wsp_summary_figure(cases) -> Figure:
     ax3.set(ylabel="vented air [l]")
     ax3.set_xticks(x, names, rotation=70, ha="right", fontsize=7)
     for ax in (ax1, ax2, ax3):
+        ax.grid(alpha=0.3, axis="y")
+    fig.tight_layout()
+    return fig
+
+
+def _phases(ax, t, creep, threshold):
+    """Shade the slide (red) and spin (blue) phases of the odometry axles (one collection
+    each)."""
+    for mask, color in ((np.any(creep > threshold, axis=1), "tab:red"),
+                        (np.any(creep < -threshold, axis=1), "tab:blue")):
+        if not np.any(mask):
+            continue
+        edges = np.flatnonzero(np.diff(np.r_[0, mask.astype(np.int8), 0]))
+        ends = np.minimum(edges[1::2], len(t) - 1)
+        spans = [(t[a], max(t[b] - t[a], 1e-9)) for a, b in zip(edges[::2], ends, strict=True)]
+        ax.broken_barh(spans, (0, 1), transform=ax.get_xaxis_transform(), color=color,
+                       alpha=0.12, lw=0)
+
+
+def odometry_case_figure(traces, summary, title: str = "", threshold: float = 0.02) -> Figure:
+    """One odometry bench case: true and estimated speed; true and estimated distance; per
+    fit, its interval and estimate against the true position (violations in red). Slide
+    phases of the odometry axles are shaded red, spin phases blue (creepage beyond
+    ``threshold``).
+
+    ``traces`` and ``summary`` are those of
+    :func:`railadhesion.braking.odometry_bench.run_odometry_case`."""
+    t = traces["time"]
+    step = max(1, len(t) // 2000)
+    ts = t[::step]
+    creep = traces["creep"][::step]
+    fits = [f for f in summary.get("fits", []) if f.get("status") == "ok"]
+    rows = 2 + len(fits)
+    fig = Figure(figsize=(9, 2.0 * rows + 1.5))
+    axes = fig.subplots(rows, 1, sharex=True, height_ratios=[2.2, 1.6] + [1.2] * len(fits))
+    ax = axes[0]
+    ax.plot(ts, traces["speed"][::step] * 3.6, "k", lw=2, label="true")
+    x_true = traces["distance"][::step]
+    axes[1].plot(ts, x_true / 1e3, "k", lw=2, label="true")
+    for f in fits:
+        out = traces["outputs"][f["fit"]][::step]
+        ax.plot(ts, out[:, 0] * 3.6, lw=0.9, label=f["fit"])
+        axes[1].plot(ts, out[:, 1] / 1e3, lw=0.9, label=f["fit"])
+    ax.set(ylabel="speed [km/h]", title=title)
+    ax.legend(fontsize=7, ncol=3)
+    axes[1].set(ylabel="distance [km]")
+    for k, f in enumerate(fits):
+        a = axes[2 + k]
+        out = traces["outputs"][f["fit"]][::step]
+        lo = out[:, 2] - x_true
+        hi = out[:, 3] - x_true
+        a.fill_between(ts, np.where(np.isfinite(lo), lo, np.nan),
+                       np.where(np.isfinite(hi), hi, np.nan), color="tab:green", alpha=0.25,
+                       lw=0, label="interval")
+        a.plot(ts, out[:, 1] - x_true, "tab:green", lw=0.9, label="estimate")
+        a.axhline(0.0, color="k", lw=1)
+        for e in f.get("violations", []):
+            a.axvspan(e["start_s"], e["end_s"] + 1e-3, color="tab:red", alpha=0.6)
+        start = f.get("fault_start_s")
+        if isinstance(start, float) and np.isfinite(start) and start > 0:
+            a.axvline(start, color="k", ls="--", lw=1)
+        a.set_yscale("symlog", linthresh=1.0)
+        a.set_ylabel("− true [m]", fontsize=7)
+        inside = "inside" if f.get("inside") else f"{len(f.get('violations', []))} violation(s)"
+        a.set_title(f"{f['fit']}: stop error {f['stop_error_m']:+.1f} m, {inside}", fontsize=8)
+    for a in axes:
+        _phases(a, ts, creep, threshold)
+        a.grid(alpha=0.3)
+    axes[-1].set_xlabel("time [s]; shaded: odometry axles sliding (red) or spinning (blue)")
+    fig.subplots_adjust(left=0.1, right=0.97, top=1 - 0.5 / (2.0 * rows + 1.5),
+                        bottom=0.8 / (2.0 * rows + 1.5), hspace=0.45)
+    return fig
+
+
+def odometry_summary_figure(cases) -> Figure:
+    """Across the cases of an odometry programme: the distance error at the stop and the
+    interval's width at the stop, both over the stopping distance, per fit."""
+    rows = [(c["name"], f) for c in cases if c.get("status") != "error"
+            for f in c.get("fits", []) if f.get("status") == "ok"]
+    dist = {c["name"]: c.get("stopping_distance_m", np.nan) for c in cases}
+    x = np.arange(len(rows))
+    fig = Figure(figsize=(max(8, 0.22 * len(rows) + 2), 7))
+    ax1, ax2 = fig.subplots(2, 1, sharex=True)
+    err = [abs(f["stop_error_m"]) / dist[n] * 100 for n, f in rows]
+    width = [f["interval_width_at_stop_m"] / dist[n] * 100 for n, f in rows]
+    colors = ["tab:green" if f.get("passed") else "tab:red" for _, f in rows]
+    ax1.bar(x, err, color=colors)
+    ax1.set(ylabel="|stop error| [% of stop]", yscale="log",
+            title="Odometry programme: green passed every check, red failed one")
+    ax2.bar(x, width, color=colors)
+    ax2.set(ylabel="interval width at stop [%]", yscale="log")
+    ax2.set_xticks(x, [f"{n} / {f['fit']}" for n, f in rows], rotation=80, ha="right",
+                   fontsize=6)
+    for ax in (ax1, ax2):
         ax.grid(alpha=0.3, axis="y")
     fig.tight_layout()
     return fig

@@ -32,7 +32,8 @@ __all__ = [
     "MAX_AXLES", "MAX_CONDITIONS", "MAX_LANES", "LANE_BLOCK", "CURVE", "STATE", "SETTINGS",
     "INPUTS",
     "machine_dtype", "history_columns", "OK", "STOPPED", "NONFINITE", "BAD_DT",
-    "BAD_COMMAND", "BAD_VALVE", "ROWS_FULL", "STALE", "POLACH", "WILAC", "USER", "PYTHON",
+    "BAD_COMMAND", "BAD_VALVE", "ROWS_FULL", "BAD_TORQUE", "STALE", "POLACH", "WILAC", "USER",
+    "PYTHON",
     "NEWTON_MAX", "USER_GRID", "PEAK_FULL_EVERY", "PEAK_WINDOW",
 ]
 
@@ -47,7 +48,7 @@ MAX_LANES = MAX_AXLES * MAX_CONDITIONS
 LANE_BLOCK = 8
 
 # status codes returned by the step (STALE: compiled for another layout, see machine_dtype)
-OK, STOPPED, NONFINITE, BAD_DT, BAD_COMMAND, BAD_VALVE, ROWS_FULL, STALE = range(8)
+OK, STOPPED, NONFINITE, BAD_DT, BAD_COMMAND, BAD_VALVE, ROWS_FULL, BAD_TORQUE, STALE = range(9)
 # adhesion models the step evaluates: Polach sets on track sections, WILAC with a water-flow
 # profile, a user's compiled law mu(creep, speed, wheel load), or any model in Python
 POLACH, WILAC, USER, PYTHON = range(4)
@@ -148,8 +149,9 @@ SETTINGS = _record([
     ("demand_start", "f8"), ("demand_ramp", "f8"),
 ])
 
-#: Written by the caller between steps (:class:`~railadhesion.braking.simulator.StepInputs`).
-INPUTS = _record([("pressure_command", "f8", _A), ("valves", "f8", _A)])
+#: Written by the caller between steps (:class:`~railadhesion.braking.simulator.StepInputs`):
+#: commanded pressure [Pa], valve states, traction torque [N m] per axle.
+INPUTS = _record([("pressure_command", "f8", _A), ("valves", "f8", _A), ("torque", "f8", _A)])
 
 
 def machine_dtype(wsp_settings: np.dtype, wsp_state: np.dtype, sensor_settings: np.dtype,

@@ -5,6 +5,14 @@ every field in ``docs/braking.md``; ``examples/brake_dry.toml`` and ``examples/b
 are complete examples. Loading checks every field; errors are
 :class:`~railadhesion.braking.BrakingFileError` naming the file, the dotted field and the
 allowed range, e.g. ``damp.toml: brake.pressure_Pa: must be in (0, 2e+06], got -1.0``.
+
+Possible but implausible values give a warning naming the file and the field
+(``docs/checks.md``): a pressure below 0.05 bar or above 20 bar (a
+:class:`~railadhesion.plausibility.UnitWarning` when it would be plausible in bar, kPa or
+psi: ``pressure_Pa = 5.5`` means 5.5 bar), an initial speed above 100 m/s (km/h?), a water
+flow above 1000 µl/s, and a demand above ``max_pressure_Pa``, which the cylinders would clip
+(an :class:`~railadhesion.plausibility.AlteredResultWarning`). They are kept in
+:attr:`BrakeScenario.warnings`.
 """
 
 from __future__ import annotations
@@ -40,6 +48,7 @@ from railadhesion.braking.run import BrakeDemand, BrakingResult, simulate
 from railadhesion.braking.vehicle import Vehicle, load_vehicle
 from railadhesion.braking.wsp import WheelSlideProtection, WSPSettings, settings_file_keys
 from railadhesion.models.parameters import POLACH_PARAMETER_SETS
+from railadhesion.plausibility import AlteredResultWarning, check_plausible, warn
 
 __all__ = ["BrakeScenario", "load_scenario", "run_scenario", "SCENARIO_FORMAT"]
 
@@ -68,6 +77,8 @@ class BrakeScenario:
     compare_dry: bool = True
     description: str = ""
     source: dict = field(default_factory=dict)
+    #: Implausible fields found when loading (each also issued as a warning).
+    warnings: tuple = ()
 
     def simulate(self, dry: bool = False, dt: float | None = None,
                  progress=None) -> BrakingResult:
@@ -224,7 +235,27 @@ def _identified_law(tab: Mapping, base: Path, wheel_radius: float):
             {"model": "law", "file": str(path), "slip": law.slip_kind})
 
 
-def _scenario_from_document(doc: Mapping, base: Path) -> BrakeScenario:
+def _plausible_fields(label: str, v0: float, demand: float, max_pressure: float,
+                      max_given: bool, water: float) -> tuple[str, ...]:  # fmt: skip
+    """Warnings for the implausible fields of a scenario (module notes), naming them."""
+    found = [
+        check_plausible(v0, "initial_speed", where=f"{label}: run.initial_speed_m_s"),
+        check_plausible(demand, "brake_pressure", where=f"{label}: brake.pressure_Pa"),
+        check_plausible(max_pressure, "brake_pressure", where=f"{label}: brake.max_pressure_Pa",
+                        what="brake-cylinder pressure limit"),
+        check_plausible(water, "water_flow", where=f"{label}: adhesion.water_flow_ul_s"),
+    ]  # fmt: skip
+    if demand > max_pressure:
+        given = "" if max_given else " (its default; set brake.max_pressure_Pa)"
+        found.append(warn(
+            f"{label}: brake.pressure_Pa = {demand:g} Pa is above brake.max_pressure_Pa = "
+            f"{max_pressure:g} Pa{given}: the cylinders will hold {max_pressure:g} Pa, not the "
+            "demand (docs/checks.md)", AlteredResultWarning,
+        ))  # fmt: skip
+    return tuple(f for f in found if f)
+
+
+def _scenario_from_document(doc: Mapping, base: Path, label: str = "") -> BrakeScenario:
     keys(doc, "", ("format", "version", "vehicle", "run", "brake", "adhesion"),
          ("name", "description", "wsp"))
     if doc["format"] != SCENARIO_FORMAT:
@@ -276,6 +307,10 @@ def _scenario_from_document(doc: Mapping, base: Path) -> BrakeScenario:
         valves,
     )
     adhesion, dry, adhesion_info = _adhesion(doc["adhesion"], base, vehicle.wheel_radius)
+    found = _plausible_fields(
+        label or "scenario", v0, demand.pressure, cylinders.max_pressure,
+        "max_pressure_Pa" in bt, float(adhesion_info.get("water_flow_ul_s", 0.0)),
+    )  # fmt: skip
     # wsp
     wsp = None
     if "wsp" in doc:
@@ -299,14 +334,14 @@ def _scenario_from_document(doc: Mapping, base: Path) -> BrakeScenario:
                                  f"({dt} s), got {wsp.period} s")
     return BrakeScenario(name, vehicle, v0, demand, cylinders, adhesion, dry, wsp, dt,
                          max_time, gradient, refresh, compare, description,
-                         {"adhesion": adhesion_info, "vehicle": vehicle.name})
+                         {"adhesion": adhesion_info, "vehicle": vehicle.name}, found)
 
 
 def load_scenario(path) -> BrakeScenario:
     """Read and validate a scenario TOML file (paths inside are relative to the file)."""
     doc, label = read_toml(path)
     try:
-        return _scenario_from_document(doc, Path(os.fspath(path)).resolve().parent)
+        return _scenario_from_document(doc, Path(os.fspath(path)).resolve().parent, label)
     except FieldError as exc:
         raise BrakingFileError(f"{label}: {exc}") from None
     except ValueError as exc:
@@ -324,6 +359,8 @@ def run_scenario(scenario: BrakeScenario, progress=None, dt: float | None = None
         dry = scenario.simulate(dry=True, dt=dt)
         result.compare_dry(dry)
     result.summary["scenario"] = scenario.name
+    if scenario.warnings:  # the summary records what the file was warned for
+        result.summary["scenario_warnings"] = list(scenario.warnings)
     return result, dry
 
 

@@ -43,7 +43,22 @@ the true train speed every ``period`` with white noise ``noise`` [m/s] and deliv
 ``min_speed`` (a Doppler radar's low-speed loss) the sensor gives nothing. Lost samples read
 NaN. Default noise 0.13 m/s: the twin-radar error of about 0.47 km/h up to 130 km/h reported by
 a 2023 study of twin Doppler radars, taken as a standard deviation; latency 0.05 s, period 0.02 s,
-min_speed 0.3 m/s: assumptions.
+min_speed 0.3 m/s: assumptions. A scale error (``scale_error``: a Doppler radar's mounting
+angle, or a surface that scatters badly) multiplies the speed, and an outage window loses
+every sample taken in it.
+
+**Odometry additions** (issue 23; every default an assumption, see the classes):
+
+* encoder pulse **dropouts** (``EncoderSettings.dropout_probability``, per pulse: a missed
+  tooth makes the unit count one pitch too few, so the reading is low for a period and the
+  pulse count falls behind) and **faults** (:class:`EncoderFault`: "stuck", the reading and
+  the count freeze; "dead", no more pulses, the reading decays to zero);
+* wheel-diameter **drift with wear** (``EncoderSettings.diameter_drift``): the diameter error
+  grows with the distance the wheel rolls, ``e_i + drift · 2πR · revolutions``;
+* a **longitudinal accelerometer** (:class:`AccelerometerSettings`): the specific force along
+  the track, ``a + g sin(atan(gradient))`` (the gradient's gravity component), plus bias and
+  white noise, clipped at ± its range (saturation). Read with :func:`accelerometer` after
+  :func:`measure`.
 
 Random numbers
 --------------
@@ -63,9 +78,10 @@ the readings into ``omega_meas`` [rad/s] and ``pressure_meas`` [Pa] (one per axl
 the external speed [m/s] (NaN when there is none, it is lost, or its first sample has not
 arrived). numba ``@njit``, no exceptions, no allocation.
 
-Odometry (issue 23) extends the same records: the encoder state already counts pulses per axle
-(``pulses``), and an accelerometer, radar dropouts and encoder dropouts go in as further
-fields read by :func:`measure` in the same way.
+Odometry (issue 23) uses the same records: the encoder state counts the detected pulses per
+axle (``state["pulses"]``), the accelerometer's reading is :func:`accelerometer` ``(state)``.
+Every odometry setting defaults to "off", so a model without them draws the same random
+numbers, and gives the same readings, as before.
 """
 
 from __future__ import annotations
@@ -76,11 +92,16 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 from numba import njit
 
+from railadhesion.braking.vehicle import GRAVITY
+
 __all__ = [
     "MAX_AXLES",
+    "AccelerometerSettings",
+    "EncoderFault",
     "EncoderSettings",
     "ExternalSpeedSettings",
     "SensorModel",
+    "accelerometer",
     "measure",
     "random_normal",
     "random_uniform",
@@ -110,6 +131,22 @@ SETTINGS_DTYPE = np.dtype([
     ("external_min_speed", "f8"),
     ("external_dropout", "f8"),
     ("seed", "u8"),
+    # odometry (issue 23): encoder dropouts and faults, diameter drift with wear
+    ("encoder_dropout", "f8"),
+    ("fault_kind", "i8", (MAX_AXLES,)),     # 0 none, 1 stuck, 2 dead (FAULT_*)
+    ("fault_start", "f8", (MAX_AXLES,)),    # time the fault begins [s]
+    ("diameter_drift", "f8"),               # growth of the diameter error per m rolled [1/m]
+    ("wheel_radius", "f8"),                 # nominal radius, for the rolled distance [m]
+    # odometry: radar scale error and outage
+    ("external_scale_error", "f8"),
+    ("external_outage_start", "f8"),
+    ("external_outage_end", "f8"),
+    # odometry: longitudinal accelerometer
+    ("accel_on", "i8"),
+    ("accel_bias", "f8"),
+    ("accel_noise", "f8"),
+    ("accel_range", "f8"),
+    ("gradient", "f8"),                     # track gradient, rise over run
 ], align=True)
 
 STATE_DTYPE = np.dtype([
@@ -127,7 +164,15 @@ STATE_DTYPE = np.dtype([
     ("ext_head", "i8"),
     ("ext_count", "i8"),
     ("ext_next", "f8"),
+    # odometry (issue 23)
+    ("rolled", "f8", (MAX_AXLES,)),         # revolutions turned since the start [-]
+    ("accel_out", "f8"),                    # last accelerometer reading [m/s²], NaN if none
 ], align=True)
+
+#: Encoder fault kinds (``EncoderFault.kind``): the reading and the pulse count freeze at their
+#: values ("stuck"), or no more pulses arrive, so the reading decays to zero ("dead").
+FAULT_NONE, FAULT_STUCK, FAULT_DEAD = 0, 1, 2
+FAULT_KINDS = {"stuck": FAULT_STUCK, "dead": FAULT_DEAD}
 
 _TWO_PI = 2.0 * math.pi
 
@@ -162,6 +207,8 @@ def random_normal(rec):
 def _encoder(s, st, i, dt, omega, first):
     """Reading of axle i's encoder [rad/s], without the diameter factor."""
     n_teeth = s.pulses_per_revolution
+    if not first and s.fault_kind[i] == FAULT_STUCK and st.t_prev + dt >= s.fault_start[i]:
+        return st.omega_out[i]  # frozen: the count does not move either
     if n_teeth <= 0.0:
         return omega
     if first:
@@ -175,28 +222,59 @@ def _encoder(s, st, i, dt, omega, first):
     total = st.phase[i] + travel
     k = math.floor(total)
     reading = st.omega_out[i]
-    if k >= 1.0:
-        # time of the last edge inside the period (speed taken constant over the period)
-        t_edge = st.t_prev + (k - st.phase[i]) / travel * dt
-        pitch_time = dt / travel
-        if s.edge_jitter > 0.0:
-            t_edge += s.edge_jitter * pitch_time * random_normal(st)
-        if s.clock_resolution > 0.0:
-            t_edge = math.floor(t_edge / s.clock_resolution + 0.5) * s.clock_resolution
-        span = t_edge - st.edge_time[i]
-        if span > 0.0:
-            reading = _TWO_PI / n_teeth * k / span
-        st.edge_time[i] = t_edge
-        st.pulses[i] += np.int64(k)
-        st.phase[i] = total - k
-    else:
+    if k < 1.0:
         st.phase[i] = total
-        since = st.t_prev + dt - st.edge_time[i]
-        if since > 0.0:
-            bound = _TWO_PI / n_teeth / since
-            if bound < reading:
-                reading = bound
+        return _no_edge(s, st, i, dt, reading)
+    detected = k
+    last = k
+    if s.encoder_dropout > 0.0 or (s.fault_kind[i] == FAULT_DEAD
+                                   and st.t_prev + dt >= s.fault_start[i]):
+        detected, last = _detected(s, st, i, dt, k)
+    if detected < 1.0:
+        st.phase[i] = total - k
+        return _no_edge(s, st, i, dt, reading)
+    # time of the last detected edge inside the period (speed taken constant over it)
+    t_edge = st.t_prev + (last - st.phase[i]) / travel * dt
+    pitch_time = dt / travel
+    if s.edge_jitter > 0.0:
+        t_edge += s.edge_jitter * pitch_time * random_normal(st)
+    if s.clock_resolution > 0.0:
+        t_edge = math.floor(t_edge / s.clock_resolution + 0.5) * s.clock_resolution
+    span = t_edge - st.edge_time[i]
+    if span > 0.0:
+        reading = _TWO_PI / n_teeth * detected / span
+    st.edge_time[i] = t_edge
+    st.pulses[i] += np.int64(detected)
+    st.phase[i] = total - k
     return reading
+
+
+@njit(cache=True)
+def _no_edge(s, st, i, dt, reading):
+    """With no new edge the speed is at most one pitch over the time since the last edge."""
+    since = st.t_prev + dt - st.edge_time[i]
+    if since > 0.0:
+        bound = _TWO_PI / s.pulses_per_revolution / since
+        if bound < reading:
+            reading = bound
+    return reading
+
+
+@njit(cache=True)
+def _detected(s, st, i, dt, k):
+    """(pulses detected, position of the last detected one) among the k edges of a period:
+    each is lost with probability ``encoder_dropout``, every one after a "dead" fault. The unit
+    counts only what it detects over the time between its detected edges, so a lost pulse
+    makes the reading low."""
+    dead = s.fault_kind[i] == FAULT_DEAD and st.t_prev + dt >= s.fault_start[i]
+    detected = 0.0
+    last = 0.0
+    for j in range(1, int(k) + 1):
+        if dead or random_uniform(st) < s.encoder_dropout:
+            continue
+        detected += 1.0
+        last = float(j)
+    return detected, last
 
 
 @njit(cache=True)
@@ -209,8 +287,10 @@ def _external(s, st, t, speed):
     while st.ext_next <= t + 1e-12 and taken < EXTERNAL_BUFFER:
         value = math.nan
         if speed >= s.external_min_speed:
-            value = speed + s.external_noise * random_normal(st)
+            value = speed * (1.0 + s.external_scale_error) + s.external_noise * random_normal(st)
         if s.external_dropout > 0.0 and random_uniform(st) < s.external_dropout:
+            value = math.nan
+        if s.external_outage_start <= st.ext_next < s.external_outage_end:
             value = math.nan
         head = (st.ext_head + 1) % EXTERNAL_BUFFER
         st.ext_head = head
@@ -235,8 +315,8 @@ def _external(s, st, t, speed):
 def measure(settings, state, t, omega_true, pressure_true, speed_true, accel_true, omega_meas,
             pressure_meas):
     """Sensor readings at time ``t`` [s] (see the module docstring); returns the external
-    speed [m/s] or NaN. ``accel_true`` [m/s²] is accepted for the accelerometer of the
-    odometry work (issue 23) and not used yet."""
+    speed [m/s] or NaN. ``accel_true`` [m/s²] is the train's acceleration along the track;
+    with an accelerometer fitted its reading goes to the state (:func:`accelerometer`)."""
     s = settings[0]
     st = state[0]
     n = st.n_axles
@@ -255,9 +335,12 @@ def measure(settings, state, t, omega_true, pressure_true, speed_true, accel_tru
             reading = _encoder(s, st, i, 0.0, w, True) if first else st.omega_out[i]
         else:
             reading = _encoder(s, st, i, dt, w, False)
+        if s.diameter_drift != 0.0 and dt > 0.0:
+            st.rolled[i] += 0.5 * (st.omega_prev[i] + w) * dt / _TWO_PI
         st.omega_out[i] = reading
         st.omega_prev[i] = w
-        omega_meas[i] = reading * (1.0 + s.diameter_error[i])
+        omega_meas[i] = reading * (1.0 + s.diameter_error[i] + s.diameter_drift * _TWO_PI
+                                   * s.wheel_radius * st.rolled[i])
         p = pressure_true[i]
         if s.pressure_noise > 0.0:
             p += s.pressure_noise * random_normal(st)
@@ -266,7 +349,27 @@ def measure(settings, state, t, omega_true, pressure_true, speed_true, accel_tru
         pressure_meas[i] = p if p > 0.0 else 0.0
     if dt > 0.0:
         st.t_prev = t
+    if s.accel_on != 0:
+        _accelerometer(s, st, accel_true)
+    else:
+        st.accel_out = math.nan
     return _external(s, st, t, speed_true)
+
+
+@njit(cache=True)
+def _accelerometer(s, st, accel):
+    """Longitudinal accelerometer: specific force along the track, a + g sin(atan(gradient)),
+    plus bias and white noise, clipped to ± the range (saturation)."""
+    f = accel + GRAVITY * math.sin(math.atan(s.gradient)) + s.accel_bias
+    if s.accel_noise > 0.0:
+        f += s.accel_noise * random_normal(st)
+    st.accel_out = min(max(f, -s.accel_range), s.accel_range)
+
+
+@njit(cache=True)
+def accelerometer(state):
+    """The accelerometer reading of the last :func:`measure` call [m/s²]; NaN without one."""
+    return state[0].accel_out
 
 
 # -- the Python side ------------------------------------------------------------------------
@@ -299,6 +402,15 @@ class EncoderSettings:
         Standard deviation of the pressure readings [Pa], [0, 1e5]; default 0.
     pressure_resolution : float
         Resolution of the pressure readings [Pa], [0, 1e5]; default 0 (continuous).
+    dropout_probability : float
+        Probability that a pulse is not detected (a missed tooth: dirt, air gap, electrical
+        noise), [0, 0.5]; default 0 (assumption; no public rate was found). The unit then
+        counts one pitch too few over the span, so the reading is low for one period.
+    diameter_drift : float
+        Growth of the diameter error with the distance each wheel rolls [1/km], [0, 1e-3]:
+        a wheel wearing by Δd reads high by Δd/d; default 0. Wear of a few millimetres of
+        diameter over 10⁵ km (about 1e-8 per km rolled, an assumption; no public figure was
+        found) is negligible within one stop; the setting lets a bench exaggerate it.
     """
 
     pulses_per_revolution: float = 80.0
@@ -307,8 +419,12 @@ class EncoderSettings:
     diameter_errors: float | tuple = 0.0
     pressure_noise: float = 0.0
     pressure_resolution: float = 0.0
+    dropout_probability: float = 0.0
+    diameter_drift: float = 0.0
 
     def __post_init__(self):
+        _check(self.dropout_probability, "dropout_probability", 0.0, 0.5)
+        _check(self.diameter_drift, "diameter_drift", 0.0, 1e-3)
         ppr = self.pulses_per_revolution
         _check(ppr, "pulses_per_revolution", 0.0, 1e4)
         if 0 < ppr < 4:
@@ -360,6 +476,13 @@ class ExternalSpeedSettings:
         (assumption: a Doppler radar's low-speed loss).
     dropout_probability : float
         Probability that a sample is lost, [0, 1]; default 0.
+    scale_error : float
+        Relative error of the speed scale, [-0.2, 0.2]; default 0. A Doppler radar measures
+        the speed along its beam: an error in the mounting angle, or a surface that scatters
+        badly (snow, water), makes its reading a few per cent off (assumption).
+    outage : (start, end) or None
+        Samples taken in ``[start, end)`` [s] are lost (a radar that fails, a GNSS outage in a
+        tunnel); default None.
     """
 
     noise: float = 0.13
@@ -367,8 +490,19 @@ class ExternalSpeedSettings:
     period: float = 0.02
     min_speed: float = 0.3
     dropout_probability: float = 0.0
+    scale_error: float = 0.0
+    outage: tuple | None = None
 
     def __post_init__(self):
+        _check(self.scale_error, "scale_error", -0.2, 0.2)
+        if self.outage is not None:
+            if not isinstance(self.outage, list | tuple) or len(self.outage) != 2:
+                raise ValueError(f"outage must be (start, end) [s] or None, got {self.outage!r}")
+            _check(self.outage[0], "outage start", 0.0, 1e6)
+            _check(self.outage[1], "outage end", 0.0, 1e6)
+            if self.outage[1] <= self.outage[0]:
+                raise ValueError(f"outage end must be after its start, got {self.outage!r}")
+            object.__setattr__(self, "outage", (float(self.outage[0]), float(self.outage[1])))
         _check(self.noise, "noise", 0.0, 10.0)
         _check(self.latency, "latency", 0.0, 5.0)
         _check(self.period, "period", 0.0, 5.0, low_open=True)
@@ -377,6 +511,61 @@ class ExternalSpeedSettings:
         if self.latency / self.period > EXTERNAL_BUFFER - 4:
             raise ValueError(f"latency / period must be at most {EXTERNAL_BUFFER - 4}, got "
                              f"{self.latency} / {self.period}")
+
+
+@dataclass(frozen=True)
+class AccelerometerSettings:
+    """A longitudinal accelerometer on the car body (odometry, issue 23).
+
+    It measures the specific force along the track, ``a + g sin(atan(gradient))``: on an
+    up-gradient of 1 % it reads 0.098 m/s² more than the train's acceleration (the gravity
+    component the odometry must remove, knowing the gradient from its track data). Sampled at
+    every :func:`measure` call.
+
+    Parameters
+    ----------
+    bias : float
+        Constant offset [m/s²], [-1, 1]; default 0.005 (about 0.5 mg; assumption: the residual
+        bias of a calibrated MEMS accelerometer).
+    noise : float
+        Standard deviation of each sample [m/s²], [0, 5]; default 0.05 (assumption: sensor
+        noise and car-body vibration in a 5 ms sample).
+    range : float
+        Full scale [m/s²], (0, 1000]; readings beyond it are clipped (saturation); default
+        19.6 (± 2 g, a common MEMS range; assumption).
+    """
+
+    bias: float = 0.005
+    noise: float = 0.05
+    range: float = 19.6
+
+    def __post_init__(self):
+        _check(self.bias, "bias", -1.0, 1.0)
+        _check(self.noise, "noise", 0.0, 5.0)
+        _check(self.range, "range", 0.0, 1000.0, low_open=True)
+
+
+@dataclass(frozen=True)
+class EncoderFault:
+    """A fault of one axle's encoder from ``start`` [s] on (odometry bad-input tests).
+
+    ``kind``: ``"stuck"`` (the reading and the pulse count freeze at their values, as a
+    frozen bus value or a locked-up interface would) or ``"dead"`` (no more pulses arrive, a
+    broken cable or probe: the reading decays to zero as at standstill). ``axle`` counts from
+    1 (the leading axle).
+    """
+
+    axle: int
+    kind: str = "stuck"
+    start: float = 0.0
+
+    def __post_init__(self):
+        if isinstance(self.axle, bool) or not isinstance(self.axle, int | np.integer) or not (
+                1 <= self.axle <= MAX_AXLES):
+            raise ValueError(f"axle must be an integer in [1, {MAX_AXLES}], got {self.axle!r}")
+        if self.kind not in FAULT_KINDS:
+            raise ValueError(f"kind must be one of {', '.join(FAULT_KINDS)}, got {self.kind!r}")
+        _check(self.start, "start", 0.0, 1e6)
 
 
 @dataclass(frozen=True)
@@ -394,14 +583,31 @@ class SensorModel:
         None: no external speed sensor (the controller receives NaN).
     seed : int
         Seed of the random numbers, [0, 2**64).
+    accelerometer : AccelerometerSettings, optional
+        None: no accelerometer (:func:`accelerometer` reads NaN).
+    faults : sequence of EncoderFault
+        Encoder faults (at most one per axle); default none.
     """
 
     encoders: EncoderSettings = field(
         default_factory=lambda: EncoderSettings(pulses_per_revolution=0.0, edge_jitter=0.0))
     external: ExternalSpeedSettings | None = None
     seed: int = 0
+    accelerometer: AccelerometerSettings | None = None
+    faults: tuple = ()
 
     def __post_init__(self):
+        if self.accelerometer is not None and not isinstance(self.accelerometer,
+                                                             AccelerometerSettings):
+            raise ValueError(f"accelerometer must be an AccelerometerSettings or None, got "
+                             f"{self.accelerometer!r}")
+        faults = tuple(self.faults)
+        if not all(isinstance(f, EncoderFault) for f in faults):
+            raise ValueError(f"faults must be EncoderFault objects, got {self.faults!r}")
+        axles = [f.axle for f in faults]
+        if len(set(axles)) != len(axles):
+            raise ValueError(f"faults: at most one fault per axle, got axles {axles}")
+        object.__setattr__(self, "faults", faults)
         if not isinstance(self.encoders, EncoderSettings):
             raise ValueError(f"encoders must be an EncoderSettings, got {self.encoders!r}")
         if self.external is not None and not isinstance(self.external, ExternalSpeedSettings):
@@ -411,11 +617,24 @@ class SensorModel:
                 0 <= self.seed < 2**64):
             raise ValueError(f"seed must be an integer in [0, 2**64), got {self.seed!r}")
 
-    def settings_record(self, n_axles: int | None = None) -> np.ndarray:
+    def settings_record(self, n_axles: int | None = None, *, gradient: float = 0.0,
+                        wheel_radius: float | None = None) -> np.ndarray:
         """The settings as a one-element structured array (for :func:`measure`).
 
         ``n_axles`` is needed when the diameter errors are given per axle (to check their
-        number); one number applies to every axle."""
+        number); one number applies to every axle. ``gradient`` (rise over run) is the track's,
+        for the accelerometer's gravity component; ``wheel_radius`` [m] is needed with a
+        ``diameter_drift`` (the distance rolled)."""
+        _check(gradient, "gradient", -0.1, 0.1)
+        if self.encoders.diameter_drift > 0.0:
+            if wheel_radius is None:
+                raise ValueError("wheel_radius is needed with a diameter_drift")
+            _check(wheel_radius, "wheel_radius", 0.0, 10.0, low_open=True)
+        if n_axles is not None:
+            for f in self.faults:
+                if f.axle > n_axles:
+                    raise ValueError(f"faults: axle {f.axle} does not exist (the vehicle has "
+                                     f"{n_axles} axles)")
         rec = np.zeros(1, SETTINGS_DTYPE)
         r = rec[0]
         e = self.encoders
@@ -438,7 +657,22 @@ class SensorModel:
             r["external_period"] = x.period
             r["external_min_speed"] = x.min_speed
             r["external_dropout"] = x.dropout_probability
+            r["external_scale_error"] = x.scale_error
+            if x.outage is not None:
+                r["external_outage_start"], r["external_outage_end"] = x.outage
         r["seed"] = np.uint64(self.seed)
+        r["encoder_dropout"] = e.dropout_probability
+        r["diameter_drift"] = e.diameter_drift / 1000.0  # per metre
+        r["wheel_radius"] = 0.0 if wheel_radius is None else wheel_radius
+        r["fault_start"][:] = math.inf
+        for f in self.faults:
+            r["fault_kind"][f.axle - 1] = FAULT_KINDS[f.kind]
+            r["fault_start"][f.axle - 1] = f.start
+        a = self.accelerometer
+        r["accel_on"] = a is not None
+        if a is not None:
+            r["accel_bias"], r["accel_noise"], r["accel_range"] = a.bias, a.noise, a.range
+        r["gradient"] = gradient
         return rec
 
     def state_record(self, n_axles: int) -> np.ndarray:
@@ -471,6 +705,9 @@ class SensorModel:
         d["external"] = None if self.external is None else {
             f.name: getattr(self.external, f.name) for f in fields(self.external)}
         d["seed"] = int(self.seed)
+        d["accelerometer"] = None if self.accelerometer is None else {
+            f.name: getattr(self.accelerometer, f.name) for f in fields(self.accelerometer)}
+        d["faults"] = [{"axle": f.axle, "kind": f.kind, "start": f.start} for f in self.faults]
         return d
 
 

@@ -2,8 +2,10 @@
 
 Equations (seed 002 §4, with the vehicle of :mod:`railadhesion.braking.vehicle`):
 
-* wheelset i: ``J dω_i/dt = R T_i − c p_i`` (eq. 6), brake torque only while the wheel turns
-  (a stopped wheel is held by static brake friction while ``R T_i ≤ c p_i``);
+* wheelset i: ``J dω_i/dt = R T_i − c p_i + τ_i`` (eq. 6 with a traction torque τ_i, the
+  input ``inputs.torque``, positive driving the wheel forward; 0 unless set), brake torque
+  only while the wheel turns (a stopped wheel is held by static brake friction while
+  ``R T_i + τ_i ≤ c p_i``);
 * train: ``M_tot dv/dt = −Σ T_i − F_res(v) − M_tot g sin(atan(gradient))``;
 * creep force ``T_i = μ_i(ξ_i, v) N_i`` with ``ξ_i = (v − ω_i R)/v`` and the axle load
   ``N_i`` of eqs. 11-12 at the current deceleration (taken from the previous step);
@@ -73,6 +75,7 @@ from railadhesion.braking.cylinders import APPLY, BrakeCylinders
 from railadhesion.braking.records import (
     BAD_COMMAND,
     BAD_DT,
+    BAD_TORQUE,
     BAD_VALVE,
     MAX_AXLES,
     NONFINITE,
@@ -185,20 +188,24 @@ class StepInputs:
     ``pressure_command`` (n,) float [Pa]: commanded brake-cylinder pressure per axle, in
     [0, inf); ``valves`` (n,) float: WSP valve state per axle, 0 apply, 1 hold, 2 vent (with
     ``BrakeCylinders(valves="bogie")`` the axles of a bogie follow the most severe state of
-    the bogie; ignored while the simulator's built-in WSP runs). Both are views of the
+    the bogie; ignored while the simulator's built-in WSP runs); ``torque`` (n,) float
+    [N m]: traction torque per axle, positive driving the wheel forward
+    (``J dω/dt = R T − c p + τ``), any finite value, default 0. All are views of the
     simulator's memory: write into them (``inputs.valves[2] = 2``,
-    ``inputs.pressure_command[:] = p``, or a data-acquisition driver's ``out=``); values
-    persist until overwritten and are checked at each step.
+    ``inputs.pressure_command[:] = p``, ``inputs.torque[:] = 4e3``, or a data-acquisition
+    driver's ``out=``); values persist until overwritten and are checked at each step.
     """
 
-    __slots__ = ("pressure_command", "valves")
+    __slots__ = ("pressure_command", "valves", "torque")
 
     def __init__(self, machine: np.ndarray, n: int):
         self.pressure_command = machine["inputs"]["pressure_command"][0, :n]
         self.valves = machine["inputs"]["valves"][0, :n]
+        self.torque = machine["inputs"]["torque"][0, :n]
 
     def __repr__(self) -> str:
-        return f"StepInputs(pressure_command={self.pressure_command}, valves={self.valves})"
+        return (f"StepInputs(pressure_command={self.pressure_command}, valves={self.valves}, "
+                f"torque={self.torque})")
 
 
 _FIXED = frozenset(("vehicle", "adhesion", "cylinders", "gradient", "refresh_period",
@@ -720,6 +727,9 @@ class BrakingSimulator:
         if status == BAD_VALVE:
             raise ValueError(f"valves must be 0 (apply), 1 (hold) or 2 (vent); axle {axle + 1} "
                              f"has {value!r}")
+        if status == BAD_TORQUE:
+            raise ValueError(f"torque must be a finite number [N m]; axle {axle + 1} has "
+                             f"{value!r}")
         if status == NONFINITE:
             self._fail(axle, f" (creep {value:.6g})")
         if status == STALE:
@@ -753,23 +763,27 @@ class BrakingSimulator:
         inputs : mapping, optional
             ``pressure_command`` [Pa]: commanded brake-cylinder pressure, a number or one per
             axle (default: the previous command, initially 0); ``valves``: WSP valve states
-            per axle (or per bogie), 0 apply, 1 hold, 2 vent (default: all apply).
+            per axle (or per bogie), 0 apply, 1 hold, 2 vent (default: all apply);
+            ``torque`` [N m]: traction torque, a number or one per axle (default: the previous
+            one, initially 0).
         """
         if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
             raise ValueError(f"dt must be in (0, inf) s, got {dt!r}")
-        cmd = valves = None
+        cmd = valves = torque = None
         if inputs:
             if not isinstance(inputs, Mapping):
-                raise ValueError(
-                    "inputs must be a mapping with 'pressure_command' and/or 'valves'")
-            unknown = set(inputs) - {"pressure_command", "valves"}
+                raise ValueError("inputs must be a mapping with 'pressure_command', 'valves' "
+                                 "and/or 'torque'")
+            unknown = set(inputs) - {"pressure_command", "valves", "torque"}
             if unknown:
                 raise ValueError(f"unknown input(s) {sorted(unknown)}; allowed: "
-                                 "pressure_command, valves")
+                                 "pressure_command, valves, torque")
             cmd = inputs.get("pressure_command")
             valves = inputs.get("valves")
+            torque = inputs.get("torque")
         elif inputs is not None and not isinstance(inputs, Mapping):
-            raise ValueError("inputs must be a mapping with 'pressure_command' and/or 'valves'")
+            raise ValueError("inputs must be a mapping with 'pressure_command', 'valves' and/or "
+                             "'torque'")
         n = self._n
         u = self._inputs
         # values are checked by the step itself (errors name the axle)
@@ -779,6 +793,12 @@ class BrakingSimulator:
             except (ValueError, TypeError):
                 raise ValueError(f"pressure_command must be a number or {n} numbers in "
                                  f"[0, inf) Pa, got {cmd!r}") from None
+        if torque is not None:
+            try:
+                u.torque[:] = torque
+            except (ValueError, TypeError):
+                raise ValueError(f"torque must be a number or {n} finite numbers [N m], got "
+                                 f"{torque!r}") from None
         if valves is None:
             u.valves.fill(APPLY)
         else:

@@ -14,9 +14,11 @@ family at compile time (0: built-in, a first-class function: a user's compiled l
 a model in Python; :mod:`railadhesion.braking.curves`). It returns a status code (``OK``,
 ``STOPPED``: the train is at rest and nothing was done, ``NONFINITE``: the adhesion model
 gave a non-finite value, ``state.error_axle``/``error_value`` say where; ``BAD_DT``,
-``BAD_COMMAND``, ``BAD_VALVE``: an input is invalid, ``state.error_axle``/``error_value``
-name it, nothing was done; ``ROWS_FULL``: the history block is full, nothing was done). It
-raises nothing and allocates nothing.
+``BAD_COMMAND``, ``BAD_VALVE``, ``BAD_TORQUE``: an input is invalid,
+``state.error_axle``/``error_value`` name it, nothing was done; ``ROWS_FULL``: the history
+block is full, nothing was done). It raises nothing and allocates nothing. The inputs: the
+commanded pressure, the valve states and a traction torque per axle (``J dω/dt = R T − c p
++ τ``, positive driving the wheel forward).
 
 Each step: the valves (from ``inputs``, or from the built-in WSP every control period, with
 the sensor model between), the brake cylinders, then backward Euler for the wheels and the
@@ -47,6 +49,7 @@ from railadhesion.braking.demand import demanded_pressure
 from railadhesion.braking.records import (
     BAD_COMMAND,
     BAD_DT,
+    BAD_TORQUE,
     BAD_VALVE,
     NEWTON_MAX,
     NONFINITE,
@@ -118,7 +121,7 @@ def _refresh(s, st, tables, aux):
 
 
 @njit(cache=True, error_model="numpy")
-def _newton(s, st, tables, aux, v0, dt, external, r_pred):
+def _newton(s, st, u, tables, aux, v0, dt, external, r_pred):
     """Backward Euler by Newton on the (n + 1) arrow system (wheels and train), from the
     extrapolated previous step; wheels at rest held by static brake friction (active set).
     Returns the new train speed (> 0), or -1.0 if the safeguarded solve must take over.
@@ -168,7 +171,8 @@ def _newton(s, st, tables, aux, v0, dt, external, r_pred):
             if s.held[i] != 0:
                 continue
             rn = radius * load
-            g = j_dt * (s.trial_omega[i] - s.omega[i]) - rn * mu + brake * s.mean_pressure[i]
+            g = (j_dt * (s.trial_omega[i] - s.omega[i]) - rn * mu + brake * s.mean_pressure[i]
+                 - u.torque[i])
             a = j_dt + rn * dmu * radius * iv
             b = -rn * (dmu * dsdv + dmv)
             cc = -load * dmu * radius * iv
@@ -190,7 +194,7 @@ def _newton(s, st, tables, aux, v0, dt, external, r_pred):
             if s.held[i] != 0:
                 s.update[i] = 0.0
                 static = (-j_dt * s.omega[i] - radius * s.load[i] * c.mu[i]
-                          + brake * s.mean_pressure[i])
+                          + brake * s.mean_pressure[i] - u.torque[i])
                 if static < 0.0:  # brake friction cannot hold the wheel: it turns
                     s.held[i] = 0
                     changed = True
@@ -218,7 +222,7 @@ def _newton(s, st, tables, aux, v0, dt, external, r_pred):
 
 
 @njit(cache=True, error_model="numpy")
-def _solve_wheels(s, st, tables, aux, v, dt):
+def _solve_wheels(s, st, u, tables, aux, v, dt):
     """Every wheel's implicit equation for a trial train speed v >= 0: Newton kept inside a
     bracket (bisection); a wheel whose equation has no root with ω >= 0 is held at rest.
     ``s.trial_omega`` is the guess on entry and the wheel speeds on exit, ``s.curve.mu``
@@ -238,11 +242,12 @@ def _solve_wheels(s, st, tables, aux, v, dt):
             return i
     for i in range(n):
         rn = radius * s.load[i]
-        held = (-inertia * s.omega[i] / dt - rn * c.mu[i] + brake * s.mean_pressure[i]) >= 0.0
+        held = (-inertia * s.omega[i] / dt - rn * c.mu[i] + brake * s.mean_pressure[i]
+                - u.torque[i]) >= 0.0
         s.held[i] = 1 if held else 0
         s.searching[i] = 0 if held else 1
         s.lower[i] = 0.0
-        hi = s.omega[i] + dt * rn * 2.0 / inertia + 1e-9
+        hi = s.omega[i] + dt * (rn * 2.0 + max(u.torque[i], 0.0)) / inertia + 1e-9
         s.upper[i] = hi
         s.trial_omega[i] = min(max(s.trial_omega[i], 0.0), hi)
     for _ in range(100):
@@ -256,7 +261,8 @@ def _solve_wheels(s, st, tables, aux, v, dt):
         for i in range(n):
             rn = radius * s.load[i]
             w = s.trial_omega[i]
-            g = inertia * (w - s.omega[i]) / dt - rn * c.mu[i] + brake * s.mean_pressure[i]
+            g = (inertia * (w - s.omega[i]) / dt - rn * c.mu[i] + brake * s.mean_pressure[i]
+                 - u.torque[i])
             dg = inertia / dt + rn * c.dmu[i] * radius / ve
             step = g / dg
             converged = dg > 0.0 and abs(step) * radius < tol
@@ -292,7 +298,7 @@ def _solve_wheels(s, st, tables, aux, v, dt):
 
 
 @njit(cache=True, error_model="numpy")
-def _safeguarded(s, st, tables, aux, v0, dt, external):
+def _safeguarded(s, st, u, tables, aux, v0, dt, external):
     """Backward Euler by the nested safeguarded solve: secant steps on the train speed v >= 0
     around :func:`_solve_wheels`, to ``SAFEGUARD_TOL``. Returns (v, failed axle or -1); v is
     0.0 when the train comes to rest within the step (the forces at v -> 0+ stop it)."""
@@ -305,7 +311,7 @@ def _safeguarded(s, st, tables, aux, v0, dt, external):
     v_prev = v
     r_prev = 0.0
     for it in range(30):
-        bad = _solve_wheels(s, st, tables, aux, v, dt)
+        bad = _solve_wheels(s, st, u, tables, aux, v, dt)
         if bad >= 0:
             s.error_value = c.creep[bad]
             return v, bad
@@ -389,11 +395,11 @@ def _substep(s, st, u, tables, rows, dt, aux):
         resistance = st.davis_a + st.davis_b * v0 + st.davis_c * v0 * v0
     external = resistance + st.gradient_force
     r_pred = dt / s.previous_step if s.previous_step > 0.0 else 0.0
-    v = _newton(s, st, tables, aux, v0, dt, external, r_pred)
+    v = _newton(s, st, u, tables, aux, v0, dt, external, r_pred)
     rest_time = -1.0
     if v < 0.0:
         s.safeguarded_steps += 1
-        v, bad = _safeguarded(s, st, tables, aux, v0, dt, external)
+        v, bad = _safeguarded(s, st, u, tables, aux, v0, dt, external)
         if bad >= 0:
             s.error_axle = bad
             return NONFINITE
@@ -403,7 +409,7 @@ def _substep(s, st, u, tables, rows, dt, aux):
     wb = 0.0
     wc = 0.0
     for i in range(n):
-        wb += brake * s.mean_pressure[i] * s.trial_omega[i] * dt
+        wb += (brake * s.mean_pressure[i] - u.torque[i]) * s.trial_omega[i] * dt
         wc += c.mu[i] * s.load[i] * (v - s.trial_omega[i] * radius) * dt
     s.brake_work += wb
     s.creep_work += wc
@@ -516,6 +522,11 @@ def step(s, st, u, wsp_settings, wsp_state, sensor_settings, sensor_state, table
             s.error_axle = i
             s.error_value = valve
             return BAD_VALVE
+        torque = u.torque[i]
+        if not (torque > -math.inf and torque < math.inf):
+            s.error_axle = i
+            s.error_value = torque
+            return BAD_TORQUE
     nsub = max(1, int(math.ceil(dt / st.max_step - 1e-9)))
     if rows is not None and s.rows_written + nsub > rows.shape[0]:
         return ROWS_FULL

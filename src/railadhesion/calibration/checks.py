@@ -21,14 +21,16 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from railadhesion.models.regression import ParameterRegression, design_matrix
+from railadhesion.plausibility import UntrustedResultWarning
 
 __all__ = ["CalibrationWarning", "ConditionCheck", "check_condition", "refine_condition"]
 
 _NAMES = ("k_A", "k_S", "mu0", "A", "B")
 
 
-class CalibrationWarning(UserWarning):
-    """A calibrated parameter set that should not be trusted somewhere in its range."""
+class CalibrationWarning(UntrustedResultWarning):
+    """A calibrated parameter set that should not be trusted somewhere in its range (an
+    :class:`~railadhesion.plausibility.UntrustedResultWarning`)."""
 
 
 @dataclass(frozen=True, eq=False)

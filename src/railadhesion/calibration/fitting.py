@@ -19,6 +19,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from railadhesion._validate import check_finite, check_nonnegative, check_positive, check_range
+from railadhesion.plausibility import UntrustedResultWarning, fit_warnings, warn
 
 __all__ = [
     "FLETCHER_DEFAULT_BOUNDS",
@@ -44,6 +45,9 @@ POLACH_DEFAULT_BOUNDS: dict[str, tuple[float, float]] = {
 _POLACH_FIXED_DEFAULTS = {"k_A": 1.0, "k_S": 1.0, "A": 1.0, "B": 0.0}
 #: Domain of each Polach parameter in the model: True if it must be > 0, False if >= 0.
 _POLACH_POSITIVE = {"k_A": True, "k_S": True, "mu0": True, "A": False, "B": False}
+#: Bounds of the search that are limits of the model itself (a fitted value there is a
+#: legitimate one: no slope reduction, constant or vanishing friction at large slip).
+_POLACH_DOMAIN = {"k_A": (1.0,), "k_S": (1.0,), "A": (0.0, 1.0), "B": (0.0,)}
 
 FLETCHER_NAMES = ("k_a", "k_s", "mu")
 #: Fletcher's k_a, k_s and mu must all be > 0 in a fit (the model divides by k_s mu).
@@ -97,6 +101,13 @@ class FitResult:
         Fitted parameters that ended on a bound.
     nfev : int
         Number of model evaluations (all starts together).
+    warnings : tuple of str
+        Why the fit should not be trusted (empty if nothing was found): the quality gate
+        :func:`railadhesion.plausibility.fit_warnings` (low R², a parameter on a bound of the
+        search that is not a limit of the model, non-finite or very large standard errors, too
+        few points where a parameter shows; ``docs/checks.md``).
+    trusted : bool
+        ``not warnings``.
     """
 
     model: str
@@ -115,7 +126,13 @@ class FitResult:
     conditions: dict
     at_bound: tuple[str, ...] = ()
     nfev: int = 0
+    warnings: tuple[str, ...] = ()
     _predict: Callable | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def trusted(self) -> bool:
+        """True when the quality gate found nothing (:attr:`warnings` is empty)."""
+        return not self.warnings
 
     def predict(self, creep=None):
         """Model adhesion |T|/Q at ``creep`` (default: the fitted data's creep).
@@ -145,6 +162,9 @@ class FitResult:
                 f"fit_polach to {self.n_points} points, R^2 = {self.r_squared:.4f}, "
                 f"RMSE = {self.rmse:.4g}; fitted: {', '.join(self.fitted)}"
             )
+        if self.warnings:  # a file written from it carries them (its provenance)
+            flags = "NOT TRUSTED: " + "; ".join(self.warnings)
+            notes = f"{notes} {flags}".strip() if flags not in notes else notes
         return PolachParameters(**self.params, name=name, source=source, notes=notes)
 
     def to_dataframe(self):
@@ -169,6 +189,8 @@ class FitResult:
                 "stderr": dict(self.stderr),
                 "r_squared": self.r_squared,
                 "rmse": self.rmse,
+                "trusted": self.trusted,
+                "warnings": list(self.warnings),
                 "units": {"creep": "1", "adhesion": "1", "model": "1", "residual": "1",
                           "B": "s/m"},
             }
@@ -190,6 +212,9 @@ class FitResult:
             else:
                 lines.append(f"  {name:>4} = {value:.6g} (fixed)")
         lines.append(f"  {self.message}")
+        if self.warnings:
+            lines.append(f"  NOT TRUSTED ({len(self.warnings)} finding(s) of the quality gate):")
+            lines.extend(f"    ! {w}" for w in self.warnings)
         return "\n".join(lines)
 
     def __str__(self) -> str:
@@ -308,8 +333,18 @@ def _through_origin_slope(x: np.ndarray, y: np.ndarray) -> float | None:
     return float(np.sum(x[sel] * y[sel]) / np.sum(x[sel] ** 2))
 
 
-def _run_fit(model_name, names, residual, starts, lo, hi, fitted, fixed, s, y, conditions, predict):
-    """Least squares from each start; keep the lowest cost; build the FitResult."""
+def _run_fit(model_name, names, residual, starts, lo, hi, fitted, fixed, s, y, conditions, predict,
+             *, domain, gate=None, warn_untrusted=True):  # fmt: skip
+    """Least squares from each start; keep the lowest cost; build the FitResult.
+
+    ``domain``: ``{name: (low, high)}`` limits of each parameter in the model (a parameter
+    ending on a bound of the search equal to one of them is a legitimate value, e.g.
+    ``k_A = 1``; on any other bound the data push it out of the search: not trusted).
+    ``gate(params)``: extra arguments of :func:`~railadhesion.plausibility.fit_warnings`
+    (``region_points``, ``ignore_stderr``) for the fitted values. ``warn_untrusted``: issue
+    an :class:`~railadhesion.plausibility.UntrustedResultWarning` when the gate finds
+    anything.
+    """
 
     def solve(x0, max_nfev):
         return least_squares(
@@ -368,6 +403,16 @@ def _run_fit(model_name, names, residual, starts, lo, hi, fitted, fixed, s, y, c
     values = {**fixed, **{name: float(v) for name, v in zip(fitted, x, strict=True)}}
     params = {name: values[name] for name in names}
     message = best.message.rstrip(".") + ("; " + "; ".join(notes) if notes else "")
+    outside = tuple(
+        name for i, name in enumerate(fitted) if name in at_bound
+        and not any(abs(x[i] - lim) <= 1e-6 * span[i] for lim in domain.get(name, ()))
+    )  # fmt: skip
+    flags = fit_warnings(
+        r_squared=float(r2), params=params, fitted=fitted, stderr=stderr, at_bound=outside,
+        success=bool(best.success), **(gate(params) if gate is not None else {}),
+    )  # fmt: skip
+    if flags and warn_untrusted:
+        warn(f"{model_name} fit not trusted: " + "; ".join(flags), UntrustedResultWarning)
     return FitResult(
         model=model_name,
         params=params,
@@ -385,6 +430,7 @@ def _run_fit(model_name, names, residual, starts, lo, hi, fitted, fixed, s, y, c
         conditions=conditions,
         at_bound=at_bound,
         nfev=int(nfev),
+        warnings=flags,
         _predict=lambda c: predict(c, params),
     )
 
@@ -408,6 +454,7 @@ def fit_polach(
     spin=0.0,
     shear_modulus=8.2e10,
     poisson=0.28,
+    warn_untrusted: bool = True,
 ) -> FitResult:
     """Fit parameters of Polach's creep-force model to a measured creep curve.
 
@@ -441,11 +488,15 @@ def fit_polach(
         Combined shear modulus G [Pa].
     poisson : float, default 0.28
         Combined Poisson's ratio [-].
+    warn_untrusted : bool, default True
+        Issue an :class:`~railadhesion.plausibility.UntrustedResultWarning` when the quality
+        gate flags the fit (its findings are in ``warnings`` either way).
 
     Returns
     -------
     FitResult
-        ``params`` (all five), ``stderr`` of the fitted ones, residuals, R², RMSE;
+        ``params`` (all five), ``stderr`` of the fitted ones, residuals, R², RMSE, and the
+        quality gate's ``trusted`` and ``warnings`` (see Notes);
         :meth:`FitResult.as_polach_parameters` gives a validated parameter set.
 
     Raises
@@ -466,11 +517,18 @@ def fit_polach(
     origin on the points before the peak and below 0.6 x the peak) to Kalker's, since
     Polach's slope at small creep is (k_A + k_S)/2 times Kalker's (Polach 2005). The fit is
     started from a few variants (k_A above/at k_S with B = 1/w_max and 5/w_max, w_max the
-    largest slip velocity |xi|V; and four fixed (k_A, k_S) pairs from (1, 1) to
-    (0.05, 0.02)) and the lowest cost is kept. Standard errors: ``sqrt(diag(s² (JᵀJ)⁻¹))``,
+    largest slip velocity |xi|V; and six fixed (k_A, k_S) pairs from (1, 1) to
+    (0.05, 0.005)) and the lowest cost is kept. Standard errors: ``sqrt(diag(s² (JᵀJ)⁻¹))``,
     s² = SSR/(n - p), the Jacobian at the solution (as :func:`scipy.optimize.curve_fit`);
     they are unreliable for a parameter at a bound. With B = 0 (or A = 1) the other of the
     pair is not identifiable.
+
+    Quality gate (:func:`railadhesion.plausibility.fit_warnings`, ``docs/checks.md``): the
+    fit is not trusted if R² < 0.9, a fitted parameter ends on a bound of the search that is
+    not a limit of the model (k_A = 1, k_S = 1, A = 0 or 1 and B = 0 are legitimate values),
+    a standard error is not finite or larger than its value, or fewer than 3 points lie
+    where a parameter shows: k_A, k_S on the rising part (below the peak), A and B beyond
+    the peak (not required when the fitted friction falls by less than 1 % over the data).
 
     References
     ----------
@@ -483,7 +541,7 @@ def fit_polach(
 
     >>> import numpy as np
     >>> from railadhesion.models.polach import polach_forces
-    >>> creep = -np.linspace(0.001, 0.3, 40)
+    >>> creep = -np.geomspace(0.001, 0.3, 40)
     >>> true = dict(k_A=0.6, k_S=0.2, mu0=0.4, A=0.4, B=0.5)
     >>> fx, _ = polach_forces(creep, 0.0, 0.0, 4200.0, 5.0, 4e-3, 3e-3, **true)
     >>> res = fit_polach(creep, fx / 4200.0, normal_force=4200.0, speed=5.0, a=4e-3, b=3e-3)
@@ -565,7 +623,9 @@ def fit_polach(
     b_starts = [1.0 / w_max, 5.0 / w_max] if w_max > 0 else [b_lo]
     # Data-driven slope pairs with two B values, plus a fixed spread of slopes (for curves
     # whose first points are already past the k_A hump, or have no rising part at all).
-    spread = [(1.0, 1.0), (1.0, 0.2), (0.3, 0.1), (0.05, 0.02)]
+    # k_S down to a tenth of k_A: a curve still rising at its largest creep (a small k_S)
+    # has a second minimum near k_S/k_A ~ 0.3 that starts above it do not leave.
+    spread = [(1.0, 1.0), (1.0, 0.2), (0.3, 0.1), (0.3, 0.03), (0.05, 0.02), (0.05, 0.005)]
     variants = [(1.5 * k_mean, 0.5 * k_mean, b0) for b0 in b_starts] if k_mean else []
     variants += [(k_mean, k_mean, b_starts[0])] if k_mean else []
     variants += [(ka, ks, b_starts[-1]) for ka, ks in spread]
@@ -582,8 +642,26 @@ def fit_polach(
         "shear_modulus": g, "poisson": nu,
     }  # fmt: skip
     conditions = {k: (float(x) if np.ndim(x) == 0 else x) for k, x in conditions.items()}
+
+    def gate(params):
+        # the fall of the friction over the data: A and B matter only if it shows
+        fall = (1.0 - params["A"]) * -np.expm1(-params["B"] * w_max)
+        quiet = ("A", "B") if abs(fall) < 0.01 else ()
+        if per_point:  # several curves at once: no single peak to split the data at
+            return {"ignore_stderr": quiet}
+        k = int(np.argmax(y))
+        rising = int(np.count_nonzero((mag > 0) & (mag < mag[k]) & (y < 0.9 * y[k])))
+        beyond = int(np.count_nonzero(mag > mag[k]))
+        regions = {"k_A": (rising, "on the rising part of the curve (below the peak)"),
+                   "k_S": (rising, "on the rising part of the curve (below the peak)")}
+        if not quiet:
+            regions.update({n: (beyond, "beyond the peak (where the friction falls)")
+                            for n in ("A", "B")})  # fmt: skip
+        return {"region_points": regions, "ignore_stderr": quiet}
+
     return _run_fit(
-        "polach", POLACH_NAMES, residual, starts, lo, hi, fitted, fixed, s, y, conditions, model
+        "polach", POLACH_NAMES, residual, starts, lo, hi, fitted, fixed, s, y, conditions, model,
+        domain=_POLACH_DOMAIN, gate=gate, warn_untrusted=warn_untrusted,
     )
 
 
@@ -601,6 +679,7 @@ def fit_fletcher(
     mu=None,
     initial=None,
     bounds: Mapping | None = None,
+    warn_untrusted: bool = True,
 ) -> FitResult:
     """Fit Fletcher's (2013) 2D reduction factors k_a, k_s (and/or mu) to twin-disc data.
 
@@ -627,11 +706,17 @@ def fit_fletcher(
     bounds : mapping of str to (low, high), optional
         Overrides :data:`FLETCHER_DEFAULT_BOUNDS` (k_a in [1e-4, 5], k_s in [1e-4, 2],
         mu in [1e-4, 1.5]).
+    warn_untrusted : bool, default True
+        Issue an :class:`~railadhesion.plausibility.UntrustedResultWarning` when the quality
+        gate flags the fit (its findings are in ``warnings`` either way).
 
     Returns
     -------
     FitResult
-        With ``model == "fletcher"`` and ``params`` k_a, k_s, mu.
+        With ``model == "fletcher"`` and ``params`` k_a, k_s, mu; ``trusted`` and ``warnings``
+        of the quality gate: as :func:`fit_polach` (no bound of the search is a limit of the
+        model), with k_a carried by the points below the creep of full slip and k_s or mu by
+        the points from half that creep on.
 
     Notes
     -----
@@ -712,6 +797,19 @@ def fit_fletcher(
     lo = np.array([bnd[n][0] for n in fitted])
     hi = np.array([bnd[n][1] for n in fitted])
     conditions = {"half_width": a, "radius": r}
+
+    def gate(params):
+        # creep of full slip of the fitted curve (eqs. (8)-(12): c = 0)
+        sat = 3.0 * a * params["k_s"] * params["mu"] / (2.0 * params["k_a"] * r)
+        below = int(np.count_nonzero((mag > 0) & (mag < sat)))
+        bend = int(np.count_nonzero(mag >= 0.5 * sat))
+        return {"region_points": {
+            "k_a": (below, f"below the creep of full slip ({sat * 100:.3g} %)"),
+            "k_s": (bend, f"from half the creep of full slip ({sat * 50:.3g} %) on"),
+            "mu": (bend, f"from half the creep of full slip ({sat * 50:.3g} %) on"),
+        }}  # fmt: skip
+
     return _run_fit(
-        "fletcher", FLETCHER_NAMES, residual, starts, lo, hi, fitted, fixed, s, y, conditions, model
+        "fletcher", FLETCHER_NAMES, residual, starts, lo, hi, fitted, fixed, s, y, conditions,
+        model, domain={}, gate=gate, warn_untrusted=warn_untrusted,
     )

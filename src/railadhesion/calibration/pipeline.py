@@ -47,6 +47,7 @@ from railadhesion.calibration.fitting import POLACH_NAMES, FitResult, fit_polach
 from railadhesion.calibration.regression import RegressionFit, build_regression
 from railadhesion.io.creepcurves import CreepCurve, read_creep_curves
 from railadhesion.models.regression import ParameterRegression
+from railadhesion.plausibility import MIN_R_SQUARED
 
 __all__ = [
     "CalibrationWarning",
@@ -179,7 +180,9 @@ class WilacCalibration:
     checks : dict of str to ConditionCheck
         The check of each condition on a grid between the data points.
     warnings : tuple of str
-        Every problem found; empty when the set can be trusted over its calibrated range.
+        Every problem found: the checks between the data points, and curves whose own Polach
+        fit has R² below :data:`railadhesion.plausibility.MIN_R_SQUARED` (the model does not
+        describe them); empty when the set can be trusted over its calibrated range.
     """
 
     parameters: object
@@ -542,7 +545,7 @@ def run_wilac_calibration(
             res = fit_polach(
                 curve.creep, curve.adhesion, normal_force=curve.normal_force, speed=curve.speed,
                 a=a, b=b, fit=fit, initial=init, bounds=bounds, shear_modulus=shear_modulus,
-                poisson=poisson,
+                poisson=poisson, warn_untrusted=False,
             )  # fmt: skip
         except ValueError as exc:  # name the curve: the fit's message does not know it
             raise ValueError(
@@ -658,6 +661,13 @@ def run_wilac_calibration(
         )  # fmt: skip
         report("check", k_cond + 1, len(WILAC_CONDITIONS))
     problems = tuple(msg for chk in checks.values() for msg in chk.problems)
+    # curves the Polach model does not describe: their parameters entered the regressions
+    problems += tuple(
+        f"curve {cf.curve.name or Path(cf.curve.source).name} ({cf.condition}): its own Polach "
+        f"fit has R^2 = {cf.fit.r_squared:.3g} < {MIN_R_SQUARED:g}"
+        + ("" if cf.fit.success else ", not converged")
+        for cf in curve_fits if not (cf.fit.r_squared >= MIN_R_SQUARED and cf.fit.success)
+    )  # fmt: skip
     if problems:
         warnings.warn(
             CalibrationWarning(
@@ -667,6 +677,11 @@ def run_wilac_calibration(
             ),
             stacklevel=2,
         )
+    if problems:  # the file written from the set carries them (its provenance)
+        prov = dict(params.provenance)
+        prov["notes"] = (prov.get("notes", "") + " NOT TRUSTED (railadhesion's checks): "
+                         + "; ".join(problems)).strip()  # fmt: skip
+        params = params.replace(provenance=prov)
     return WilacCalibration(params, tuple(checked), regressions, checks, problems)
 
 

@@ -45,6 +45,7 @@ from railadhesion._validate import (
     check_positive,
     check_range,
 )
+from railadhesion.plausibility import input_checker
 
 __all__ = [
     "ExactResult",
@@ -799,6 +800,11 @@ def _discrete_shape(aob: float, nu: float, nx: int, ny: int, scale: float) -> np
     return shp
 
 
+#: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
+_PLAUSIBLE = input_checker(("creep_long", "creep_lat", "spin", "normal_force", "a", "b",
+                            "shear_modulus", "poisson", "speed"))
+
+
 def exact_rolling(
     creep_long,
     creep_lat,
@@ -1034,6 +1040,7 @@ def exact_rolling(
             "state": state.reshape(*shape, ny, nx),
             "mu_local": mu_all.reshape(*shape, ny, nx),
         }
+    _PLAUSIBLE((xi, eta, phi, fz, a_, b_, g_mod, nu, speed))  # implausible inputs warn
     return ExactResult(
         shaped(out_f[:, 0]),
         shaped(out_f[:, 1]),

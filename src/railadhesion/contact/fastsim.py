@@ -48,6 +48,7 @@ from railadhesion.contact.kalker import (
     axis_ratio,
     kalker_coefficients,
 )
+from railadhesion.plausibility import input_checker
 
 __all__ = ["FastsimResult", "fastsim"]
 
@@ -192,6 +193,11 @@ def _flexibilities(a, b, xi, eta, phi, normal_force, mu, g_mod, nu, blended):
         (1.0 - w) * l2 + w * l_crss,
         (1.0 - w) * l3 + w * l_crss,
     )
+
+
+#: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
+_PLAUSIBLE = input_checker(("creep_long", "creep_lat", "spin", "normal_force", "a", "b", "mu",
+                            "shear_modulus", "poisson"))
 
 
 @labelled(units=FASTSIM_UNITS)
@@ -371,6 +377,7 @@ def fastsim(
         if values is not None:
             out = _fastsim_scalar(*values, nx, ny, bound, flexibility)
             if out is not None:
+                _PLAUSIBLE(values)  # implausible inputs warn (docs/checks.md)
                 return out
     xi = check_finite(creep_long, "creep_long")
     eta = check_finite(creep_lat, "creep_lat")
@@ -406,6 +413,7 @@ def fastsim(
             a_, b_, xi, eta, phi, fz, mu_, g_mod, nu, flexibility == "blended"
         )
 
+    _PLAUSIBLE(args[:9])  # implausible inputs warn (docs/checks.md); errors were raised above
     if not return_tractions:  # the compiled march (same numbers as the NumPy one below)
         from railadhesion.contact import _fastsim_kernels as kern
 

@@ -10,9 +10,17 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from railadhesion._validate import check_positive
 
-__all__ = ["NAMED_GEOMETRIES", "WILAC_GEOMETRIES", "contact_semi_axes", "geometry_description"]
+__all__ = [
+    "NAMED_GEOMETRIES",
+    "WILAC_GEOMETRIES",
+    "check_geometry",
+    "contact_semi_axes",
+    "geometry_description",
+]
 
 #: Named wheel–rail (or wheel–roller) geometries (WILAC figures, CLI, tests), as the radii
 #: of :func:`railadhesion.contact.hertz.hertz_3d` [m] (steel, E = 210 GPa, ν = 0.28).
@@ -41,7 +49,29 @@ NAMED_GEOMETRIES: dict[str, dict[str, float]] = {
 WILAC_GEOMETRIES = NAMED_GEOMETRIES
 
 
-def contact_semi_axes(geometry, normal_force) -> tuple[float, float]:
+def check_geometry(geometry):
+    """``geometry`` validated: a key of :data:`NAMED_GEOMETRIES` (returned as is) or semi-axes
+    ``(a, b)`` [m], finite and > 0 (returned as a tuple of floats).
+
+    Examples
+    --------
+    >>> check_geometry("tram"), check_geometry([4e-3, 6e-3])
+    ('tram', (0.004, 0.006))
+    """
+    if isinstance(geometry, str):
+        if geometry not in NAMED_GEOMETRIES:
+            raise _geometry_error(geometry)
+        return geometry
+    try:
+        a, b = (float(x) for x in geometry)
+    except (TypeError, ValueError) as exc:
+        raise _geometry_error(geometry) from exc
+    if not (math.isfinite(a) and math.isfinite(b) and a > 0 and b > 0):
+        raise ValueError(f"geometry: semi-axes a, b must be finite and > 0 m, got [{a}, {b}]")
+    return a, b
+
+
+def contact_semi_axes(geometry, normal_force):
     """Semi-axes ``(a, b)`` [m] of a named geometry at a normal force, or ``geometry`` itself.
 
     Parameters
@@ -50,13 +80,14 @@ def contact_semi_axes(geometry, normal_force) -> tuple[float, float]:
         A key of :data:`NAMED_GEOMETRIES` (Hertz contact via
         :func:`railadhesion.contact.hertz.hertz_3d`), or the semi-axes ``(a, b)`` [m] along the
         rolling direction and laterally.
-    normal_force : float
+    normal_force : float or array_like
         Normal force Q [N], > 0.
 
     Returns
     -------
-    (float, float)
-        ``a`` (rolling direction) and ``b`` (lateral) [m].
+    (float, float) or (ndarray, ndarray)
+        ``a`` (rolling direction) and ``b`` (lateral) [m]: floats for a scalar normal force or
+        given semi-axes, arrays shaped as ``normal_force`` for a named geometry otherwise.
 
     Examples
     --------
@@ -64,35 +95,30 @@ def contact_semi_axes(geometry, normal_force) -> tuple[float, float]:
     >>> round(a * 1e3, 2), round(b * 1e3, 2)
     (1.41, 3.15)
     """
-    q = float(check_positive(normal_force, "normal_force"))
-    if isinstance(geometry, str):
-        if geometry not in NAMED_GEOMETRIES:
-            raise _geometry_error(geometry)
-        from railadhesion.contact.hertz import hertz_3d
+    q = check_positive(normal_force, "normal_force")
+    geometry = check_geometry(geometry)
+    if not isinstance(geometry, str):
+        return geometry
+    from railadhesion.contact.hertz import hertz_3d
 
-        g = NAMED_GEOMETRIES[geometry]
-        contact = hertz_3d(
-            q,
-            g["wheel_radius"],
-            g["wheel_lateral_radius"],
-            g["rail_lateral_radius"],
-            g["rail_radius"],
-            young=2.1e11,
-            poisson=0.28,
-        )
+    g = NAMED_GEOMETRIES[geometry]
+    contact = hertz_3d(
+        q,
+        g["wheel_radius"],
+        g["wheel_lateral_radius"],
+        g["rail_lateral_radius"],
+        g["rail_radius"],
+        young=2.1e11,
+        poisson=0.28,
+    )
+    if np.ndim(q) == 0:
         return float(contact.a), float(contact.b)
-    try:
-        a, b = (float(x) for x in geometry)
-    except (TypeError, ValueError) as exc:
-        raise _geometry_error(geometry) from exc
-    check_positive(a, "geometry a")
-    check_positive(b, "geometry b")
-    return a, b
+    return np.asarray(contact.a), np.asarray(contact.b)
 
 
 def _geometry_error(geometry) -> ValueError:
     return ValueError(
-        f"geometry must be one of {sorted(NAMED_GEOMETRIES)} or an (a, b) pair in m, "
+        f"geometry: expected one of {sorted(NAMED_GEOMETRIES)} or an (a, b) pair in m, "
         f"got {geometry!r}"
     )
 

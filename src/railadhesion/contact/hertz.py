@@ -19,6 +19,7 @@ from scipy.special import ellipe, ellipkm1
 
 from railadhesion._labelled import HERTZ_UNITS, LINE_UNITS, labelled
 from railadhesion._validate import as_float_array, check_positive, check_range
+from railadhesion.plausibility import check_plausible, input_checker
 
 __all__ = [
     "HertzContact",
@@ -115,6 +116,11 @@ class LineContact:
     effective_modulus: float | np.ndarray
 
 
+#: Plausibility checks of the inputs (:func:`railadhesion.plausibility.input_checker`).
+_PLAUSIBLE_MATERIAL = input_checker(("young", "poisson", "young_rail", "poisson_rail"))
+_PLAUSIBLE_3D = input_checker(("normal_force", "wheel_radius"))
+
+
 @labelled(units=("Pa", "Pa", "1"))
 def combined_elastic_constants(young, poisson, young_rail=None, poisson_rail=None):
     """Effective modulus E*, combined shear modulus G and Poisson's ratio nu of two bodies.
@@ -158,6 +164,7 @@ def combined_elastic_constants(young, poisson, young_rail=None, poisson_rail=Non
     nu2 = nu1 if poisson_rail is None else check_range(poisson_rail, "poisson_rail", 0.0, 0.5)
     if e1.ndim == 0 and nu1.ndim == 0 and e2.ndim == 0 and nu2.ndim == 0:
         e1, nu1, e2, nu2 = float(e1), float(nu1), float(e2), float(nu2)  # cheap scalar path
+    _PLAUSIBLE_MATERIAL((e1, nu1, young_rail, poisson_rail))  # implausible inputs warn
     e_star = 1.0 / ((1.0 - nu1**2) / e1 + (1.0 - nu2**2) / e2)
     g1 = e1 / (2.0 * (1.0 + nu1))
     g2 = e2 / (2.0 * (1.0 + nu2))
@@ -313,7 +320,9 @@ def hertz_3d_from_curvatures(
     q = check_positive(normal_force, "normal_force")
     ca = check_positive(curvature_A, "curvature_A")
     cb = check_positive(curvature_B, "curvature_B")
-    return _hertz_core(q, ca, cb, young, poisson, young_rail, poisson_rail)
+    out = _hertz_core(q, ca, cb, young, poisson, young_rail, poisson_rail)
+    _PLAUSIBLE_3D((q, None))  # implausible inputs warn (docs/checks.md)
+    return out
 
 
 def _hertz_core(q, ca, cb, young, poisson, young_rail, poisson_rail) -> HertzContact:
@@ -467,7 +476,9 @@ def hertz_3d(
             "|wheel_lateral_radius| > rail_lateral_radius, got "
             f"B = {np.asarray(cb).ravel()[:3].tolist()} 1/m"
         )
-    return _hertz_core(q, np.asarray(ca), np.asarray(cb), young, poisson, young_rail, poisson_rail)
+    out = _hertz_core(q, np.asarray(ca), np.asarray(cb), young, poisson, young_rail, poisson_rail)
+    _PLAUSIBLE_3D((q, rwx))  # implausible inputs warn (docs/checks.md)
+    return out
 
 
 def _reduced_radius(radius_1, radius_2) -> np.ndarray:
@@ -574,6 +585,7 @@ def line_contact_from_pressure(
     e_star = combined_elastic_constants(young, poisson, young_2, poisson_2)[0]
     a = 2.0 * p0 * r / e_star
     p = np.pi * a * p0 / 2.0
+    check_plausible(p0, "max_pressure")  # implausible inputs warn (docs/checks.md)
     return _line_result(a, p0, p, r, e_star)
 
 

@@ -31,6 +31,7 @@ import numpy as np
 
 from railadhesion._labelled import labelled
 from railadhesion._validate import check_finite, check_positive, check_range
+from railadhesion.plausibility import input_checker
 
 __all__ = ["KalkerCoefficients", "kalker_coefficients", "linear_creep_forces"]
 
@@ -319,6 +320,11 @@ def axis_ratio(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return r
 
 
+#: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
+_PLAUSIBLE = input_checker(("creep_long", "creep_lat", "spin", "a", "b", "shear_modulus",
+                            "poisson"))
+
+
 @labelled(units=("N", "N", "N m"))
 def linear_creep_forces(creep_long, creep_lat, spin, a, b, shear_modulus, poisson):
     """Creep forces and spin moment of Kalker's linear theory (small creepages, full stick).
@@ -386,6 +392,7 @@ def linear_creep_forces(creep_long, creep_lat, spin, a, b, shear_modulus, poisso
     b_ = check_positive(b, "b")
     g_mod = check_positive(shear_modulus, "shear_modulus")
     coef = kalker_coefficients(axis_ratio(a_, b_), poisson)
+    _PLAUSIBLE((xi, eta, phi, a_, b_, g_mod, poisson))  # implausible inputs warn
     c = np.sqrt(a_ * b_)
     gc2 = g_mod * c * c
     gc3 = gc2 * c

@@ -61,6 +61,7 @@ from railadhesion.models.kernels import (
     _thread_pool,
 )
 from railadhesion.models.kernels import kalker_scalar as _kalker_scalar
+from railadhesion.plausibility import input_checker
 
 __all__ = ["exact_table_forces", "table_axes"]
 
@@ -587,6 +588,11 @@ def _interp(d, laob, shape, xi, eta, phi, kx, ky, ks, kf, km, lv, la, lb):
 _NO_AOB = _read_only(np.empty(0))
 
 
+#: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
+_PLAUSIBLE = input_checker(("creep_long", "creep_lat", "spin", "normal_force", "a", "b",
+                            "speed", "shear_modulus", "poisson"))
+
+
 def exact_table_forces(
     creep_long,
     creep_lat,
@@ -691,11 +697,16 @@ def exact_table_forces(
         _is_real(x) for x in (creep_long, creep_lat, spin, normal_force, a, b, mu,
                               shear_modulus, poisson, friction_ratio, friction_decay)
     ):  # fmt: skip
-        # one contact in Python numbers (ODE right-hand sides): checks in plain Python
-        res = _scalar_forces(creep_long, creep_lat, spin, normal_force, a, b, mu,
-                             shear_modulus, poisson, speed, friction_ratio,
-                             friction_decay)  # fmt: skip
+        # one contact in Python numbers (ODE right-hand sides): checks in plain Python; ints
+        # become floats (the compiled lookup is typed for float64)
+        res = _scalar_forces(*(float(x) for x in (creep_long, creep_lat, spin, normal_force, a,
+                                                  b, mu, shear_modulus, poisson)),
+                             float(speed) if _is_real(speed) else speed,
+                             float(friction_ratio), float(friction_decay))  # fmt: skip
         if res is not None:
+            # implausible inputs warn (docs/checks.md)
+            _PLAUSIBLE((creep_long, creep_lat, spin, normal_force, a, b, speed, shear_modulus,
+                        poisson))  # fmt: skip
             return res
     xi = check_finite(creep_long, "creep_long")
     eta = check_finite(creep_lat, "creep_lat")
@@ -741,6 +752,7 @@ def exact_table_forces(
     # global slip velocity V |(xi, eta)| (spin not counted)
     fx, fy, mz = _interp(d, laob, shape, xi, eta, phi, f * coef[0], f * coef[1],
                          c * f * coef[2], scale, scale * c, v, ratio, decay)  # fmt: skip
+    _PLAUSIBLE((xi, eta, phi, fz, a_, b_, speed, g, nu))  # implausible inputs warn
     if fx.ndim == 0:
         return float(fx), float(fy), float(mz)
     return fx, fy, mz

@@ -5,6 +5,9 @@
   (no Python at run time; :mod:`railadhesion.export.native` builds any step model so);
 * :func:`build_braking_fmu`: the braking simulator's stepping API as an FMU (inputs: commanded
   pressure and WSP valve per axle);
+* :func:`build_monitor_fmu`: the on-board adhesion monitor as an FMU (inputs: speed
+  reference, wheel speeds, pressures and/or torques; outputs: estimates, levels, reasons);
+  :func:`build_native_monitor_fmu`: the same, native (no Python at run time);
 * :func:`creep_force_table`: a model evaluated on a grid, written as NetCDF
   (:func:`write_table_netcdf`) and as a plain CSV (:func:`write_table_csv`), with the error
   of multilinear interpolation in the table measured at the cell midpoints.
@@ -20,6 +23,12 @@ from railadhesion.export.fmu import (
     build_fmu,
     creep_force_variables,
     resolve_parameters,
+)
+from railadhesion.export.monitor_fmu import (
+    build_monitor_fmu,
+    build_native_monitor_fmu,
+    monitor_fmu_variables,
+    monitor_step_model,
 )
 from railadhesion.export.native import NativeBuildError
 from railadhesion.export.native_creepforce import build_native_creep_force_fmu
@@ -43,10 +52,14 @@ __all__ = [
     "build_braking_fmu",
     "build_creep_force_fmu",
     "build_fmu",
+    "build_monitor_fmu",
     "build_native_creep_force_fmu",
+    "build_native_monitor_fmu",
     "creep_force_table",
     "creep_force_variables",
     "interpolation_error",
+    "monitor_fmu_variables",
+    "monitor_step_model",
     "read_table_csv",
     "resolve_parameters",
     "write_table_csv",

@@ -31,6 +31,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
+from railadhesion.plausibility import check_plausible
+
 __all__ = [
     "FMU_MODELS",
     "UNIT_DEFINITIONS",
@@ -51,6 +53,7 @@ FMU_MODELS = ("wilac", "polach")
 #: optional factor). Water flow is in µl/s as everywhere in the package (spelt ``ul/s``).
 UNIT_DEFINITIONS: dict[str, dict[str, str]] = {
     "1": {},
+    "s": {"s": "1"},
     "m": {"m": "1"},
     "m/s": {"m": "1", "s": "-1"},
     "m/s2": {"m": "1", "s": "-2"},
@@ -58,6 +61,7 @@ UNIT_DEFINITIONS: dict[str, dict[str, str]] = {
     "rad/m": {"m": "-1", "rad": "1"},
     "N": {"kg": "1", "m": "1", "s": "-2"},
     "Pa": {"kg": "1", "m": "-1", "s": "-2"},
+    "N.m": {"kg": "1", "m": "2", "s": "-2"},
     "ul/s": {"m": "3", "s": "-1", "factor": "1e-09"},
 }
 
@@ -311,6 +315,8 @@ def creep_force_variables(model: str, *, shear_modulus: float = 8.2e10,
         raise ValueError(f"shear_modulus must be in (0, inf), got {shear_modulus!r}")
     if not (0.0 <= nu <= 0.5):
         raise ValueError(f"poisson must be in [0, 0.5], got {poisson!r}")
+    for name, value in (("shear_modulus", g), ("poisson", nu)):  # G = 82000 (N/mm^2): a warning
+        check_plausible(value, name, where=f"{name} (start value)")
     inputs = [
         FmuVariable("creep_long", "input", "1",
                     "Longitudinal creepage xi = (V - omega R)/V; braking > 0, traction < 0", 0.0),

@@ -9,7 +9,7 @@
   :func:`detect_low_adhesion`.
 """
 
-from railadhesion.identification.braking import (
+from railadhesion.identification.brake_tests import (
     BrakeCoefficient,
     BrakingIdentification,
     brake_coefficient,

@@ -15,11 +15,32 @@ spread of mu within each (exact up to the slip spread within a bin of width max/
 slip range is the 1st to 99th percentile of the samples at that resolution. Samples are
 collected in one compiled pass over the log.
 
+The minimum is found by variable projection (Golub and Pereyra 1973): for fixed ``s0`` and
+``B`` the law is linear in ``c1 = mu_s A`` and ``c2 = mu_s (1 - A)``, solved exactly, so the
+search runs over (s0, B) only: a grid, then a pattern search after Hooke and Jeeves (1961),
+then scipy's ``least_squares`` polishes all four parameters.
+
 Uncertainty [our approximation]: the standard errors are the linearised ones
 (``s^2 (J^T W J)^-1``) with the residual variance of the samples, inflated by
 ``sqrt(n / n_eff)`` where ``n_eff`` counts one independent sample per correlation time of the
 filtered signals (``1/(2 f_c)``, f_c the wheel cut-off) and per axle: filtered samples 2.4 ms
 apart are not independent.
+
+References: G. H. Golub and V. Pereyra, "The differentiation of pseudo-inverses and nonlinear
+least squares problems whose variables separate", SIAM J. Numer. Anal. 10 (1973) 413-432.
+R. Hooke and T. A. Jeeves, "'Direct search' solution of numerical and statistical problems",
+J. ACM 8 (1961) 212-229.
+
+Quality gate (``docs/checks.md``; :attr:`CurveFit.warnings`, :attr:`AdhesionLaw.trusted`): a
+curve is not trusted if R^2 < 0.3 (:data:`railadhesion.plausibility.MIN_R_SQUARED_SCATTER`:
+identified adhesion scatters, a good fit to a braking log has R^2 of 0.5-0.8), a
+parameter ends on a bound of the search that is not a limit of the law (``A`` = 0 or 1 and
+``B = 0`` are), the standard error of ``mu_s`` or ``s0`` is not finite or above its value, the
+standard error of the curve itself (delta method, over its slip range) exceeds
+:data:`MAX_CURVE_STDERR` of its peak, or fewer than 3 independent samples (``n_eff``) lie
+below the peak (``s0``) or, when the law falls by more than 1 %, beyond it (``A``, ``B``).
+The shape parameters ``A`` and ``B`` trade off against each other; their own standard errors
+are reported but the curve's is what is judged.
 
 A fit is saved as a TOML parameter file (``format = "railadhesion-adhesion-law"``,
 ``version = 1``, docs/identification.md) and loaded by :func:`load_adhesion_law` as an
@@ -39,7 +60,13 @@ from numba import njit
 from scipy import optimize
 
 from railadhesion._validate import check_choice
-from railadhesion.identification.surface import _cell
+from railadhesion.identification.surface import cell_index
+from railadhesion.plausibility import (
+    MIN_R_SQUARED_SCATTER,
+    UntrustedResultWarning,
+    fit_warnings,
+    warn,
+)
 
 __all__ = [
     "LAW_FORMAT",
@@ -53,6 +80,9 @@ __all__ = [
 LAW_FORMAT = "railadhesion-adhesion-law"
 LAW_VERSION = 1
 PARAM_NAMES = ("mu_s", "s0", "A", "B")
+#: Largest standard error of a fitted curve over its slip range, relative to its peak, in a
+#: trusted law (an assumption: a tenth of the adhesion).
+MAX_CURVE_STDERR = 0.1
 
 
 def falling_adhesion(s, mu_s, s0, A, B):  # noqa: N803 - the law's own symbols
@@ -89,6 +119,8 @@ class CurveFit:
         Goodness of fit on the samples.
     speed_mean : float
         Mean speed of the samples [m/s].
+    warnings : tuple of str
+        Why the curve should not be trusted (the quality gate, module notes); empty if none.
     """
 
     speed_band: tuple[float, float]
@@ -100,6 +132,12 @@ class CurveFit:
     r_squared: float
     rmse: float
     speed_mean: float
+    warnings: tuple[str, ...] = ()
+
+    @property
+    def trusted(self) -> bool:
+        """True when the quality gate found nothing (:attr:`warnings` is empty)."""
+        return not self.warnings
 
     def __call__(self, slip):
         """mu at the given slip (the band's curve)."""
@@ -129,7 +167,7 @@ def _band_stats(speed, x, mu, use, phase, edges):  # pragma: no cover - compiled
     band = np.empty(n, np.int64)
     for k in range(n):
         v = speed[k]
-        b = _cell(v, edges) if v < edges[nb] else -1  # bands are [low, high)
+        b = cell_index(v, edges) if v < edges[nb] else -1  # bands are [low, high)
         band[k] = b
         h0 = False
         h1 = False
@@ -279,8 +317,8 @@ def _linear_part(suu, suv, svv, sut, svt, stt, top):  # pragma: no cover - compi
 @njit(cache=True, nogil=True)
 def _grid_search(xb, yb, sw, s0_grid, b_grid, top):  # pragma: no cover - compiled
     """For each (s0, B) of the grid the linear parameters c1 = mu_s A and c2 = mu_s (1 - A) are
-    solved exactly (variable projection): half the cost and (mu_s, A) at every grid point,
-    shape (len(s0_grid), len(b_grid), 3)."""
+    solved exactly (variable projection, Golub and Pereyra 1973): half the cost and (mu_s, A)
+    at every grid point, shape (len(s0_grid), len(b_grid), 3)."""
     m = xb.size
     ns = s0_grid.size
     nb = b_grid.size
@@ -350,7 +388,8 @@ def _projected(xb, yb, sw, s0, b_rate, top):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True)
 def _pattern_search(xb, yb, sw, s0, b_rate, lo, hi, step, top, h_min):  # pragma: no cover
     """Local minimum of the projected cost over (log s0, log B) from a start: a pattern
-    search (8 directions; a successful direction is followed with doubled steps; the step is
+    search after Hooke and Jeeves (1961) (exploratory moves in 8 directions; a successful
+    direction is followed with doubled steps, our form of their pattern move; the step is
     halved when no direction improves, down to ``h_min``). B is kept >= 1e-9 (B = 0 and
     B = 1e-9 give the same curve to 1e-8). Returns (cost, mu_s, s0, A, B)."""
     b_min = 1e-9
@@ -417,9 +456,10 @@ def _global_start(xb, yb, sw, lo_b, hi_b, candidates: int = GLOBAL_CANDIDATES,
 
     For fixed s0 and B the law is linear in c1 = mu_s A and c2 = mu_s (1 - A) (c1, c2 >= 0,
     c1 + c2 <= mu_s's bound), so the search runs over (s0, B) only with the linear pair solved
-    exactly (variable projection): a ``grid`` x ``grid`` log grid over the whole box, then a
-    compiled pattern search from each of its ``candidates`` best local minima (down to steps
-    of ``h_min`` in log s0 and log B); the best point found."""
+    exactly (variable projection, Golub and Pereyra 1973): a ``grid`` x ``grid`` log grid
+    over the whole box, then a compiled pattern search (Hooke and Jeeves 1961) from each of
+    its ``candidates`` best local minima (down to steps of ``h_min`` in log s0 and log B); the
+    best point found."""
     s0_grid = np.geomspace(lo_b[1], hi_b[1], grid)
     b_grid = np.r_[0.0, np.geomspace(1e-3, hi_b[3], grid - 1)]
     starts = _grid_best(xb, yb, sw, s0_grid, b_grid, hi_b[0], candidates)
@@ -475,21 +515,65 @@ def _fit_one(stats, n_eff, slip_kind):
         cov = np.linalg.pinv(jac.T @ jac) * s2 * max(n / max(n_eff, 1.0), 1.0)
         err = np.sqrt(np.clip(np.diag(cov), 0, None))
     except np.linalg.LinAlgError:  # pragma: no cover
+        cov = np.full((4, 4), np.inf)
         err = np.full(4, np.inf)
     params = dict(zip(PARAM_NAMES, (float(v) for v in p), strict=True))
     stderr = dict(zip(PARAM_NAMES, (float(v) for v in err), strict=True))
     r2 = 1.0 - ssr / sst if sst > 0 else float("nan")
-    return params, stderr, r2, math.sqrt(max(ssr, 0.0) / n), (lo_x, hi_x)
+    flags = _gate(p, cov, params, stderr, r2, (lo_x, hi_x), xf, cnt_f[okf], n, n_eff, lo_b,
+                  hi_b)  # fmt: skip
+    return params, stderr, r2, math.sqrt(max(ssr, 0.0) / n), (lo_x, hi_x), flags
+
+
+def _gate(p, cov, params, stderr, r2, slip_range, xf, cf, n, n_eff, lo_b, hi_b):
+    """The quality gate of one fitted curve (module notes): its findings."""
+    span = hi_b - lo_b
+    limits = {"A": (0.0, 1.0), "B": (0.0,)}  # bounds that are limits of the law itself
+    on_bound = [k for k, name in enumerate(PARAM_NAMES)
+                if p[k] <= lo_b[k] + 1e-6 * span[k] or p[k] >= hi_b[k] - 1e-6 * span[k]]
+    outside = tuple(PARAM_NAMES[k] for k in on_bound
+                    if not any(abs(p[k] - lim) <= 1e-6 * span[k]
+                               for lim in limits.get(PARAM_NAMES[k], ())))  # fmt: skip
+    at_limit = tuple(PARAM_NAMES[k] for k in on_bound if PARAM_NAMES[k] not in outside)
+    # the curve's own standard error over its slip range (delta method)
+    xs = np.linspace(slip_range[0], slip_range[1], 41)
+    step = 1e-7 * np.maximum(np.abs(p), 1e-3)
+    grad = np.stack([(falling_adhesion(xs, *(p + step[k] * np.eye(4)[k]))
+                      - falling_adhesion(xs, *(p - step[k] * np.eye(4)[k]))) / (2 * step[k])
+                     for k in range(4)], axis=1)  # fmt: skip
+    with np.errstate(invalid="ignore", over="ignore"):
+        var = np.einsum("ij,jk,ik->i", grad, cov, grad)
+    curve = falling_adhesion(xs, *p)
+    peak_at = float(xs[int(np.argmax(curve))])
+    independent = max(n_eff, 1.0) / max(n, 1.0)  # independent samples per sample
+    below = int(np.sum(cf[xf < peak_at]) * independent)
+    beyond = int(np.sum(cf[xf > peak_at]) * independent)
+    fall = (1.0 - params["A"]) * -math.expm1(-params["B"] * slip_range[1])
+    regions = {"s0": (below, "below the peak of the curve (independent samples)")}
+    if fall >= 0.01:
+        regions.update({k: (beyond, "beyond the peak of the curve (independent samples)")
+                        for k in ("A", "B")})  # fmt: skip
+    flags = list(fit_warnings(
+        r_squared=float(r2), params=params, fitted=PARAM_NAMES, stderr=stderr,
+        at_bound=outside, region_points=regions, min_r_squared=MIN_R_SQUARED_SCATTER,
+        ignore_stderr=("A", "B", *at_limit),
+    ))  # fmt: skip
+    rel = float(np.sqrt(np.max(var)) / np.max(curve)) if np.max(curve) > 0 else math.inf
+    if not rel <= MAX_CURVE_STDERR:  # NaN too
+        flags.append(f"the curve's standard error reaches {rel:.2g} of its peak (above "
+                     f"{MAX_CURVE_STDERR:g}): the samples do not determine it")  # fmt: skip
+    return tuple(flags)
 
 
 def fit_adhesion_curves(ident, *, slip: str = "absolute", speed_bands=None, phase: str = "all",
-                        min_samples: int = 200, per_band: bool = True):
+                        min_samples: int = 200, per_band: bool = True,
+                        warn_untrusted: bool = True):  # fmt: skip
     """Fit mu(slip) per speed band (and over all speeds) to an identification's samples.
 
     Parameters
     ----------
     ident : BrakingIdentification
-        From :func:`~railadhesion.identification.braking.identify_adhesion` (its ``speed``,
+        From :func:`~railadhesion.identification.brake_tests.identify_adhesion` (its ``speed``,
         ``slip`` or ``relative_slip``, ``mu``, ``use`` and ``phase`` arrays).
     slip : {"absolute", "relative"}
         Fit against the absolute slip [m/s] or the relative slip [-].
@@ -502,11 +586,15 @@ def fit_adhesion_curves(ident, *, slip: str = "absolute", speed_bands=None, phas
         Smallest number of samples a band needs.
     per_band : bool, default True
         Fit each speed band; ``False``: only the curve over all speeds (``bands`` empty).
+    warn_untrusted : bool, default True
+        Issue an :class:`~railadhesion.plausibility.UntrustedResultWarning` when the quality
+        gate flags a curve (the findings are in ``law.warnings`` either way).
 
     Returns
     -------
     AdhesionLaw
-        ``bands`` (one :class:`CurveFit` per band with data) and ``overall`` (all speeds).
+        ``bands`` (one :class:`CurveFit` per band with data) and ``overall`` (all speeds);
+        ``trusted`` and ``warnings`` from the quality gate of every curve (module notes).
 
     Raises
     ------
@@ -536,10 +624,10 @@ def fit_adhesion_curves(ident, *, slip: str = "absolute", speed_bands=None, phas
 
     def fit(st, band, vmean):
         nb = int(st[0].sum())
-        params, stderr, r2, rmse, rng = _fit_one(st, nb / corr, slip)
+        params, stderr, r2, rmse, rng, flags = _fit_one(st, nb / corr, slip)
         return CurveFit(
             speed_band=band, slip_kind=slip, params=params, stderr=stderr, slip_range=rng,
-            n_samples=nb, r_squared=r2, rmse=rmse, speed_mean=vmean,
+            n_samples=nb, r_squared=r2, rmse=rmse, speed_mean=vmean, warnings=flags,
         )
 
     def mean_speed(b):
@@ -551,7 +639,7 @@ def fit_adhesion_curves(ident, *, slip: str = "absolute", speed_bands=None, phas
             if stats[b, 0].sum() >= min_samples:
                 bands.append(fit(stats[b], (float(lo), float(hi)), mean_speed(b)))
     overall = fit(stats[-1], (float(edges[0]), float(edges[-1])), mean_speed(-1))
-    return AdhesionLaw(
+    law = AdhesionLaw(
         slip_kind=slip, bands=tuple(bands), overall=overall, phase=phase,
         provenance={
             "source": "identified from a braking-test log (railadhesion.identification)",
@@ -562,6 +650,10 @@ def fit_adhesion_curves(ident, *, slip: str = "absolute", speed_bands=None, phas
             "phase": phase,
         },
     )
+    if warn_untrusted and law.warnings:
+        warn(f"identified adhesion law ({slip} slip, phase {phase}) not trusted: "
+             + "; ".join(law.warnings), UntrustedResultWarning)  # fmt: skip
+    return law
 
 
 @dataclass(frozen=True)
@@ -585,7 +677,11 @@ class AdhesionLaw:
     phase : str
         Samples the curves were fitted to.
     provenance : dict
-        Where the law comes from.
+        Where the law comes from (a saved law also records ``trusted`` and ``warnings``).
+    warnings : tuple of str
+        The findings of the quality gate of every curve, each prefixed with its band.
+    trusted : bool
+        ``not warnings``.
     """
 
     slip_kind: str
@@ -593,6 +689,20 @@ class AdhesionLaw:
     overall: CurveFit
     phase: str = "all"
     provenance: dict = field(default_factory=dict, compare=False)
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """Findings of the quality gate, curve by curve (bands, then all speeds)."""
+        return tuple(f"{label}: {w}" for label, c in self._labelled_curves() for w in c.warnings)
+
+    @property
+    def trusted(self) -> bool:
+        """True when no curve of the law was flagged by the quality gate."""
+        return not self.warnings
+
+    def _labelled_curves(self):
+        return [*((f"{b.speed_band[0]:g}-{b.speed_band[1]:g} m/s", b) for b in self.bands),
+                ("all speeds", self.overall)]
 
     def of_slip(self, slip, speed):
         """mu at the slip (in this law's kind: m/s or -) and speed [m/s]."""
@@ -633,13 +743,13 @@ class AdhesionLaw:
         import pandas as pd
 
         rows = []
-        for label, c in [*((f"{b.speed_band[0]:g}-{b.speed_band[1]:g} m/s", b)
-                           for b in self.bands), ("all speeds", self.overall)]:
+        for label, c in self._labelled_curves():
             row = {"band": label, "n_samples": c.n_samples, "speed_mean": c.speed_mean}
             row.update(c.params)
             row.update({f"{k}_stderr": v for k, v in c.stderr.items()})
             row.update({"slip_min": c.slip_range[0], "slip_max": c.slip_range[1],
-                        "r_squared": c.r_squared, "rmse": c.rmse})
+                        "r_squared": c.r_squared, "rmse": c.rmse, "trusted": c.trusted,
+                        "warnings": "; ".join(c.warnings)})
             rows.append(row)
         return pd.DataFrame(rows)
 
@@ -655,11 +765,14 @@ class AdhesionLaw:
                 **{f"{k}_stderr": v for k, v in c.stderr.items()},
                 "slip_min": c.slip_range[0], "slip_max": c.slip_range[1],
                 "n_samples": c.n_samples, "r_squared": c.r_squared, "rmse": c.rmse,
+                "warnings": list(c.warnings),
             }
 
+        provenance = {k: v for k, v in self.provenance.items() if v is not None}
+        provenance.update({"trusted": self.trusted, "warnings": list(self.warnings)})
         doc = {
             "format": LAW_FORMAT, "version": LAW_VERSION,
-            "provenance": {k: v for k, v in self.provenance.items() if v is not None},
+            "provenance": provenance,
             "law": {
                 "form": "mu_s * (1 - exp(-s/s0)) * (A + (1 - A) * exp(-B*s))",
                 "slip": self.slip_kind,
@@ -695,6 +808,7 @@ def _curve_from(tab, kind, where):
         slip_range=(get("slip_min"), get("slip_max")), n_samples=int(tab.get("n_samples", 0)),
         r_squared=get("r_squared"), rmse=get("rmse"),
         speed_mean=get("speed_mean_m_s"),
+        warnings=tuple(str(w) for w in tab.get("warnings", ())),
     )
 
 
@@ -724,6 +838,10 @@ def load_adhesion_law(path) -> AdhesionLaw:
     overall = _curve_from(law["overall"], kind, f"{p}: law.overall")
     bands = tuple(_curve_from(b, kind, f"{p}: law.band[{i}]")
                   for i, b in enumerate(law.get("band", [])))
-    return AdhesionLaw(slip_kind=kind, bands=bands, overall=overall,
-                       phase=str(law.get("phase", "all")),
-                       provenance=dict(doc.get("provenance", {})))
+    out = AdhesionLaw(slip_kind=kind, bands=bands, overall=overall,
+                      phase=str(law.get("phase", "all")),
+                      provenance=dict(doc.get("provenance", {})))
+    if out.warnings:  # a law that was not trusted when identified is not trusted now
+        warn(f"{p}: the adhesion law is not trusted (the quality gate when it was "
+             "identified): " + "; ".join(out.warnings), UntrustedResultWarning)  # fmt: skip
+    return out

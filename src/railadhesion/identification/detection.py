@@ -18,6 +18,13 @@ creep of full slip, ``xi_sat = 3 a mu / (2 k_a R)``, therefore bound mu from bel
 adhesion never exceeds mu) but often not from above. The uncertainty is reported as a
 profile-likelihood interval, whose upper end is ``inf`` when the data are consistent with an
 arbitrarily large mu: then no warning can be given either way and the level says so.
+
+When the fit itself cannot be trusted (the quality gate of ``docs/checks.md``: R^2 below 0.3
+(:data:`railadhesion.plausibility.MIN_R_SQUARED_SCATTER`: at low creep the adhesion spans
+little more than the measurement noise, CG1 to 0.2 % creep with noise 0.002 gives 0.83),
+k_a not determined, fewer than 3 points below the creep of full slip, e.g. data that run to
+20-60 % creep, far beyond it), the level is ``unknown``, never ``normal`` or ``low``, and
+:attr:`DetectionResult.warnings` says why.
 :func:`fletcher_detection_study` runs this on Fletcher's ten conditions (README table).
 """
 
@@ -30,6 +37,12 @@ import numpy as np
 from scipy import optimize
 
 from railadhesion._validate import check_choice, check_positive, check_range
+from railadhesion.plausibility import (
+    MIN_R_SQUARED_SCATTER,
+    UntrustedResultWarning,
+    fit_warnings,
+    warn,
+)
 
 __all__ = [
     "RSSB_BRAKING_ADHESION",
@@ -63,7 +76,8 @@ class DetectionResult:
         when the data do not bound mu from above; Polach: ``mu +/- 1.96 stderr``).
     level : str
         ``"low"`` (the whole interval is below ``threshold``), ``"normal"`` (the whole interval
-        is at or above it) or ``"caution"`` (the interval straddles it: the data cannot tell).
+        is at or above it), ``"caution"`` (the interval straddles it: the data cannot tell) or
+        ``"unknown"`` (the fit cannot be trusted, see :attr:`warnings`: no level is given).
     threshold : float
         Warning threshold [-] (default 0.14, RSSB GM/GN2642).
     model : str
@@ -81,6 +95,10 @@ class DetectionResult:
         Number of data points used.
     fit : FitResult
         The underlying fit (:mod:`railadhesion.calibration.fitting`).
+    warnings : tuple of str
+        Why the estimate cannot be trusted (then ``level == "unknown"``); empty otherwise.
+    trusted : bool
+        ``not warnings``.
     """
 
     mu: float
@@ -96,6 +114,12 @@ class DetectionResult:
     rmse: float
     n_points: int
     fit: object = field(repr=False, compare=False, default=None)
+    warnings: tuple[str, ...] = ()
+
+    @property
+    def trusted(self) -> bool:
+        """True when the fit passed the quality gate (:attr:`warnings` is empty)."""
+        return not self.warnings
 
     @property
     def reached_full_slip(self) -> bool:
@@ -120,6 +144,9 @@ class DetectionResult:
             f"  fit: R^2 = {self.r_squared:.4f}, RMSE = {self.rmse:.3g}",
             f"  warning level: {self.level.upper()} (threshold {self.threshold:g})",
         ]
+        if self.warnings:
+            lines.append("  no level: the fit cannot be trusted, so it cannot bound mu:")
+            lines.extend(f"    ! {w}" for w in self.warnings)
         return "\n".join(lines)
 
     def __str__(self) -> str:
@@ -149,7 +176,7 @@ def _profile_interval(xi, y, g, mu_hat, ka_hat, ssr_min, dof):
     """
     # floor: exact (noise-free) data still get a finite, tiny interval
     s2 = max(ssr_min / dof, (1e-6 * float(np.max(y))) ** 2, 1e-300)
-    from scipy import stats  # imported when needed (scipy.stats takes 0.5 s to import)
+    from scipy import stats  # imported when needed (scipy.stats is slow to import)
 
     limit = ssr_min + s2 * stats.chi2.ppf(_LEVEL, 1)
 
@@ -201,6 +228,7 @@ def detect_low_adhesion(
     speed: float | None = None,
     a: float | None = None,
     b: float | None = None,
+    warn_untrusted: bool = True,
 ) -> DetectionResult:
     """Estimate the friction coefficient at full slip from adhesion measured at low creep.
 
@@ -224,6 +252,9 @@ def detect_low_adhesion(
         Warning threshold on mu [-] (RSSB GM/GN2642, cited by Fletcher 2013 §1).
     normal_force, speed, a, b : float, optional
         Polach's contact: normal force Q [N], rolling speed [m/s], semi-axes [m].
+    warn_untrusted : bool, default True
+        Issue an :class:`~railadhesion.plausibility.UntrustedResultWarning` when the fit cannot
+        be trusted (the level is then ``"unknown"`` either way).
 
     Returns
     -------
@@ -283,7 +314,7 @@ def detect_low_adhesion(
             try:
                 fits.append(fit_fletcher(
                     s, y, half_width=a_, radius=r_, fit=("k_a", "mu"), mu=mu0,
-                    initial={"k_s": 1.0}, bounds={"mu": (1e-4, _MU_MAX)},
+                    initial={"k_s": 1.0}, bounds={"mu": (1e-4, _MU_MAX)}, warn_untrusted=False,
                 ))
             except ValueError:
                 continue
@@ -298,6 +329,16 @@ def detect_low_adhesion(
         hi = max(hi, mu_hat)
         sat = mu_hat / (g * ka_hat)
         stderr = float(fit.stderr.get("mu", math.inf))
+        # the gate on what the profile interval rests on: the model describes the data and
+        # they determine the initial slope k_a (mu itself is bounded by the profile interval,
+        # honestly unbounded above when the data do not bend)
+        below = int(np.count_nonzero((s > 0) & (s < sat)))
+        flags = fit_warnings(
+            r_squared=float(fit.r_squared), params=fit.params, fitted=("k_a",),
+            stderr=fit.stderr, success=fit.success, min_r_squared=MIN_R_SQUARED_SCATTER,
+            at_bound=tuple(n for n in fit.at_bound if n == "k_a"),
+            region_points={"k_a": (below, f"below the creep of full slip ({sat * 100:.3g} %)")},
+        )  # fmt: skip
     else:
         missing = [n for n, v in (("normal_force", normal_force), ("speed", speed), ("a", a),
                                   ("b", b)) if v is None]  # fmt: skip
@@ -305,21 +346,35 @@ def detect_low_adhesion(
             raise ValueError(f"model='polach' needs {', '.join(missing)} (the contact)")
         fit = fit_polach(
             s, y, normal_force=normal_force, speed=speed, a=a, b=b, fit=("k_A", "k_S", "mu0"),
-            initial={"A": 1.0, "B": 0.0},
+            initial={"A": 1.0, "B": 0.0}, warn_untrusted=False,
         )
         mu_hat = fit.params["mu0"]
         stderr = float(fit.stderr.get("mu0", math.inf))
+        # the linearised interval rests on a fit that describes the data, a finite and
+        # moderate standard error of mu0, and data on the rising part of the curve (low creep)
+        k = int(np.argmax(y))
+        rising = int(np.count_nonzero((s > 0) & (s < s[k]) & (y < 0.9 * y[k])))
+        flags = fit_warnings(
+            r_squared=float(fit.r_squared), params=fit.params, fitted=("k_A", "mu0"),
+            stderr=fit.stderr, success=fit.success, min_r_squared=MIN_R_SQUARED_SCATTER,
+            at_bound=tuple(n for n in fit.at_bound if n == "mu0"), ignore_stderr=("k_A",),
+            region_points={"k_A": (rising, "on the rising part of the curve (below its peak)")},
+        )  # fmt: skip
         from scipy import stats
 
         z = stats.norm.ppf(0.5 + _LEVEL / 2)
         lo = max(mu_hat - z * stderr, 0.0) if math.isfinite(stderr) else 0.0
         hi = mu_hat + z * stderr if math.isfinite(stderr) else math.inf
         sat = math.inf
+    if flags and warn_untrusted:
+        warn(f"low-adhesion detection ({model}): no warning level, the fit cannot be trusted: "
+             + "; ".join(flags), UntrustedResultWarning)  # fmt: skip
     return DetectionResult(
         mu=float(mu_hat), stderr=stderr, interval=(float(lo), float(hi)),
-        level=_level(lo, hi, thr), threshold=thr, model=model, max_creep=max_creep,
-        saturation_creep=float(sat), params=dict(fit.params), r_squared=float(fit.r_squared),
-        rmse=float(fit.rmse), n_points=int(s.size), fit=fit,
+        level="unknown" if flags else _level(lo, hi, thr), threshold=thr, model=model,
+        max_creep=max_creep, saturation_creep=float(sat), params=dict(fit.params),
+        r_squared=float(fit.r_squared), rmse=float(fit.rmse), n_points=int(s.size), fit=fit,
+        warnings=flags,
     )
 
 
@@ -359,8 +414,8 @@ def fletcher_detection_study(
     pandas.DataFrame
         One row per (condition, truncation): ``test_code``, ``lubricant``, ``mu_true``,
         ``max_creep``, ``saturation_creep_true``, ``mu``, ``stderr``, ``mu_low``, ``mu_high``,
-        ``level``, ``level_true`` (the level the true mu would give) and ``covered`` (the
-        interval holds the true mu).
+        ``level``, ``level_true`` (the level the true mu would give), ``covered`` (the
+        interval holds the true mu) and ``trusted`` (the fit passed the quality gate).
     """
     import pandas as pd
 
@@ -376,7 +431,8 @@ def fletcher_detection_study(
             xi = np.linspace(trunc / n_points, trunc, n_points)
             y = np.abs(cond.adhesion(xi) + rng.normal(0.0, noise, xi.size))
             res = detect_low_adhesion(
-                xi, y, half_width=cond.half_width, radius=cond.radius, threshold=threshold
+                xi, y, half_width=cond.half_width, radius=cond.radius, threshold=threshold,
+                warn_untrusted=False,
             )
             lo, hi = res.interval
             rows.append({
@@ -384,6 +440,6 @@ def fletcher_detection_study(
                 "max_creep": trunc, "saturation_creep_true": sat_true, "mu": res.mu,
                 "stderr": res.stderr, "mu_low": lo, "mu_high": hi, "level": res.level,
                 "level_true": _level(cond.mu, cond.mu, threshold),
-                "covered": bool(lo <= cond.mu <= hi),
+                "covered": bool(lo <= cond.mu <= hi), "trusted": res.trusted,
             })
     return pd.DataFrame(rows)

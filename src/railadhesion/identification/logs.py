@@ -30,6 +30,13 @@ missing channel    column absent or all NaN: the axle is excluded from identific
                    the brake coefficient (eq. 14, which needs every axle) the mean of the
                    other axles' channel is substituted
 =================  =====================================================================
+
+Units are sniffed as well (``docs/checks.md``): pressures outside the plausible range of a
+brake cylinder in bar (Pa, kPa or psi under the bar column names), a train speed that is not
+the wheels' ``R omega`` while they roll (km/h, mph; wheel speeds in rpm), a sampling period
+too long for a braking-test log (time in ms). Each gives a
+:class:`~railadhesion.plausibility.UnitWarning` naming the column and the likely unit, and is
+kept in :attr:`BrakingLog.warnings`; the values are not changed.
 """
 
 from __future__ import annotations
@@ -40,6 +47,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from railadhesion.plausibility import (
+    AlteredResultWarning,
+    check_plausible,
+    sniff_sample_period,
+    sniff_speed_ratio,
+)
 
 __all__ = [
     "BAR",
@@ -57,8 +71,9 @@ _WHEEL = re.compile(r"^wheel_speed_(\d+)$")
 _PRESSURE = re.compile(r"^brake_pressure_(\d+)$")
 
 
-class BrakingLogWarning(UserWarning):
-    """A braking log had defects (see :attr:`BrakingLog.issues`)."""
+class BrakingLogWarning(AlteredResultWarning):
+    """A braking log had defects, repaired or marked (see :attr:`BrakingLog.issues`): the data
+    differ from the file's (an :class:`~railadhesion.plausibility.AlteredResultWarning`)."""
 
 
 @dataclass(frozen=True)
@@ -119,6 +134,9 @@ class BrakingLog:
     substituted : ndarray of bool, shape (N,)
         Axles with a missing channel replaced by the mean of the others' (used only in the
         brake coefficient, eq. 14; the axle itself is not identified).
+    warnings : tuple of str
+        Columns whose values look as if they were in another unit (module notes); a log with
+        such findings should not be identified from until they are explained.
     """
 
     time: np.ndarray
@@ -131,6 +149,7 @@ class BrakingLog:
     source: str = ""
     rows: np.ndarray = field(default=None)
     substituted: np.ndarray = field(default=None)
+    warnings: tuple = ()
 
     @property
     def n_axles(self) -> int:
@@ -444,10 +463,17 @@ def _log_from_columns(
                     f"constant for >= {stuck_pressure_time:g} s while the other pressures "
                     f"changed by > 0.5 bar: samples invalid for axle {i + 1}",
                 ))
+    # -- units (each finding a UnitWarning naming the column; values left as they are)
+    found = (
+        check_plausible(np.array([press.min(), press.max()]) / BAR, "brake_pressure",
+                        quantity="log_pressure", where=f"{where}brake_pressure_i (columns)"),
+        sniff_speed_ratio(v, wheel, where=f"{where}train_speed"),
+        sniff_sample_period(med, where=f"{where}time"),
+    )  # fmt: skip
     log = BrakingLog(
         time=t, train_speed=v, wheel_speed=wheel, brake_pressure=press, valid=valid,
         segment=segment, issues=tuple(issues), source=source, rows=src_rows,
-        substituted=substituted,
+        substituted=substituted, warnings=tuple(w for w in found if w),
     )
     if warn and issues:
         warnings.warn(

@@ -15,6 +15,7 @@ Outputs (``out``): ``summary.json``, ``surface.nc``, ``surface_relative.nc``,
 from __future__ import annotations
 
 import json
+import math
 import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
@@ -23,11 +24,19 @@ from pathlib import Path
 
 import numpy as np
 
-from railadhesion.identification.braking import _worker_count, identify_adhesion
+from railadhesion.identification.brake_tests import identify_adhesion, worker_count
 from railadhesion.identification.curves import band_statistics, fit_adhesion_curves
 from railadhesion.identification.logs import BrakingLog, read_braking_log
 from railadhesion.identification.signals import VEHICLE_CUTOFF, WHEEL_CUTOFF
 from railadhesion.identification.surface import adhesion_surface, save_surface
+from railadhesion.plausibility import (
+    PlausibilityWarning,
+    UnitWarning,
+    UntrustedResultWarning,
+    sniff_ratio,
+    sniff_speed_ratio,
+    warn,
+)
 
 __all__ = ["STAGES", "IdentificationRun", "run_identification", "write_frame_csv"]
 
@@ -62,6 +71,12 @@ class IdentificationRun:
         Stage -> wall time [s].
     threads : int
         Threads used.
+    warnings : tuple of str
+        Why the identification should not be trusted (``docs/checks.md``): columns of the log
+        in another unit, a brake coefficient far from the vehicle's, curves of the laws that
+        the quality gate flags. Empty if none; also in ``summary.json`` and the law files.
+    trusted : bool
+        ``not warnings``.
     """
 
     log: BrakingLog
@@ -75,31 +90,22 @@ class IdentificationRun:
     paths: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
     threads: int = 1
+    warnings: tuple = ()
+
+    @property
+    def trusted(self) -> bool:
+        """True when nothing was found against the identification (:attr:`warnings`)."""
+        return not self.warnings
 
 
 def write_frame_csv(frame, path) -> Path:
-    """Write a DataFrame as CSV without its index, numbers in their shortest round-trip form
-    (pyarrow's writer; pandas' if pyarrow is missing)."""
+    """Write a DataFrame as CSV without its index (:func:`pyarrow.csv.write_csv`: numbers in
+    their shortest round-trip form, column names and strings quoted)."""
+    import pyarrow as pa
+    import pyarrow.csv as pcsv
+
     path = Path(path)
-    try:
-        import pyarrow as pa
-        import pyarrow.csv as pcsv
-    except ImportError:  # pragma: no cover - pyarrow is a dependency
-        frame.to_csv(path, index=False)
-        return path
-    table = pa.Table.from_pandas(frame, preserve_index=False)
-    body = pa.BufferOutputStream()
-    if len(frame):
-        try:  # plain values, as pandas writes them
-            pcsv.write_csv(table, body, write_options=pcsv.WriteOptions(
-                include_header=False, quoting_style="none"))
-        except pa.ArrowInvalid:  # a value holds a comma, quote or newline: quote strings
-            body = pa.BufferOutputStream()
-            pcsv.write_csv(table, body, write_options=pcsv.WriteOptions(
-                include_header=False, quoting_style="needed"))
-    with path.open("wb") as fh:
-        fh.write((",".join(str(c) for c in frame.columns) + "\n").encode())
-        fh.write(body.getvalue().to_pybytes())
+    pcsv.write_csv(pa.Table.from_pandas(frame, preserve_index=False), str(path))
     return path
 
 
@@ -134,7 +140,7 @@ def run_identification(
     figures : bool, default False
         Also draw the figures (``out/figures``; needs ``out``).
     threads : int, optional
-        Threads for the compiled stages (default: every core available).
+        Threads for the compiled stages (default: ``numba.get_num_threads()``).
     progress : callable, optional
         Called with the name of each stage of :data:`STAGES` after the first as it starts.
 
@@ -148,7 +154,7 @@ def run_identification(
         Unreadable log or vehicle, bad options, no braking in the log.
     """
     step = progress or (lambda _stage: None)
-    workers = _worker_count(threads)
+    workers = worker_count(threads)
     timings: dict[str, float] = {}
     clock = [time.perf_counter()]
 
@@ -168,6 +174,11 @@ def run_identification(
                               vehicle_cutoff=vehicle_cutoff, wheel_cutoff=wheel_cutoff,
                               progress=step, threads=workers)
     lap("identify (filters, eq. 14, loads, mu, windows)")
+    findings = [*getattr(log, "warnings", ()), *_brake_coefficient_check(ident, vehicle)]
+    if not any("train_speed" in w for w in findings):  # against the vehicle's own radius
+        found = sniff_speed_ratio(log.train_speed, log.wheel_speed, vehicle.wheel_radius,
+                                  where=f"{log.source or 'log'}: train_speed")  # fmt: skip
+        findings += [found] if found else []
     bands = [float(x) for x in speed_bands]
     step("surface")
     paths: dict[str, Path] = {}
@@ -189,16 +200,24 @@ def run_identification(
         if out is not None:
             paths["windows"] = write_frame_csv(ident.windows, out / "windows.csv")
         stats_abs.result()
-        law = fit_adhesion_curves(ident, speed_bands=bands)
+        step("fitted curves")
+        law = fit_adhesion_curves(ident, speed_bands=bands, warn_untrusted=False)
         phase_curves = {}
         for phase in ("loss", "recovery"):
             try:
-                phase_curves[phase] = fit_adhesion_curves(ident, speed_bands=bands,
-                                                          phase=phase, per_band=False).overall
+                phase_curves[phase] = fit_adhesion_curves(
+                    ident, speed_bands=bands, phase=phase, per_band=False, warn_untrusted=False,
+                ).overall  # fmt: skip
             except ValueError as exc:  # too few samples in that phase
                 phase_curves[phase] = str(exc)
         stats_rel.result()
-        law_rel = fit_adhesion_curves(ident, slip="relative", speed_bands=bands)
+        law_rel = fit_adhesion_curves(ident, slip="relative", speed_bands=bands,
+                                      warn_untrusted=False)  # fmt: skip
+        findings += [f"law (absolute slip) {w}" for w in law.warnings]
+        findings += [f"law (relative slip) {w}" for w in law_rel.warnings]
+        if findings:  # the law files carry every finding of the run in their provenance
+            for one in (law, law_rel):
+                one.provenance.update({"run_trusted": False, "run_warnings": list(findings)})
         lap("fitted curves (4 bands + all, both slips; loss, recovery)")
         surface = surface_abs.result()
         surface_relative = surface_rel.result()
@@ -206,7 +225,6 @@ def run_identification(
         if pool is not None:
             pool.shutdown()
     lap("surfaces (waiting for them)")
-    step("fitted curves")
     if out is not None:
         save_surface(surface, out / "surface.nc")
         save_surface(surface_relative, out / "surface_relative.nc")
@@ -224,15 +242,43 @@ def run_identification(
         lap("figures")
     step("summary")
     summary = _summary(ident, law, law_rel, phase_curves)
+    summary.update({"trusted": not findings, "warnings": list(findings)})
     if out is not None:
         paths["summary"] = out / "summary.json"
         paths["summary"].write_text(json.dumps(summary, indent=2), encoding="utf-8")
     lap("summary")
+    if findings:
+        warn(f"identification not trusted ({len(findings)} finding(s)): " + "; ".join(findings),
+             UntrustedResultWarning)  # fmt: skip
     return IdentificationRun(
         log=log, ident=ident, surface=surface, surface_relative=surface_relative, law=law,
         law_relative=law_rel, phase_curves=phase_curves, summary=summary, paths=paths,
-        timings=timings, threads=workers,
+        timings=timings, threads=workers, warnings=tuple(findings),
     )
+
+
+#: Factor between the identified brake coefficient and the vehicle's when the log's
+#: pressures are in another unit than bar (eq. 14 divides by the pressures).
+_PRESSURE_SLIPS = {"Pa": 1e-5, "kPa": 1e-2, "psi": 1.0 / 14.503774, "MPa": 10.0}
+
+
+def _brake_coefficient_check(ident, vehicle) -> list[str]:
+    """The identified c against the vehicle's (eq. 14 is c = brake torque / pressure): a
+    factor of 1e-5 means pressures in Pa under the bar column names, 1e-2 kPa, 0.069 psi.
+    Returns the finding (a :class:`~railadhesion.plausibility.UnitWarning` issued) or []."""
+    c_vehicle = float(getattr(vehicle, "brake_coefficient", math.nan))
+    c = float(ident.brake.mean)
+    if not (c_vehicle > 0 and math.isfinite(c)):
+        return []
+    ok, unit = sniff_ratio(c / c_vehicle, "brake coefficient", _PRESSURE_SLIPS)
+    if ok:
+        return []
+    text = (f"brake coefficient: the identified c = {c:.3g} N m/Pa is {c / c_vehicle:.3g} x the "
+            f"vehicle's {c_vehicle:.3g} N m/Pa")  # fmt: skip
+    if unit is not None:
+        return [warn(text + f": brake_pressure_i in {unit}? (the braking-log format records "
+                     "bar)", UnitWarning)]  # fmt: skip
+    return [warn(text + ": check the pressures' unit and the vehicle file", PlausibilityWarning)]
 
 
 class _Done:

@@ -29,7 +29,7 @@ def _edges(edges, name):
 
 
 @njit(cache=True, nogil=True)
-def _cell(x, edges):  # pragma: no cover - compiled
+def cell_index(x, edges):  # pragma: no cover - compiled
     """Cell of x for increasing edges (-1 outside; the last edge belongs to the last cell):
     ``searchsorted(edges, x, "right") - 1``, found from the cell a uniform grid would give and
     corrected against the edges (exact for any increasing edges)."""
@@ -60,7 +60,7 @@ def _accumulate(speed, slip, mu, use, phase, se, le, cells):  # pragma: no cover
     sums = np.zeros((3, ns, nl))
     sq = np.zeros((3, ns, nl))
     for k in range(n):
-        i = _cell(speed[k], se)
+        i = cell_index(speed[k], se)
         for a in range(na):
             cells[k, a] = -1
         if i < 0:
@@ -68,7 +68,7 @@ def _accumulate(speed, slip, mu, use, phase, se, le, cells):  # pragma: no cover
         for a in range(na):
             if not use[k, a]:
                 continue
-            j = _cell(slip[k, a], le)
+            j = cell_index(slip[k, a], le)
             if j < 0:
                 continue
             cells[k, a] = i * nl + j
@@ -102,7 +102,7 @@ def adhesion_surface(ident, *, speed_edges=None, slip_edges=None, slip: str = "a
     Parameters
     ----------
     ident : BrakingIdentification
-        From :func:`~railadhesion.identification.braking.identify_adhesion`.
+        From :func:`~railadhesion.identification.brake_tests.identify_adhesion`.
     speed_edges : array_like, optional
         Cell edges in speed [m/s]; default 0, 1, ..., 40 (the paper's 40 cells).
     slip_edges : array_like, optional

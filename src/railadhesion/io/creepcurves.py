@@ -36,6 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
+from railadhesion.plausibility import AlteredResultWarning
+
 __all__ = [
     "CreepCurve",
     "CreepCurveWarning",
@@ -64,8 +66,9 @@ MAX_ABS_CREEP = 1.0
 MAX_ADHESION = 2.0
 
 
-class CreepCurveWarning(UserWarning):
-    """Rows of a creep-curve file were excluded (see :attr:`CreepCurve.excluded`)."""
+class CreepCurveWarning(AlteredResultWarning):
+    """Rows of a creep-curve file were excluded (see :attr:`CreepCurve.excluded`): the data
+    read differ from the file's (an :class:`~railadhesion.plausibility.AlteredResultWarning`)."""
 
 
 @dataclass(frozen=True)

@@ -42,8 +42,8 @@ from railadhesion.models.wilac_parameters import (
     WaterTransition,
     WilacCondition,
     WilacParameters,
-    _check_provenance,
-    _check_transitions,
+    check_provenance,
+    check_transitions,
 )
 
 if TYPE_CHECKING:
@@ -207,7 +207,7 @@ def _provenance(value, where: str = "provenance") -> dict:
     table = _table(value, where)
     _keys(table, where, (), tuple(PROVENANCE_FIELDS))
     try:
-        return _check_provenance(table, where)
+        return check_provenance(table, where)
     except ValueError as exc:  # the message already starts with the dotted path
         raise _Fail("", str(exc)) from None
 
@@ -285,7 +285,7 @@ def _wilac_from_doc(doc: Mapping) -> WilacParameters:
             s = _number(t["width_ul_s"], f"{where}.width_ul_s", positive=True)
             items.append(WaterTransition(m, s))
         try:
-            transitions = _check_transitions(items, "transitions")
+            transitions = check_transitions(items, "transitions")
         except ValueError as exc:  # the message already starts with "transitions"
             raise _Fail("", str(exc)) from None
 
@@ -443,7 +443,7 @@ def _kv(mapping: Mapping) -> str:
 
 
 def _provenance_block(provenance: Mapping) -> str:
-    prov = _check_provenance(provenance)
+    prov = check_provenance(provenance)
     if not prov:
         return ""
     out = dict(prov)
@@ -499,7 +499,7 @@ def polach_parameters_to_toml(params: PolachParameters, *, provenance=None) -> s
         prov["source"] = params.source
     if params.notes:
         prov["notes"] = params.notes
-    prov.update(_check_provenance(provenance))
+    prov.update(check_provenance(provenance))
     return "".join(
         [
             "# Polach creep-force model parameter set (Polach 2005, Wear 258, 992-1000).\n"

@@ -30,6 +30,18 @@ c22, c23, packed) -> (fx, fy)``
     1-d float64 array of :func:`pack_wilac` (``pack_wilac(params)``, once per parameter set);
     c11 as above.
 
+``fletcher_scalar(creep, slope, inverse_mu) -> (adhesion, d_creep, d_slope, d_inverse_mu)``
+    Fletcher's (2013) 2D curve with k_s = 1 (eqs. (8)-(12) in closed form, the law of
+    :func:`railadhesion.models.twod.fletcher`) as the adhesion coefficient of a creep
+    magnitude, parametrised by its initial slope and the inverse of its saturation level
+    (``inverse_mu = 0``: the straight line of the limit mu -> inf), with its partial
+    derivatives (used by the on-board monitor's estimator).
+
+``polach_curve_scalar(creep, slope, inverse_mu, ratio) -> (adhesion, d_creep, d_slope)``
+    Polach's (2005) curve for pure longitudinal creepage and constant friction (A = 1, the
+    law of :func:`railadhesion.models.polach.polach_forces`) parametrised the same way, with
+    ``ratio = k_S / k_A``.
+
 ``polach_checked(...)``, same arguments as ``polach_scalar`` -> (fx, fy, bad)
     With validation: ``bad`` is -1, or the position (0-16) of the first argument out of the
     range of :func:`~railadhesion.models.polach.polach_forces` (forces then NaN).
@@ -72,8 +84,10 @@ from railadhesion.contact.kalker import _AOB_MAX, _AOB_MIN, _C33_GT_ROWS, _G_MIN
 __all__ = [
     "HEADER_SIZE",
     "exp_scalar",
+    "fletcher_scalar",
     "kalker_scalar",
     "pack_wilac",
+    "polach_curve_scalar",
     "polach_checked",
     "polach_longitudinal",
     "polach_scalar",
@@ -1196,6 +1210,62 @@ def wilac_many(args, packed, n):
     sx, sy, psi, q, v, a, b, w, g, nu = args
     return _run_batch((sx, sy, psi, q, v, a, b, g, nu), (_ONE, _ONE, _ONE, _ZERO, _ZERO), w,
                       _read_only(packed), n, True, _PARALLEL_MIN_WILAC)  # fmt: skip
+
+
+# --- Fletcher's 2D curve (scalar) ----------------------------------------------------------
+
+
+@njit(cache=True, error_model="numpy")
+def fletcher_scalar(creep, slope, inverse_mu):
+    """Fletcher's (2013) 2D creep curve with k_s = 1 and its partial derivatives.
+
+    ``creep`` >= 0 is the creep magnitude xi [-], ``slope`` > 0 the initial slope
+    d(Q/P)/d xi = 2 k_a R / a [-], ``inverse_mu`` >= 0 the inverse 1/mu of the friction
+    coefficient (the saturation level of the curve); 0 gives the limit mu -> inf, the straight
+    line ``slope * creep``. Returns ``(Q/P, d/d creep, d/d slope, d/d inverse_mu)``.
+
+    Fletcher's eqs. (8)-(12) (Proc. IMechE Part J 227(6) (2013) 529-537) reduce to
+    ``Q/P = mu (1 - (c/a)**3)`` with ``c/a = max(1 - x/mu, 0)`` and ``x = 2 k_a xi R/(3 a)
+    = slope * xi / 3`` (:func:`railadhesion.models.twod.fletcher`, its Notes). Written with
+    u = 1 - x q (q = 1/mu): ``Q/P = x (3 - 3 x q + x**2 q**2)`` while u > 0 (finite at q = 0),
+    ``1/q`` at and beyond full slip (u <= 0); d/d xi = slope u**2, d/d slope = xi u**2,
+    d/d q = -x**2 (3 - 2 x q) before full slip, 0, 0, -1/q**2 beyond.
+    """
+    x = slope * creep / 3.0
+    u = 1.0 - x * inverse_mu
+    if u > 0.0:
+        uu = u * u
+        return (x * (3.0 - 3.0 * x * inverse_mu + x * x * inverse_mu * inverse_mu),
+                slope * uu, creep * uu, -x * x * (3.0 - 2.0 * x * inverse_mu))
+    return 1.0 / inverse_mu, 0.0, 0.0, -1.0 / (inverse_mu * inverse_mu)
+
+
+@njit(cache=True, error_model="numpy")
+def polach_curve_scalar(creep, slope, inverse_mu, ratio):
+    """Polach's (2005) adhesion-creep curve without falling friction, and two derivatives.
+
+    ``creep`` >= 0 the creep magnitude [-], ``slope`` > 0 the initial slope d(F/Q)/d creep,
+    ``inverse_mu`` >= 0 the inverse of the friction coefficient mu (the curve's asymptote; 0
+    gives the straight line), ``ratio`` = k_S / k_A > 0. Returns ``(F/Q, d/d creep,
+    d/d slope)``.
+
+    Polach (Wear 258 (2005) 992-1000; ``docs`` MODELS §3) for pure longitudinal creepage,
+    A = 1 (no falling friction): ``F/Q = (2 mu/pi) (k_A eps/(1 + (k_A eps)**2) +
+    arctan(k_S eps))`` with ``eps = K creep / mu`` (K = (pi/4) G a b C11 / Q), whose initial
+    slope is ``slope = (2/pi)(k_A + k_S) K``. With ``x = k_A eps = pi slope creep q /
+    (2 (1 + ratio))``: ``F/Q = (2/pi) z (1/(1 + x**2) + ratio atan(ratio x)/(ratio x))``,
+    ``z = x / q``, finite at q = 0 (the line ``slope * creep``); d/d creep =
+    ``slope F'(x)/(1 + ratio)`` and d/d slope = ``creep F'(x)/(1 + ratio)`` with
+    ``F'(x) = (1 - x**2)/(1 + x**2)**2 + ratio/(1 + (ratio x)**2)``.
+    """
+    z = math.pi * slope * creep / (2.0 * (1.0 + ratio))
+    x = z * inverse_mu
+    y = ratio * x
+    g = math.atan(y) / y if y > 1e-6 else 1.0 - y * y / 3.0
+    xx = x * x
+    f = 2.0 / math.pi * z * (1.0 / (1.0 + xx) + ratio * g)
+    fp = (1.0 - xx) / ((1.0 + xx) * (1.0 + xx)) + ratio / (1.0 + y * y)
+    return f, slope * fp / (1.0 + ratio), creep * fp / (1.0 + ratio)
 
 
 # --- helpers for the public functions ---------------------------------------------------------

@@ -37,6 +37,7 @@ from railadhesion._validate import (
 )
 from railadhesion.contact.kalker import _AOB_MAX, _AOB_MIN, axis_ratio, kalker_coefficients
 from railadhesion.models.parameters import PolachParameters, polach_parameters
+from railadhesion.plausibility import input_checker
 
 __all__ = ["Polach", "PolachContact", "polach_forces"]
 
@@ -233,7 +234,9 @@ def polach_forces(
     )  # fmt: skip
     scalars = _scalars(args)
     if scalars is None:
-        return _polach_array(*args)
+        out = _polach_array(*args)
+        _PLAUSIBLE(args)  # implausible inputs warn (docs/checks.md); errors were raised above
+        return out
     sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu = scalars
     fx, fy, bad = _kernels().polach_checked(
         sx, sy, psi, q, v, a, b, g, nu, 0.0, 0.0, 0.0, k_a, k_s, mu0, big_a, big_b
@@ -241,6 +244,7 @@ def polach_forces(
     if bad >= 0:
         _polach_scalar(*scalars)  # the reference scalar path raises the error naming it
         raise AssertionError("polach kernel flagged an input the reference accepts")
+    _PLAUSIBLE(scalars)  # implausible inputs warn (docs/checks.md)
     return np.float64(fx), np.float64(fy)
 
 
@@ -346,6 +350,8 @@ _ARG_NAMES = (
     "creep_long", "creep_lat", "spin", "normal_force", "speed", "a", "b",
     "mu0", "k_A", "k_S", "A", "B", "shear_modulus", "poisson",
 )  # fmt: skip
+#: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
+_PLAUSIBLE = input_checker(_ARG_NAMES)
 
 
 _KERNELS = []
@@ -501,7 +507,7 @@ class Polach:
 
     def adhesion(self, creep_long, creep_lat, spin, normal_force, speed, a, b):
         """Adhesion coefficient sqrt(fx^2 + fy^2)/Q [-] (:func:`railadhesion.adhesion`)."""
-        from railadhesion import adhesion
+        from railadhesion.contact.traction import adhesion
 
         fx, fy = self.forces(creep_long, creep_lat, spin, normal_force, speed, a, b)
         return adhesion(fx, fy, normal_force)
@@ -572,6 +578,7 @@ class PolachContact:
         if scalars is None:
             raise ValueError("PolachContact holds one contact: every argument must be a scalar")
         _polach_scalar(*scalars)  # validates every argument, errors name it
+        _PLAUSIBLE(scalars)  # implausible inputs warn (docs/checks.md), once per contact
         (_, _, _, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu) = (float(x) for x in scalars)
         self.normal_force, self.speed, self.a, self.b = q, v, a, b
         self.mu0, self.k_A, self.k_S, self.A, self.B = mu0, k_a, k_s, big_a, big_b

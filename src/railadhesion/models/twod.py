@@ -52,6 +52,7 @@ from railadhesion._validate import (
     check_nonnegative,
     check_positive,
 )
+from railadhesion.plausibility import input_checker
 
 __all__ = [
     "TwoDTraction",
@@ -100,6 +101,10 @@ def _inputs(creep, normal_load, half_width, radius, mu):
     r = check_positive(radius, "radius")
     m = check_nonnegative(mu, "mu")
     return xi, load, a, r, m
+
+
+#: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
+_PLAUSIBLE = input_checker(("creep", "half_width", "radius"))
 
 
 def _ratio_or_inf(num: np.ndarray, den: np.ndarray) -> np.ndarray:
@@ -185,6 +190,7 @@ def carter(creep, normal_load, half_width, radius, mu) -> TwoDTraction:
     slip = scale * slip_frac
     stick = traction - slip
     stick_half_width = a * (1.0 - kappa) * np.ones_like(traction)
+    _PLAUSIBLE((xi, a, r))  # implausible inputs warn (docs/checks.md)
     return TwoDTraction(
         _scalar(traction), _scalar(stick), _scalar(slip), _scalar(stick_half_width)
     )
@@ -272,6 +278,7 @@ def fletcher(creep, normal_load, half_width, radius, mu, k_a=1.0, k_s=1.0) -> Tw
     slip = scale * slip_frac
     traction = stick + slip  # eq. (12)
     c = c * np.ones_like(traction)
+    _PLAUSIBLE((xi, a, r))  # implausible inputs warn (docs/checks.md)
     return TwoDTraction(_scalar(traction), _scalar(stick), _scalar(slip), _scalar(c))
 
 
@@ -440,6 +447,7 @@ class FletcherCondition:
             creep, self.normal_load, self.half_width, self.radius, self.mu, self.k_a, self.k_s
         )
 
+    @labelled(units="1")
     def adhesion(self, creep):
         """Adhesion coefficient |Q|/P [-] of Fletcher's fitted model at creep xi [-] (fraction).
 
@@ -451,6 +459,7 @@ class FletcherCondition:
         res = self.traction(creep)
         return np.abs(res.traction) / self.normal_load
 
+    @labelled(units="1")
     def elastic_foundation_adhesion(self, creep):
         """Adhesion coefficient |Q|/P [-] of the unmodified model (k_a = k_s = 1), Fig. 4/5's
         "original model", at creep xi [-]."""

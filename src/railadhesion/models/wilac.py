@@ -39,6 +39,7 @@ from railadhesion.models.polach import (
     _scalars,
     polach_forces,
 )
+from railadhesion.plausibility import check_calibrated, input_checker
 
 __all__ = [
     "WILAC_CONDITIONS",
@@ -73,9 +74,7 @@ from railadhesion.models.wilac_parameters import (  # noqa: F401 - re-exported
     _as_regression,
     _as_transition_key,
     _check_pair,
-    _check_provenance,
     _check_ref,
-    _check_transitions,
     _compile_condition,
     _condition_from_mapping,
     _erf_transitions,
@@ -186,6 +185,7 @@ def wilac_forces(
         if not ok:  # the reference raises the error naming the argument
             _wilac_scalar(*scalars[:8], params, *scalars[8:])
             raise AssertionError("WILAC kernel flagged an input the reference accepts")
+        _check_inputs(scalars, params)  # implausible inputs, clamped Q, v warn (docs/checks.md)
         return np.float64(fx), np.float64(fy)
     arrays = [as_float_array(x, name) for x, name in zip(args, _WILAC_ARGS, strict=True)]
     shape, n, flat = kernels.flatten_args(arrays)
@@ -193,6 +193,7 @@ def wilac_forces(
     if not ok:
         _wilac_reference(*arrays[:8], params, shear_modulus=arrays[8], poisson=arrays[9])
         raise AssertionError("WILAC kernel flagged an input the reference accepts")
+    _check_inputs(arrays, params)  # implausible inputs, clamped Q, v warn (docs/checks.md)
     if not shape:
         return np.float64(fx[0]), np.float64(fy[0])
     return fx.reshape(shape), fy.reshape(shape)
@@ -202,6 +203,21 @@ _WILAC_ARGS = (
     "creep_long", "creep_lat", "spin", "normal_force", "speed", "a", "b", "water_flow",
     "shear_modulus", "poisson",
 )  # fmt: skip
+_PLAUSIBLE = input_checker(_WILAC_ARGS)
+
+
+def _check_inputs(values, params: WilacParameters) -> None:
+    """Warn for implausible inputs (:func:`railadhesion.plausibility.input_checker`) and for a
+    normal force or speed outside the set's calibrated ranges, where the parameters are held
+    at the boundary values (:func:`railadhesion.plausibility.check_calibrated`)."""
+    _PLAUSIBLE(values)
+    q, v = values[3], values[4]
+    (qlo, qhi), (vlo, vhi) = params.normal_force_range, params.speed_range
+    if type(q) is float and type(v) is float and qlo <= q <= qhi and vlo <= v <= vhi:
+        return
+    what = f"the WILAC set {params.name or '(unnamed)'!r}"
+    check_calibrated(q, "normal_force", qlo, qhi, unit="N", what=what)
+    check_calibrated(v, "speed", vlo, vhi, unit="m/s", what=what)
 
 
 def _packed(params: WilacParameters) -> np.ndarray:
@@ -339,8 +355,10 @@ class Wilac:
             shear_modulus=self.shear_modulus, poisson=self.poisson,
         )
 
+    @labelled(units="1")
     def adhesion(self, creep_long, creep_lat, spin, normal_force, speed, a, b, water_flow):
-        """Adhesion coefficient |T|/Q [-] of :func:`wilac_forces`."""
+        """Adhesion coefficient |T|/Q [-] of :func:`wilac_forces` (pandas and xarray inputs
+        give results labelled with units "1")."""
         fx, fy = self.forces(creep_long, creep_lat, spin, normal_force, speed, a, b, water_flow)
         return np.hypot(fx, fy) / np.asarray(normal_force, dtype=float)
 

@@ -27,6 +27,7 @@ from railadhesion._labelled import labelled
 from railadhesion._validate import check_choice, check_nonnegative, check_positive
 from railadhesion.models.parameters import PARAMETER_RANGES
 from railadhesion.models.regression import ParameterRegression
+from railadhesion.plausibility import check_calibrated
 
 __all__ = [
     "WILAC_CONDITIONS",
@@ -94,7 +95,7 @@ PAPER_TRANSITIONS: tuple[WaterTransition, ...] = (
 )
 
 
-def _check_transitions(transitions, where: str = "transitions") -> tuple[WaterTransition, ...]:
+def check_transitions(transitions, where: str = "transitions") -> tuple[WaterTransition, ...]:
     """Validated tuple of three :class:`WaterTransition`; errors name ``where``."""
     try:
         items = list(transitions)
@@ -140,7 +141,7 @@ def _check_transitions(transitions, where: str = "transitions") -> tuple[WaterTr
 
 @functools.lru_cache(maxsize=32)
 def _transition_arrays(transitions: tuple) -> tuple[np.ndarray, np.ndarray]:
-    checked = _check_transitions(transitions)
+    checked = check_transitions(transitions)
     return (
         np.array([t.midpoint for t in checked]),
         np.array([t.width for t in checked]),
@@ -156,7 +157,7 @@ def _as_transition_key(transitions) -> tuple:
     try:
         return tuple((float(m), float(s)) for m, s in transitions)
     except (TypeError, ValueError):
-        _check_transitions(transitions)  # raises the specific error
+        check_transitions(transitions)  # raises the specific error
         raise
 
 
@@ -309,7 +310,9 @@ class WilacCondition:
         return {name: getattr(self, name) for name in POLACH_PARAMETER_NAMES}
 
 
-def _check_provenance(provenance, where: str = "provenance") -> dict:
+def check_provenance(provenance, where: str = "provenance") -> dict:
+    """Validated provenance table (the fields of :data:`PROVENANCE_FIELDS`; ``created`` an ISO
+    date); errors name ``where``. ``None`` gives an empty dict."""
     if provenance is None:
         return {}
     if not isinstance(provenance, Mapping):
@@ -451,10 +454,10 @@ class WilacParameters:
             _check_pair(self.normal_force_range, "normal_force_range"),
         )
         object.__setattr__(self, "speed_range", _check_pair(self.speed_range, "speed_range"))
-        object.__setattr__(self, "transitions", _check_transitions(self.transitions))
+        object.__setattr__(self, "transitions", check_transitions(self.transitions))
         if not isinstance(self.name, str):
             raise ValueError(f"name: expected a string, got {self.name!r}")
-        object.__setattr__(self, "provenance", _check_provenance(self.provenance))
+        object.__setattr__(self, "provenance", check_provenance(self.provenance))
         # Every regression must be finite over the whole calibrated range (corners and a grid).
         q = np.linspace(*self.normal_force_range, 9)[:, None] / self.normal_force_ref
         v = np.linspace(*self.speed_range, 9)[None, :] / self.speed_ref
@@ -504,12 +507,26 @@ class WilacParameters:
         >>> cond = WilacCondition(k_A=1.0, k_S=0.4, mu0=0.55, A=0.4, B=0.6)
         >>> p = WilacParameters({c: cond for c in WILAC_CONDITIONS}, 1e5, 40.0,
         ...                     (4e3, 1e5), (1.0, 40.0))
-        >>> round(float(p.polach_parameters("wet", 5e4, 0.0)["mu0"]), 4)
+        >>> round(float(p.polach_parameters("wet", 5e4, 20.0)["mu0"]), 4)
         0.55
+
+        Below the calibrated speed range (a train near standstill) the parameters are those
+        of the lowest calibrated speed, with an
+        :class:`~railadhesion.plausibility.AlteredResultWarning` saying so:
+
+        >>> import warnings
+        >>> with warnings.catch_warnings(record=True) as caught:
+        ...     warnings.simplefilter("always")
+        ...     mu0 = p.polach_parameters("wet", 5e4, 0.0)["mu0"]
+        >>> type(caught[0].message).__name__, round(float(mu0), 4)
+        ('AlteredResultWarning', 0.55)
         """
         check_choice(condition, "condition", WILAC_CONDITIONS)
         q = check_positive(normal_force, "normal_force")
         v = check_nonnegative(speed, "speed")
+        what = f"the WILAC set {self.name or '(unnamed)'!r}"
+        check_calibrated(q, "normal_force", *self.normal_force_range, unit="N", what=what)
+        check_calibrated(v, "speed", *self.speed_range, unit="m/s", what=what)
         qn, vn = self._normalise(q, v)
         return _evaluate_condition(self, condition, qn, vn)
 

@@ -13,13 +13,14 @@ Fletcher's test codes).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
 
 import numpy as np
+
+from railadhesion.contact.geometry import check_geometry, contact_semi_axes
 
 __all__ = [
     "DIMENSIONS",
@@ -48,43 +49,6 @@ LABEL_DIMENSIONS: dict[str, str] = {
     "parameter_set": "parameter set: a named set, 'default' or a parameter-file path",
     "condition": "Fletcher (2013) test condition (Table 1 test code)",
 }
-
-
-def _semi_axes(geometry, normal_force: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Contact semi-axes (a, b) [m] of a named Hertz geometry (vectorised over Q) or fixed."""
-    if isinstance(geometry, str):
-        from railadhesion.contact.hertz import hertz_3d
-        from railadhesion.plotting import WILAC_GEOMETRIES
-
-        g = WILAC_GEOMETRIES[geometry]
-        h = hertz_3d(
-            normal_force, g["wheel_radius"], g["wheel_lateral_radius"],
-            g["rail_lateral_radius"], g["rail_radius"], young=2.1e11, poisson=0.28,
-        )  # fmt: skip
-        return h.a, h.b
-    return geometry
-
-
-def _check_geometry(geometry):
-    from railadhesion.plotting import WILAC_GEOMETRIES
-
-    if isinstance(geometry, str):
-        if geometry not in WILAC_GEOMETRIES:
-            raise ValueError(
-                f"geometry: expected one of {sorted(WILAC_GEOMETRIES)} or [a, b] in m, "
-                f"got {geometry!r}"
-            )
-        return geometry
-    try:
-        a, b = (float(x) for x in geometry)
-    except (TypeError, ValueError):
-        raise ValueError(
-            f"geometry: expected one of {sorted(WILAC_GEOMETRIES)} or [a, b] in m, "
-            f"got {geometry!r}"
-        ) from None
-    if not (math.isfinite(a) and math.isfinite(b) and a > 0 and b > 0):
-        raise ValueError(f"geometry: semi-axes a, b must be finite and > 0 m, got [{a}, {b}]")
-    return (a, b)
 
 
 @dataclass(frozen=True)
@@ -166,7 +130,7 @@ class WilacSweep(SweepModel):
     name = "wilac"
 
     def __post_init__(self):
-        object.__setattr__(self, "geometry", _check_geometry(self.geometry))
+        object.__setattr__(self, "geometry", check_geometry(self.geometry))
         object.__setattr__(
             self, "inputs",
             {"creep_long": None, "creep_lat": 0.0, "spin": 0.0, "normal_force": None,
@@ -205,7 +169,7 @@ class WilacSweep(SweepModel):
 
         params = self.resolve("parameter_set", labels["parameter_set"])
         q = values["normal_force"]
-        a, b = _semi_axes(self.geometry, q)
+        a, b = contact_semi_axes(self.geometry, q)
         fx, fy = wilac_forces(
             values["creep_long"], values["creep_lat"], values["spin"], q, values["speed"],
             a, b, values["water_flow"], params,
@@ -249,7 +213,7 @@ class PolachSweep(SweepModel):
     name = "polach"
 
     def __post_init__(self):
-        object.__setattr__(self, "geometry", _check_geometry(self.geometry))
+        object.__setattr__(self, "geometry", check_geometry(self.geometry))
         object.__setattr__(
             self, "inputs",
             {"creep_long": None, "creep_lat": 0.0, "spin": 0.0, "normal_force": None,
@@ -294,7 +258,7 @@ class PolachSweep(SweepModel):
 
         p = self.resolve("parameter_set", labels["parameter_set"])
         q = values["normal_force"]
-        a, b = _semi_axes(self.geometry, q)
+        a, b = contact_semi_axes(self.geometry, q)
         fx, fy = polach_forces(
             values["creep_long"], values["creep_lat"], values["spin"], q, values["speed"],
             a, b, **p.as_dict(), shear_modulus=self.shear_modulus, poisson=self.poisson,
@@ -474,7 +438,7 @@ class FunctionSweep(SweepModel):
 
 def _geometry_text(geometry) -> str:
     if isinstance(geometry, str):
-        return f"{geometry} (Hertz, railadhesion.plotting.WILAC_GEOMETRIES)"
+        return f"{geometry} (Hertz, railadhesion.contact.geometry.NAMED_GEOMETRIES)"
     return f"fixed semi-axes a = {geometry[0]!r} m, b = {geometry[1]!r} m"
 
 

@@ -24,11 +24,17 @@ Format (``format = "railadhesion-sweep"``, ``format_version = 1``)::
 
 Every field is validated; errors name the file and the field
 (``map.toml: grid.speed.num: expected an integer >= 1, got 'ten'``). Unknown fields are
-errors. Relative parameter-file paths are taken relative to the spec file.
+errors. Relative parameter-file paths are taken relative to the spec file. Careless values
+give a warning naming the file and the field (``docs/checks.md``): a creepage above 1 (given
+in percent?), a speed above 100 m/s (km/h?), a normal force outside 500 N to 500 kN (kN?), a
+water flow above 1000 µl/s; so do loads and speeds outside a WILAC set's calibrated ranges,
+where it holds its parameters. They are kept in :attr:`SweepSpec.warnings` and in the map's
+``attrs["warnings"]``.
 """
 
 from __future__ import annotations
 
+import json
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -68,6 +74,8 @@ class SweepSpec:
     chunk_points: int = DEFAULT_CHUNK_POINTS
     title: str = ""
     source: str = ""
+    #: Careless values found when loading (each also issued as a warning).
+    warnings: tuple = ()
 
     def plan(self) -> SweepPlan:
         return plan_sweep(self.model, self.grid, fixed=self.fixed, chunks=self.chunks,
@@ -80,84 +88,98 @@ class SweepSpec:
         attrs = {"spec_file": self.source}
         if self.title:
             attrs["title"] = self.title
+        if self.warnings:  # the map records what its spec was warned for
+            attrs["warnings"] = json.dumps(list(self.warnings))
         return run_sweep(self.plan(), out=out, attrs=attrs, **kwargs)
 
 
-def _fail(where: str, message: str):
+# Field readers of spec files, shared by sweep and study specs: each names the field
+# (dotted path) in its SpecError.
+
+
+def fail_field(where: str, message: str):
+    """Raise a :class:`SpecError` naming the field ``where``."""
     raise SpecError(f"{where}: {message}")
 
 
-def _int(value, where: str, low: int = 1) -> int:
+def int_field(value, where: str, low: int = 1) -> int:
+    """``value`` if it is an integer >= ``low`` (not a bool), else a SpecError."""
     if isinstance(value, bool) or not isinstance(value, int) or value < low:
-        _fail(where, f"expected an integer >= {low}, got {value!r}")
+        fail_field(where, f"expected an integer >= {low}, got {value!r}")
     return value
 
 
-def _num(value, where: str) -> float:
+def number_field(value, where: str) -> float:
+    """``value`` as a float if it is a finite number (not a bool), else a SpecError."""
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        _fail(where, f"expected a finite number, got {value!r}")
+        fail_field(where, f"expected a finite number, got {value!r}")
     return float(value)
 
 
-def _keys(table, where: str, allowed, required=()) -> None:
+def check_keys(table, where: str, allowed, required=()) -> None:
+    """A SpecError unless ``table`` is a table holding only ``allowed`` keys and every
+    ``required`` one."""
     if not isinstance(table, dict):
-        _fail(where, f"expected a table, got {table!r}")
+        fail_field(where, f"expected a table, got {table!r}")
     unknown = sorted(set(table) - set(allowed))
     if unknown:
-        _fail(f"{where}.{unknown[0]}" if where else unknown[0],
-              f"unknown field; allowed: {', '.join(allowed)}")  # fmt: skip
+        fail_field(f"{where}.{unknown[0]}" if where else unknown[0],
+                   f"unknown field; allowed: {', '.join(allowed)}")  # fmt: skip
     for key in required:
         if key not in table:
-            _fail(f"{where}.{key}" if where else key, "missing (required)")
+            fail_field(f"{where}.{key}" if where else key, "missing (required)")
 
 
-def _axis(dim: str, value, where: str, base: Path):
+def axis_values(dim: str, value, where: str, base: Path):
     """Values of one grid dimension from a list or a range table."""
     if dim in LABEL_DIMENSIONS:
         values = value.get("values") if isinstance(value, dict) else value
         if isinstance(value, dict):
-            _keys(value, where, ("values",), ("values",))
+            check_keys(value, where, ("values",), ("values",))
             where = f"{where}.values"
         if not isinstance(values, list) or not values or not all(
             isinstance(v, str) for v in values
         ):
-            _fail(where, f"expected a non-empty list of names, got {values!r}")
+            fail_field(where, f"expected a non-empty list of names, got {values!r}")
         return [_path_label(v, base) for v in values]
     if isinstance(value, list):
-        return [_num(v, f"{where}[{i}]") for i, v in enumerate(value)]
+        return [number_field(v, f"{where}[{i}]") for i, v in enumerate(value)]
     if not isinstance(value, dict):
-        _fail(where, f"expected a list of numbers or a table (values, or start/stop/num), "
+        fail_field(where, f"expected a list of numbers or a table (values, or start/stop/num), "
                      f"got {value!r}")  # fmt: skip
-    _keys(value, where, ("values", "start", "stop", "num", "step", "spacing"))
+    check_keys(value, where, ("values", "start", "stop", "num", "step", "spacing"))
     if "values" in value:
         if len(value) > 1:
-            _fail(where, "give either 'values' or a range (start, stop, num or step), not both")
+            fail_field(where,
+                       "give either 'values' or a range (start, stop, num or step), not both")
         if not isinstance(value["values"], list) or not value["values"]:
-            _fail(f"{where}.values", f"expected a non-empty list of numbers, "
+            fail_field(f"{where}.values", f"expected a non-empty list of numbers, "
                                      f"got {value['values']!r}")  # fmt: skip
-        return [_num(v, f"{where}.values[{i}]") for i, v in enumerate(value["values"])]
+        return [number_field(v, f"{where}.values[{i}]") for i, v in enumerate(value["values"])]
     for key in ("start", "stop"):
         if key not in value:
-            _fail(f"{where}.{key}", "missing (a range needs start, stop and num or step)")
-    start, stop = _num(value["start"], f"{where}.start"), _num(value["stop"], f"{where}.stop")
+            fail_field(f"{where}.{key}", "missing (a range needs start, stop and num or step)")
+    start = number_field(value["start"], f"{where}.start")
+    stop = number_field(value["stop"], f"{where}.stop")
     spacing = value.get("spacing", "linear")
     if spacing not in ("linear", "log"):
-        _fail(f"{where}.spacing", f"expected 'linear' or 'log', got {spacing!r}")
+        fail_field(f"{where}.spacing", f"expected 'linear' or 'log', got {spacing!r}")
     if ("num" in value) == ("step" in value):
-        _fail(where, "give exactly one of 'num' and 'step'")
+        fail_field(where, "give exactly one of 'num' and 'step'")
     if "step" in value:
         if spacing == "log":
-            _fail(f"{where}.step", "a step needs linear spacing; use num with spacing = 'log'")
-        step = _num(value["step"], f"{where}.step")
+            fail_field(f"{where}.step", "a step needs linear spacing; use num with spacing = 'log'")
+        step = number_field(value["step"], f"{where}.step")
         if step <= 0 or stop < start:
-            _fail(f"{where}.step", f"expected step > 0 and stop >= start, got start={start}, "
+            fail_field(f"{where}.step", f"expected step > 0 and stop >= start, got start={start}, "
                                    f"stop={stop}, step={step}")  # fmt: skip
         n = int(math.floor((stop - start) / step + 1e-9)) + 1
         return list(start + step * np.arange(n))
-    num = _int(value["num"], f"{where}.num")
+    num = int_field(value["num"], f"{where}.num")
     if spacing == "log":
         if start <= 0 or stop <= 0:
-            _fail(f"{where}.start", f"log spacing needs start and stop > 0, got {start}, {stop}")
+            fail_field(f"{where}.start",
+                       f"log spacing needs start and stop > 0, got {start}, {stop}")
         return list(np.geomspace(start, stop, num))
     return list(np.linspace(start, stop, num))
 
@@ -171,36 +193,36 @@ def _path_label(label: str, base: Path) -> str:
 
 def parse_sweep_spec(doc: dict, *, base: Path = Path("."), source: str = "") -> SweepSpec:
     """Validate a parsed spec (a dict from TOML) into a :class:`SweepSpec`."""
-    _keys(doc, "", ("format", "format_version", "title", "chunk_points", "model", "grid",
+    check_keys(doc, "", ("format", "format_version", "title", "chunk_points", "model", "grid",
                     "fixed", "chunks"), ("format", "format_version", "model", "grid"))  # fmt: skip
     if doc["format"] != FORMAT:
-        _fail("format", f"expected {FORMAT!r}, got {doc['format']!r}")
+        fail_field("format", f"expected {FORMAT!r}, got {doc['format']!r}")
     if doc["format_version"] != FORMAT_VERSION:
-        _fail("format_version", f"expected {FORMAT_VERSION}, got {doc['format_version']!r}")
+        fail_field("format_version", f"expected {FORMAT_VERSION}, got {doc['format_version']!r}")
     title = doc.get("title", "")
     if not isinstance(title, str):
-        _fail("title", f"expected a string, got {title!r}")
-    chunk_points = _int(doc.get("chunk_points", DEFAULT_CHUNK_POINTS), "chunk_points")
+        fail_field("title", f"expected a string, got {title!r}")
+    chunk_points = int_field(doc.get("chunk_points", DEFAULT_CHUNK_POINTS), "chunk_points")
 
     m = doc["model"]
-    _keys(m, "model", ("name", *sorted({o for v in _MODEL_OPTIONS.values() for o in v})),
+    check_keys(m, "model", ("name", *sorted({o for v in _MODEL_OPTIONS.values() for o in v})),
           ("name",))  # fmt: skip
     name = m["name"]
     if name not in SWEEP_MODELS:
-        _fail("model.name", f"expected one of {list(SWEEP_MODELS)}, got {name!r}")
+        fail_field("model.name", f"expected one of {list(SWEEP_MODELS)}, got {name!r}")
     options = {}
     for key, value in m.items():
         if key == "name":
             continue
         if key not in _MODEL_OPTIONS[name]:
-            _fail(f"model.{key}", f"not an option of the {name!r} model; options: "
+            fail_field(f"model.{key}", f"not an option of the {name!r} model; options: "
                                   f"{', '.join(_MODEL_OPTIONS[name])}")  # fmt: skip
         if key in ("shear_modulus", "poisson"):
-            value = _num(value, f"model.{key}")
+            value = number_field(value, f"model.{key}")
         elif key == "geometry" and isinstance(value, list):
-            value = tuple(_num(v, f"model.geometry[{i}]") for i, v in enumerate(value))
+            value = tuple(number_field(v, f"model.geometry[{i}]") for i, v in enumerate(value))
         elif not isinstance(value, str):
-            _fail(f"model.{key}", f"expected a string, got {value!r}")
+            fail_field(f"model.{key}", f"expected a string, got {value!r}")
         elif key == "parameters":
             value = _path_label(value, base)
         options[key] = value
@@ -209,29 +231,64 @@ def parse_sweep_spec(doc: dict, *, base: Path = Path("."), source: str = "") -> 
     except ValueError as exc:
         text = str(exc)
         if text.startswith("geometry:"):
-            _fail("model.geometry", text.split(":", 1)[1].strip())
+            fail_field("model.geometry", text.split(":", 1)[1].strip())
         culprit = next((k for k in ("parameters", "condition") if k in options), None)
-        _fail(f"model.{culprit}" if culprit else "model", text)
+        fail_field(f"model.{culprit}" if culprit else "model", text)
 
     grid_doc = doc["grid"]
     if not isinstance(grid_doc, dict) or not grid_doc:
-        _fail("grid", "expected a table with at least one dimension")
-    grid = {dim: _axis(dim, value, f"grid.{dim}", base) for dim, value in grid_doc.items()}
+        fail_field("grid", "expected a table with at least one dimension")
+    grid = {dim: axis_values(dim, value, f"grid.{dim}", base) for dim, value in grid_doc.items()}
     fixed = doc.get("fixed", {})
     if not isinstance(fixed, dict):
-        _fail("fixed", f"expected a table, got {fixed!r}")
-    fixed = {k: (_path_label(v, base) if isinstance(v, str) else _num(v, f"fixed.{k}"))
+        fail_field("fixed", f"expected a table, got {fixed!r}")
+    fixed = {k: (_path_label(v, base) if isinstance(v, str) else number_field(v, f"fixed.{k}"))
              for k, v in fixed.items()}  # fmt: skip
     chunks = doc.get("chunks", {})
     if not isinstance(chunks, dict):
-        _fail("chunks", f"expected a table, got {chunks!r}")
-    chunks = {k: _int(v, f"chunks.{k}") for k, v in chunks.items()}
+        fail_field("chunks", f"expected a table, got {chunks!r}")
+    chunks = {k: int_field(v, f"chunks.{k}") for k, v in chunks.items()}
     spec = SweepSpec(model, grid, fixed, chunks, chunk_points, title, source)
     try:
         spec.plan()  # the plan's checks name grid.<dim>, fixed.<input>, chunks.<dim>
     except ValueError as exc:
         raise SpecError(str(exc)) from None
+    spec.warnings = _plausible_inputs(Path(source).name if source else "spec", model, grid,
+                                      fixed)  # fmt: skip
     return spec
+
+
+def _plausible_inputs(name: str, model, grid: dict, fixed: dict) -> tuple[str, ...]:
+    """Warnings for careless numeric inputs of a spec (module notes), naming the field; for a
+    WILAC map also the loads and speeds outside each parameter set's calibrated ranges, where
+    the model holds its parameters (an AlteredResultWarning)."""
+    from railadhesion.plausibility import ARGUMENT_QUANTITY, check_calibrated, check_plausible
+    from railadhesion.sweeps.models import WilacSweep
+
+    found = []
+    if isinstance(model, WilacSweep):
+        labels = grid.get("parameter_set", [fixed.get("parameter_set",
+                                                      model.labels["parameter_set"])])
+        for label in labels:
+            params = model.resolve("parameter_set", str(label))
+            what = f"the WILAC set {params.name or label!r}"
+            for key, (lo, hi), unit in (("normal_force", params.normal_force_range, "N"),
+                                        ("speed", params.speed_range, "m/s")):  # fmt: skip
+                where, values = (f"grid.{key}", grid[key]) if key in grid else (
+                    f"fixed.{key}", fixed.get(key))  # fmt: skip
+                if values is not None and not isinstance(values, dict):
+                    found.append(check_calibrated(np.asarray(values, dtype=float),
+                                                  f"{name}: {where}", lo, hi, unit=unit,
+                                                  what=what))  # fmt: skip
+    for where, values in [*((f"grid.{k}", v) for k, v in grid.items()),
+                          *((f"fixed.{k}", v) for k, v in fixed.items())]:  # fmt: skip
+        columns = values if isinstance(values, dict) else {where.split(".", 1)[1]: values}
+        for key, column in columns.items():
+            if key in ARGUMENT_QUANTITY and not isinstance(column, str):
+                label = where if not isinstance(values, dict) else f"{where}.{key}"
+                found.append(check_plausible(np.asarray(column, dtype=float), key,
+                                             where=f"{name}: {label}"))  # fmt: skip
+    return tuple(f for f in found if f)
 
 
 def load_sweep_spec(path) -> SweepSpec:

@@ -16,6 +16,13 @@ protection on, 0: off).
 Outputs per stop: stopping distance and time, the same stop on a dry rail (``water_flow = 0``)
 and the extension against it (m and %), the longest lock and the total locked time of any
 axle [s], the maximum creepage, and whether the train stopped before ``max_time``.
+
+A stop that cannot be trusted (the train did not stop within ``max_time``, a NaN distance, or
+a braking result flagged ``trusted = False``) is a failed point: its outputs are NaN and
+``error`` holds the reason, so that ``failed stops: N`` counts it (``docs/checks.md``).
+Spec files are checked for careless values (``load_study_spec``): a brake pressure below
+0.05 bar or above 20 bar (bar for Pa?), or above the cylinders' ``max_pressure``, an initial
+speed above 100 m/s (km/h?), a water flow above 1000 µl/s.
 """
 
 from __future__ import annotations
@@ -63,14 +70,15 @@ STUDY_OUTPUTS: dict[str, tuple[str, str]] = {
 
 
 @functools.lru_cache(maxsize=256)
-def _stop(vehicle, wsp_settings: tuple, dt: float, max_time: float, initial_speed: float,
-          water_flow: float, wet_length: float, payload: float, brake_pressure: float,
-          wsp: bool):  # fmt: skip
+def _stop(vehicle, wsp_settings: tuple, dt: float, max_time: float, max_pressure: float | None,
+          initial_speed: float, water_flow: float, wet_length: float, payload: float,
+          brake_pressure: float, wsp: bool):  # fmt: skip
     """One simulated stop (summary dict); memoised per process: the dry reference of a
     scenario is shared by all its flow rates. Pure: same arguments, same result."""
     from dataclasses import replace
 
     from railadhesion.braking import (
+        BrakeCylinders,
         WaterFlowProfile,
         WheelSlideProtection,
         WilacAdhesion,
@@ -84,15 +92,25 @@ def _stop(vehicle, wsp_settings: tuple, dt: float, max_time: float, initial_spee
     else:
         profile = WaterFlowProfile.sections([(0.0, wet_length, water_flow)], base=0.0)
     controller = WheelSlideProtection(WSPSettings(**dict(wsp_settings))) if wsp else None
+    cylinders = BrakeCylinders() if max_pressure is None else BrakeCylinders(
+        max_pressure=max_pressure)  # fmt: skip
     res = simulate(veh, WilacAdhesion(profile), initial_speed, brake_pressure, wsp=controller,
-                   dt=dt, max_time=max_time)  # fmt: skip
+                   dt=dt, max_time=max_time, cylinders=cylinders)  # fmt: skip
     s = res.summary
+    untrusted = [str(w) for w in getattr(res, "warnings", ())] if not getattr(
+        res, "trusted", True) else []  # fmt: skip
+    if not res.success:
+        untrusted.append(f"the train did not stop within max_time = {max_time:g} s "
+                         f"({res.message})")  # fmt: skip
+    if not math.isfinite(s["stopping_distance_m"]):
+        untrusted.append(f"the stopping distance is {s['stopping_distance_m']} (NaN results)")
     return {
         "stopping_distance": s["stopping_distance_m"],
         "stopping_time": s["stopping_time_s"],
         "longest_lock": s["longest_lock_s"],
         "max_slip": s["max_slip"],
         "stopped": float(res.success),
+        "untrusted": tuple(untrusted),
     }
 
 
@@ -110,12 +128,19 @@ class BrakingStudy(SweepModel):
         Simulation step [s].
     max_time : float, optional
         Longest simulated stop [s].
+    max_pressure : float or None, optional
+        Pressure limit of the brake cylinders [Pa]; default 6e5, as in the example scenarios,
+        so that the default emergency demand ``brake_pressure = 5.5e5`` is applied as asked
+        (``None``: the default of :class:`railadhesion.braking.BrakeCylinders`, 3.8 bar, which
+        would clip it). A ``brake_pressure`` above it is clipped by the cylinders, and
+        :func:`load_study_spec` warns.
     """
 
     vehicle: object = "coach_default"
     wsp_settings: dict = field(default_factory=dict)
     dt: float = 1e-3
     max_time: float = 600.0
+    max_pressure: float | None = 6e5
     name = "braking_study"
     pointwise = True
 
@@ -124,9 +149,18 @@ class BrakingStudy(SweepModel):
         object.__setattr__(self, "labels", {})
         object.__setattr__(self, "wsp_settings", dict(self.wsp_settings))
         self._vehicle()  # validates
-        from railadhesion.braking import WSPSettings
+        from railadhesion.braking import BrakeCylinders, WSPSettings
 
         WSPSettings(**self.wsp_settings)
+        if self.max_pressure is not None:
+            BrakeCylinders(max_pressure=self.max_pressure)  # validates
+
+    @property
+    def cylinder_max_pressure(self) -> float:
+        """The cylinders' pressure limit [Pa] the stops use."""
+        from railadhesion.braking import BrakeCylinders
+
+        return BrakeCylinders().max_pressure if self.max_pressure is None else self.max_pressure
 
     @property
     def input_attrs(self):
@@ -150,10 +184,13 @@ class BrakingStudy(SweepModel):
         if x["wsp"] not in (0.0, 1.0):
             raise ValueError(f"wsp must be 0 or 1, got {x['wsp']}")
         common = (self._vehicle(), tuple(sorted(self.wsp_settings.items())), self.dt,
-                  self.max_time, x["initial_speed"])  # fmt: skip
+                  self.max_time, self.max_pressure, x["initial_speed"])  # fmt: skip
         rest = (x["payload"], x["brake_pressure"], bool(x["wsp"]))
         wet = _stop(*common, x["water_flow"], x["wet_length"], *rest)
         dry = _stop(*common, 0.0, math.inf, *rest)
+        for label, stop in (("", wet), ("the dry reference stop: ", dry)):
+            if stop["untrusted"]:  # a failed point, its reason in the sweep's error record
+                raise ValueError(label + stop["untrusted"][0])
         d, d0 = wet["stopping_distance"], dry["stopping_distance"]
         out = {**wet, "dry_stopping_distance": d0, "extension": d - d0,
                "extension_percent": 100.0 * (d - d0) / d0}  # fmt: skip
@@ -168,7 +205,8 @@ class BrakingStudy(SweepModel):
         return {"model": "braking stops: railadhesion.braking.simulate with WILAC adhesion "
                          "(Trummer et al. 2017) and the default WILAC set",
                 "vehicle": fields_, "wsp_settings": self.wsp_settings, "dt": self.dt,
-                "max_time": self.max_time}  # fmt: skip
+                "max_time": self.max_time,
+                "max_pressure": self.cylinder_max_pressure}  # fmt: skip
 
 
 def plot_extension_distribution(ds, by: str = "water_flow", *, bins: int = 8, ax=None):
@@ -229,7 +267,8 @@ _DISTRIBUTIONS = {"uniform": 2, "normal": 2, "lognormal": 2, "choice": 1}
 
 @dataclass
 class StudySpec:
-    """A validated study spec (``railadhesion study SPEC.toml --out DIR``)."""
+    """A validated study spec (``railadhesion study SPEC.toml --out DIR``); ``warnings`` holds
+    the careless values found when loading it (each also issued as a warning)."""
 
     model: BrakingStudy
     grid: dict
@@ -237,6 +276,7 @@ class StudySpec:
     chunks: dict
     title: str = ""
     source: str = ""
+    warnings: tuple = ()
 
     def plan(self):
         from railadhesion.sweeps.plan import plan_sweep
@@ -245,21 +285,61 @@ class StudySpec:
                           chunk_points=4)  # fmt: skip
 
 
+def _plausible_study(name: str, model: BrakingStudy, grid: dict, fixed: dict) -> tuple:
+    """Warnings for careless values of a study spec (module notes), naming the field."""
+    from railadhesion.plausibility import AlteredResultWarning, check_plausible, warn
+
+    def values(key):  # (field, values) of a study input: swept, drawn, fixed or default
+        if key in grid:
+            return f"grid.{key}", np.asarray(grid[key], dtype=float)
+        for dim, columns in grid.items():
+            if isinstance(columns, dict) and key in columns:
+                return f"distributions.{key} (along {dim})", np.asarray(columns[key], float)
+        if key in fixed:
+            return f"fixed.{key}", np.asarray(fixed[key], dtype=float)
+        return f"{key} (default)", np.asarray(STUDY_INPUTS[key][2], dtype=float)
+
+    found = []
+    for key in ("initial_speed", "water_flow", "brake_pressure"):
+        where, x = values(key)
+        if x.size:
+            found.append(check_plausible(x, key, where=f"{name}: {where}"))
+    where, x = values("brake_pressure")
+    limit = model.cylinder_max_pressure
+    if x.size and float(np.max(x)) > limit:
+        given = "study.max_pressure" if model.max_pressure is not None else (
+            "the cylinders' default; set study.max_pressure")  # fmt: skip
+        found.append(warn(
+            f"{name}: {where} reaches {float(np.max(x)):g} Pa, above the brake cylinders' "
+            f"max_pressure = {limit:g} Pa ({given}): the cylinders will hold {limit:g} Pa, not "
+            "the demand (docs/checks.md)", AlteredResultWarning,
+        ))  # fmt: skip
+    return tuple(f for f in found if f)
+
+
 def load_study_spec(path) -> StudySpec:
     """Read and validate a study spec; errors name the file and the field.
 
     Format (``format = "railadhesion-study"``, ``format_version = 1``): ``[study]`` vehicle,
-    dt, max_time, wsp_settings; ``[design]`` kind = "factorial" or "monte_carlo" (with n and
-    seed); ``[grid]`` swept inputs (lists or ranges, as in sweep specs); ``[distributions]``
-    (Monte Carlo) input = ["uniform", low, high] | ["normal", mean, sd] |
-    ["lognormal", mean_of_log, sd_of_log] | ["choice", [values]]; ``[fixed]`` other inputs.
+    dt, max_time, max_pressure (the cylinders' limit [Pa]), wsp_settings; ``[design]`` kind =
+    "factorial" or "monte_carlo" (with n and seed); ``[grid]`` swept inputs (lists or ranges,
+    as in sweep specs); ``[distributions]`` (Monte Carlo) input = ["uniform", low, high] |
+    ["normal", mean, sd] | ["lognormal", mean_of_log, sd_of_log] | ["choice", [values]];
+    ``[fixed]`` other inputs.
     See ``examples/braking_study.toml``.
     """
     import tomllib
     from pathlib import Path
 
     from railadhesion.sweeps.plan import monte_carlo
-    from railadhesion.sweeps.spec import SpecError, _axis, _fail, _int, _keys, _num
+    from railadhesion.sweeps.spec import (
+        SpecError,
+        axis_values,
+        check_keys,
+        fail_field,
+        int_field,
+        number_field,
+    )
 
     path = Path(path)
     try:
@@ -269,93 +349,94 @@ def load_study_spec(path) -> StudySpec:
     except tomllib.TOMLDecodeError as exc:
         raise SpecError(f"{path}: not valid TOML: {exc}") from None
     try:
-        _keys(doc, "", ("format", "format_version", "title", "study", "design", "grid",
+        check_keys(doc, "", ("format", "format_version", "title", "study", "design", "grid",
                         "distributions", "fixed", "chunks"),
               ("format", "format_version", "design"))  # fmt: skip
         if doc["format"] != STUDY_FORMAT:
-            _fail("format", f"expected {STUDY_FORMAT!r}, got {doc['format']!r}")
+            fail_field("format", f"expected {STUDY_FORMAT!r}, got {doc['format']!r}")
         if doc["format_version"] != 1:
-            _fail("format_version", f"expected 1, got {doc['format_version']!r}")
+            fail_field("format_version", f"expected 1, got {doc['format_version']!r}")
         study = doc.get("study", {})
-        _keys(study, "study", ("vehicle", "dt", "max_time", "wsp_settings"))
+        check_keys(study, "study", ("vehicle", "dt", "max_time", "max_pressure", "wsp_settings"))
         options = {}
         if "vehicle" in study:
             v = study["vehicle"]
             if not isinstance(v, str):
-                _fail("study.vehicle", f"expected a vehicle name or file, got {v!r}")
+                fail_field("study.vehicle", f"expected a vehicle name or file, got {v!r}")
             options["vehicle"] = str((path.parent / v).resolve()) if v.endswith(".toml") else v
-        for key in ("dt", "max_time"):
+        for key in ("dt", "max_time", "max_pressure"):
             if key in study:
-                options[key] = _num(study[key], f"study.{key}")
+                options[key] = number_field(study[key], f"study.{key}")
                 if options[key] <= 0:
-                    _fail(f"study.{key}", f"expected a number > 0, got {study[key]!r}")
+                    fail_field(f"study.{key}", f"expected a number > 0, got {study[key]!r}")
         if "wsp_settings" in study:
             ws = study["wsp_settings"]
             if not isinstance(ws, dict):
-                _fail("study.wsp_settings", f"expected a table, got {ws!r}")
-            options["wsp_settings"] = {k: _num(v, f"study.wsp_settings.{k}")
+                fail_field("study.wsp_settings", f"expected a table, got {ws!r}")
+            options["wsp_settings"] = {k: number_field(v, f"study.wsp_settings.{k}")
                                        for k, v in ws.items()}  # fmt: skip
         try:
             model = BrakingStudy(**options)
         except (ValueError, TypeError) as exc:
-            _fail("study", str(exc))
+            fail_field("study", str(exc))
         design = doc["design"]
-        _keys(design, "design", ("kind", "n", "seed"), ("kind",))
+        check_keys(design, "design", ("kind", "n", "seed"), ("kind",))
         kind = design["kind"]
         if kind not in ("factorial", "monte_carlo"):
-            _fail("design.kind", f"expected 'factorial' or 'monte_carlo', got {kind!r}")
+            fail_field("design.kind", f"expected 'factorial' or 'monte_carlo', got {kind!r}")
         grid = {}
         for dim, value in doc.get("grid", {}).items():
             if dim not in STUDY_INPUTS:
-                _fail(f"grid.{dim}", f"not a study input; inputs: {', '.join(STUDY_INPUTS)}")
-            grid[dim] = _axis(dim, value, f"grid.{dim}", path.parent)
+                fail_field(f"grid.{dim}", f"not a study input; inputs: {', '.join(STUDY_INPUTS)}")
+            grid[dim] = axis_values(dim, value, f"grid.{dim}", path.parent)
         dists = doc.get("distributions", {})
         if kind == "monte_carlo":
             for key in ("n", "seed"):
                 if key not in design:
-                    _fail(f"design.{key}", "missing (required for a Monte Carlo design)")
-            n = _int(design["n"], "design.n")
-            seed = _int(design["seed"], "design.seed", low=0)
+                    fail_field(f"design.{key}", "missing (required for a Monte Carlo design)")
+            n = int_field(design["n"], "design.n")
+            seed = int_field(design["seed"], "design.seed", low=0)
             if not isinstance(dists, dict) or not dists:
-                _fail("distributions", "a Monte Carlo design needs at least one distribution")
+                fail_field("distributions", "a Monte Carlo design needs at least one distribution")
             checked = {}
             for name, spec in dists.items():
                 where = f"distributions.{name}"
                 if name not in STUDY_INPUTS:
-                    _fail(where, f"not a study input; inputs: {', '.join(STUDY_INPUTS)}")
+                    fail_field(where, f"not a study input; inputs: {', '.join(STUDY_INPUTS)}")
                 if not (isinstance(spec, list) and spec and spec[0] in _DISTRIBUTIONS
                         and len(spec) == 1 + _DISTRIBUTIONS[spec[0]]):  # fmt: skip
-                    _fail(where, "expected [\"uniform\", low, high], [\"normal\", mean, sd], "
+                    fail_field(where, "expected [\"uniform\", low, high], [\"normal\", mean, sd], "
                           "[\"lognormal\", mean_of_log, sd_of_log] or [\"choice\", [values]], "
                           f"got {spec!r}")  # fmt: skip
                 if spec[0] == "choice":
                     if not isinstance(spec[1], list) or not spec[1]:
-                        _fail(where, "choice needs a non-empty list of values")
-                    args = [[_num(x, f"{where}[1]") for x in spec[1]]]
+                        fail_field(where, "choice needs a non-empty list of values")
+                    args = [[number_field(x, f"{where}[1]") for x in spec[1]]]
                 else:
-                    args = [_num(x, f"{where}[{i + 1}]") for i, x in enumerate(spec[1:])]
+                    args = [number_field(x, f"{where}[{i + 1}]") for i, x in enumerate(spec[1:])]
                 checked[name] = (spec[0], *args)
             grid.update(monte_carlo(n, seed, **checked))
         elif dists:
-            _fail("distributions", "only for design.kind = 'monte_carlo'")
+            fail_field("distributions", "only for design.kind = 'monte_carlo'")
         elif "n" in design or "seed" in design:
-            _fail("design.n" if "n" in design else "design.seed",
+            fail_field("design.n" if "n" in design else "design.seed",
                   "only for design.kind = 'monte_carlo'")  # fmt: skip
         if not grid:
-            _fail("grid", "expected at least one swept input")
+            fail_field("grid", "expected at least one swept input")
         fixed = doc.get("fixed", {})
         if not isinstance(fixed, dict):
-            _fail("fixed", f"expected a table, got {fixed!r}")
-        fixed = {k: _num(v, f"fixed.{k}") for k, v in fixed.items()}
-        chunks = {k: _int(v, f"chunks.{k}") for k, v in doc.get("chunks", {}).items()}
+            fail_field("fixed", f"expected a table, got {fixed!r}")
+        fixed = {k: number_field(v, f"fixed.{k}") for k, v in fixed.items()}
+        chunks = {k: int_field(v, f"chunks.{k}") for k, v in doc.get("chunks", {}).items()}
         title = doc.get("title", "")
         if not isinstance(title, str):
-            _fail("title", f"expected a string, got {title!r}")
+            fail_field("title", f"expected a string, got {title!r}")
         spec = StudySpec(model, grid, fixed, chunks, title, str(path))
         try:
             spec.plan()
         except ValueError as exc:
             raise SpecError(str(exc)) from None
+        spec.warnings = _plausible_study(path.name, model, grid, fixed)
         return spec
     except SpecError as exc:
         raise SpecError(f"{path.name}: {exc}") from None
@@ -372,6 +453,10 @@ def run_study(spec: StudySpec, out_dir, **kwargs):
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     attrs = {"spec_file": spec.source, "title": spec.title or "braking study"}
+    if spec.warnings:  # the study records what its spec was warned for
+        import json
+
+        attrs["warnings"] = json.dumps(list(spec.warnings))
     result = run_sweep(spec.plan(), out=out_dir / "study.zarr", attrs=attrs, **kwargs)
     ds = result.dataset.load()
     ds.to_dataframe().reset_index().to_csv(out_dir / "study.csv", index=False)

@@ -6,7 +6,11 @@ import pandas as pd
 import pytest
 
 from railadhesion.braking import Vehicle
-from railadhesion.identification.braking import identify_adhesion
+from railadhesion.identification.brake_tests import (
+    brake_coefficient,
+    brake_coefficient_per_sample,
+    identify_adhesion,
+)
 from railadhesion.identification.curves import fit_adhesion_curves
 from railadhesion.identification.logs import braking_log_from_frame
 
@@ -46,6 +50,46 @@ def test_eq14_returns_the_true_c_on_a_noise_free_log(mode):
     assert res.brake.mean == pytest.approx(c_true, rel=1e-7)
     assert res.brake.std < 1e-7 * c_true
     assert res.brake.n_samples > 5000
+
+
+def test_eq14_per_sample_by_hand_with_running_resistance():
+    # eq. 14 with F_res: c = (M_tot d - F_res - J sum w_dot / R) / (sum p / R)
+    veh = Vehicle(davis_a=1500.0, davis_b=20.0, davis_c=3.0)
+    r, j, m = veh.wheel_radius, veh.wheelset_inertia, veh.total_mass
+    d = np.array([0.9, 1.1, 0.0])
+    wsum = np.array([-8.0, -9.5, 0.0])
+    psum = np.array([12e5, 14e5, 0.0])
+    v = np.array([30.0, 20.0, 10.0])
+    res = 1500.0 + 20.0 * v + 3.0 * v * v
+    c = brake_coefficient_per_sample(d, wsum, psum, veh, resistance=res, where=psum > 0)
+    hand = (m * d[:2] - res[:2] - j * wsum[:2] / r) / (psum[:2] / r)
+    assert c[:2] == pytest.approx(hand, rel=1e-14)
+    assert np.isnan(c[2])  # brake released: no c (no division by zero)
+    # the window path subtracts the same resistance when given the speed
+    wd = np.repeat(wsum[:2, None] / 4, 4, axis=1)
+    p = np.repeat(psum[:2, None] / 4, 4, axis=1)
+    got = brake_coefficient([0.0, 0.1], d[:2], wd, p, veh, speed=v[:2])
+    assert got.per_sample == pytest.approx(hand, rel=1e-14)
+
+
+def test_both_paths_compute_eq14_with_one_function(monkeypatch):
+    from railadhesion.identification import brake_tests
+
+    calls = []
+    law = brake_tests.brake_coefficient_per_sample
+
+    def counted(*args, **kwargs):
+        calls.append(len(np.atleast_1d(args[0])))
+        return law(*args, **kwargs)
+
+    monkeypatch.setattr(brake_tests, "brake_coefficient_per_sample", counted)
+    veh = Vehicle()
+    frame, wdot, d, p = analytic_log(veh, 0.02, n=3000)
+    ident = brake_tests.identify_adhesion(braking_log_from_frame(frame), veh)
+    direct = brake_tests.brake_coefficient(frame["time"], d, wdot, p, veh)
+    assert calls == [3000, 3000]
+    assert direct.mean == pytest.approx(0.02, rel=1e-12)
+    assert ident.brake.mean == pytest.approx(0.02, rel=1e-7)
 
 
 def test_load_transfer_against_hand_calculation():
@@ -158,6 +202,24 @@ def test_threads_do_not_change_the_results(mini_run, mini_vehicle):
     pd.testing.assert_frame_equal(one.windows, two.windows)
     with pytest.raises(ValueError, match="threads"):
         identify_adhesion(log, mini_vehicle, threads=0)
+
+
+def test_default_threads_follow_numba():
+    # the identification uses as many threads as the compiled kernels: numba's setting, not
+    # the cores the process may run on
+    import numba
+
+    from railadhesion.identification.brake_tests import worker_count
+
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        assert worker_count() == 1
+        numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+        assert worker_count() == numba.config.NUMBA_NUM_THREADS
+    finally:
+        numba.set_num_threads(before)
+    assert worker_count(3) == 3
 
 
 def test_loads_of_a_vehicle_that_is_not_affine_in_d(mini_run, mini_vehicle):

@@ -26,15 +26,14 @@ accelerations and pressures: those sums are filtered, which the filter's lineari
 same as summing the filtered channels, to rounding.)
 
 The channels (per segment: speed and deceleration, the eq. 14 sums, each axle's filters and
-derivatives) and then the axles (loads, eq. 10, windows) run in compiled kernels that release
-the GIL, in threads (``threads=``); each is computed alone, so the results do not depend on
-the number of threads. The running resistance ``F_res`` is the vehicle's Davis
-resistance (0 unless given): the paper neglects it (eq. 7).
+derivatives) and then the axles (loads, eq. 10, windows) run in compiled kernels and scipy's
+filters, which release the GIL, in threads (``threads=``); each is computed alone, so the
+results do not depend on the number of threads. The running resistance ``F_res`` is the
+vehicle's Davis resistance (0 unless given): the paper neglects it (eq. 7).
 """
 
 from __future__ import annotations
 
-import os
 import threading
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
@@ -51,16 +50,18 @@ from railadhesion.identification.signals import (
     VEHICLE_CUTOFF,
     WHEEL_CUTOFF,
     FirstOrderFilter,
-    _gradient_weighted,
     gradient_coefficients,
+    gradient_weighted,
 )
 
 __all__ = [
     "BrakeCoefficient",
     "BrakingIdentification",
     "brake_coefficient",
+    "brake_coefficient_per_sample",
     "identify_adhesion",
     "identification_windows",
+    "worker_count",
 ]
 
 #: Samples this close to a segment's ends are not used for the brake coefficient [s].
@@ -285,10 +286,11 @@ def brake_coefficient(
 
     Notes
     -----
-    Eq. 14 (seed 002), from the vehicle's translation (eq. 8) and each wheelset's rotation
-    (eq. 6): ``c = (M_tot d - sum_i J w_dot_i / R) / (sum_i p_i / R)``. The running resistance
-    ``F_res(v)`` of the vehicle, when given, is subtracted from ``M_tot d`` (the paper neglects
-    it). Valid while every wheel turns (a locked wheel's brake torque is not ``c p``).
+    Eq. 14 (seed 002) at every sample is :func:`brake_coefficient_per_sample`, with the sums
+    over the axles of the angular accelerations and pressures. The running resistance
+    ``F_res(v)`` of the vehicle, when given with ``speed``, is subtracted from ``M_tot d`` (the
+    paper neglects it). Valid while every wheel turns (a locked wheel's brake torque is not
+    ``c p``).
 
     Examples
     --------
@@ -308,26 +310,76 @@ def brake_coefficient(
     1.0
     """
     t = np.asarray(time, dtype=float)
-    d = np.asarray(deceleration, dtype=float)
     wd = np.asarray(angular_acceleration, dtype=float)
     p = np.asarray(pressure, dtype=float)
-    r = float(vehicle.wheel_radius)
-    j = float(vehicle.wheelset_inertia)
-    force = float(vehicle.total_mass) * d - j * wd.sum(axis=1) / r
+    resistance = None
     if speed is not None and hasattr(vehicle, "running_resistance"):
-        force = force - np.asarray(vehicle.running_resistance(np.asarray(speed, float)))
+        resistance = vehicle.running_resistance(np.asarray(speed, float))
     ok = np.ones(t.size, bool) if mask is None else np.asarray(mask, bool).copy()
-    return _brake_from_force(t, force, p.sum(axis=1) / r, p.mean(axis=1), ok, min_pressure)
+    return _brake_window(t, deceleration, wd.sum(axis=1), p.sum(axis=1), p.mean(axis=1),
+                         vehicle, resistance, ok, min_pressure)
 
 
-def _brake_from_force(t, force, psum, pmean, ok, min_pressure):
-    """Eq. 14 from its numerator (``M_tot d - F_res - sum J w_dot / R``) and denominator
-    (``sum p / R``) per sample, the mean pressure and the allowed samples."""
-    applied = pmean >= max(float(min_pressure), 1e-9)
-    c = np.full(t.size, np.nan)
-    c[applied] = force[applied] / psum[applied]
-    top = np.max(pmean[ok & applied]) if np.any(ok & applied) else np.inf
-    window = ok & applied & (pmean >= 0.5 * top) & np.isfinite(c)
+def brake_coefficient_per_sample(deceleration, wheel_acceleration_sum, pressure_sum, vehicle, *,
+                                 resistance=None, where=None):
+    """Eq. 14 of seed 002: the brake coefficient c at every sample [N m/Pa].
+
+    ``c = (M_tot d - F_res - sum_i J w_dot_i / R) / (sum_i p_i / R)``, from the vehicle's
+    translation (eq. 8) and each wheelset's rotation (eq. 6). The one implementation of
+    eq. 14: :func:`brake_coefficient` and :func:`identify_adhesion` call it.
+
+    Parameters
+    ----------
+    deceleration : array_like (n,)
+        d = -dv/dt [m/s^2].
+    wheel_acceleration_sum : array_like (n,)
+        Sum over the axles of the angular accelerations w_dot_i [rad/s^2].
+    pressure_sum : array_like (n,)
+        Sum over the axles of the brake-cylinder pressures p_i [Pa].
+    vehicle : Vehicle
+        ``total_mass`` M_tot [kg], ``wheelset_inertia`` J [kg m^2] (each axle),
+        ``wheel_radius`` R [m].
+    resistance : array_like (n,), optional
+        Running resistance F_res [N] (the paper neglects it, eq. 7).
+    where : array_like of bool (n,), optional
+        Samples to compute (the brake applied); NaN elsewhere. Default: every sample.
+
+    Examples
+    --------
+    >>> from railadhesion.braking import Vehicle
+    >>> veh = Vehicle()
+    >>> torque = veh.total_mass * 1.0 * veh.wheel_radius  # 1 m/s^2 with massless wheels
+    >>> c = brake_coefficient_per_sample([1.0], [0.0], [torque / veh.brake_coefficient],
+    ...                                  veh)
+    >>> round(float(c[0] / veh.brake_coefficient), 9)
+    1.0
+    """
+    r = float(vehicle.wheel_radius)
+    force = np.multiply(np.asarray(deceleration, dtype=float), float(vehicle.total_mass))
+    inertia = np.multiply(np.asarray(wheel_acceleration_sum, dtype=float),
+                          float(vehicle.wheelset_inertia))
+    np.divide(inertia, r, out=inertia)
+    np.subtract(force, inertia, out=force)
+    if resistance is not None:
+        np.subtract(force, np.asarray(resistance, dtype=float), out=force)
+    np.divide(np.asarray(pressure_sum, dtype=float), r, out=inertia)  # sum p / R
+    if where is None:
+        return np.divide(force, inertia, out=force)
+    c = np.full(force.shape, np.nan)
+    np.divide(force, inertia, out=c, where=np.asarray(where, dtype=bool))
+    return c
+
+
+def _brake_window(t, deceleration, wheel_acceleration_sum, pressure_sum, pressure_mean,
+                  vehicle, resistance, ok, min_pressure):
+    """:class:`BrakeCoefficient`: eq. 14 where the mean pressure is at least ``min_pressure``,
+    its statistics over the window of steady braking (at least half the largest mean
+    pressure among the allowed samples ``ok``)."""
+    applied = pressure_mean >= max(float(min_pressure), 1e-9)
+    c = brake_coefficient_per_sample(deceleration, wheel_acceleration_sum, pressure_sum,
+                                     vehicle, resistance=resistance, where=applied)
+    top = np.max(pressure_mean[ok & applied]) if np.any(ok & applied) else np.inf
+    window = ok & applied & (pressure_mean >= 0.5 * top) & np.isfinite(c)
     if not window.any():
         raise ValueError(
             "no sample with the brake applied (mean pressure >= "
@@ -539,33 +591,34 @@ def _axle_adhesion(i, wd, p, slip, v, d, wheel, train, valid, substituted, edge,
         rel[k, i] = slip[k, i] / v[k] if fast else np.nan
         use[k, i] = (valid[k, i] and not substituted and fast and wheel[k, i] * r > 0.05 * vr
                      and np.isfinite(x) and not edge[k])
+    finite = np.empty(n)  # the relative slip with NaN read as 0 (numpy.nan_to_num)
+    for k in range(n):
+        finite[k] = _finite(rel[k, i])
     for q in range(seg_a.size):
         a = seg_a[q]
         b = seg_b[q]
         if b - a < 2:
             for k in range(a, b):
                 rel_rate[k, i] = 0.0
-            continue
-        rel_rate[a, i] = (_finite(rel[a + 1, i]) - _finite(rel[a, i])) / (t[a + 1] - t[a])
-        rel_rate[b - 1, i] = (_finite(rel[b - 1, i]) - _finite(rel[b - 2, i])) / (
-            t[b - 1] - t[b - 2])
-        for k in range(a + 1, b - 1):
-            rel_rate[k, i] = (gc[0, k] * _finite(rel[k - 1, i]) + gc[1, k] * _finite(rel[k, i])
-                              + gc[2, k] * _finite(rel[k + 1, i]))
+        else:
+            gradient_weighted(finite, t, gc, a, b, rel_rate[a:b, i], 1.0)
     for k in range(n):
         if not v[k] >= min_speed:
             rel_rate[k, i] = np.nan
 
 
-def _worker_count(threads) -> int:
+def worker_count(threads=None) -> int:
+    """Threads the identification runs in: ``threads`` (>= 1), or by default
+    ``numba.get_num_threads()``, the number the package's compiled kernels use (every core
+    available unless ``NUMBA_NUM_THREADS`` or :func:`numba.set_num_threads` says otherwise)."""
     if threads is None:
-        try:
-            return max(1, len(os.sched_getaffinity(0)))
-        except AttributeError:  # pragma: no cover - not Linux
-            return max(1, os.cpu_count() or 1)
+        import numba
+
+        return max(1, int(numba.get_num_threads()))
     threads = int(threads)
     if threads < 1:
-        raise ValueError(f"threads must be >= 1 (or None for every core), got {threads}")
+        raise ValueError(
+            f"threads must be >= 1 (or None for numba.get_num_threads()), got {threads}")
     return threads
 
 
@@ -638,8 +691,9 @@ def identify_adhesion(
     progress : callable, optional
         Called with the name of each stage (for progress bars).
     threads : int, optional
-        Threads for the channels and axles (compiled kernels that release the GIL); default:
-        every core available. The results do not depend on it.
+        Threads for the channels and axles (compiled kernels and scipy's filters release the
+        GIL); default: :func:`worker_count`, ``numba.get_num_threads()``. The results do not
+        depend on it.
 
     Returns
     -------
@@ -656,7 +710,7 @@ def identify_adhesion(
     check_nonnegative(min_speed, "min_speed")
     check_nonnegative(min_pressure, "min_pressure")
     check_positive(speed_tolerance, "speed_tolerance")
-    workers = _worker_count(threads)
+    workers = worker_count(threads)
     step = progress or (lambda _stage: None)
     n_ax = log.n_axles
     if int(getattr(vehicle, "n_axles", n_ax)) != n_ax:
@@ -741,7 +795,7 @@ def _identify(log, vehicle, pool, step, filter_mode, vehicle_cutoff, wheel_cutof
 
         def vehicle_job(a=a, b=b, slow=slow, fast=fast):
             buf = scratch(0, b - a)
-            _gradient_weighted(train, t, gc, a, b, buf, -1.0)  # d = -dv/dt
+            gradient_weighted(train, t, gc, a, b, buf, -1.0)  # d = -dv/dt
             slow.apply(buf, d_f[a:b])
             fast.apply(train[a:b], v_f[a:b])
 
@@ -749,19 +803,19 @@ def _identify(log, vehicle, pool, step, filter_mode, vehicle_cutoff, wheel_cutof
             ws, ps = scratch(0, b - a), scratch(1, b - a)
             _column_sums(wheel, press, a, b, ws, ps)
             slow.apply(ps, psum[a:b])
-            _gradient_weighted(ws, t[a:b], gc[:, a:b], 0, b - a, ps, 1.0)
+            gradient_weighted(ws, t[a:b], gc[:, a:b], 0, b - a, ps, 1.0)
             slow.apply(ps, jsum[a:b])
 
         def axle_job(i, a=a, b=b, fast=fast):
             w = wheel[:, i]
             buf = scratch(0, b - a)
-            _gradient_weighted(w, t, gc, a, b, buf, 1.0)
+            gradient_weighted(w, t, gc, a, b, buf, 1.0)
             fast.apply(buf, wd2[a:b, i])
             fast.apply(press[a:b, i], p2[a:b, i])
             np.multiply(w[a:b], r, out=buf)
             np.subtract(train[a:b], buf, out=buf)
             fast.apply(buf, slip[a:b, i])
-            _gradient_weighted(slip[:, i], t, gc, a, b, slip_rate[a:b, i], 1.0)
+            gradient_weighted(slip[:, i], t, gc, a, b, slip_rate[a:b, i], 1.0)
 
         jobs += [vehicle_job, eq14_job] + [partial(axle_job, i) for i in range(n_ax)]
     _run_jobs(pool, jobs)
@@ -771,16 +825,11 @@ def _identify(log, vehicle, pool, step, filter_mode, vehicle_cutoff, wheel_cutof
     valid = np.asarray(log.valid, dtype=np.bool_)
     c_ok = np.empty(n, np.bool_)
     _brake_mask(wheel, train, valid, sub, edge, v_f, float(min_speed), r, c_ok)
-    # M_tot d - sum J w_dot / R (- F_res), the same arithmetic in place
-    force = np.multiply(d_f, float(vehicle.total_mass))
-    inertia = np.multiply(jsum, j)
-    np.divide(inertia, r, out=inertia)
-    np.subtract(force, inertia, out=force)
+    resistance = None
     if hasattr(vehicle, "running_resistance"):
-        np.subtract(force, np.asarray(vehicle.running_resistance(v_f), dtype=float), out=force)
-    np.divide(psum, r, out=inertia)  # sum p / R
-    brake = _brake_from_force(t, force, inertia, psum / n_ax, c_ok, min_pressure)
-    del force, inertia
+        resistance = vehicle.running_resistance(v_f)
+    brake = _brake_window(t, d_f, jsum, psum, psum / n_ax, vehicle, resistance, c_ok,
+                          min_pressure)
     c = brake.mean if brake_coefficient_value is None else float(
         check_positive(brake_coefficient_value, "brake_coefficient_value"))
     step("normal loads and adhesion (eqs. 10-13)")
@@ -806,16 +855,20 @@ def _identify(log, vehicle, pool, step, filter_mode, vehicle_cutoff, wheel_cutof
                        edge_fast, t, gc, seg_a, seg_b, j, c, r, float(min_speed),
                        float(load0[i]), float(load1[i]), affine is not None, loads, mu, rel,
                        rel_rate, use)
-        s0, s1, sign = _windows(t, v_f, slip_rate[:, i], use[:, i], segment_index,
-                                float(speed_tolerance), float(min_window),
-                                float(slip_rate_deadband), phase[:, i])
-        found[i] = (s0, s1, sign, _window_sums(s0, s1, v_f, mu[:, i]))
 
     _run_jobs(pool, [partial(adhesion_job, i) for i in range(n_ax)])
     pitch = None
     if getattr(vehicle, "secondary_stiffness", None) is not None:
         pitch = np.asarray(vehicle.pitch_angle(d_f), dtype=float)
     step("identification windows")
+
+    def windows_job(i):
+        s0, s1, sign = _windows(t, v_f, slip_rate[:, i], use[:, i], segment_index,
+                                float(speed_tolerance), float(min_window),
+                                float(slip_rate_deadband), phase[:, i])
+        found[i] = (s0, s1, sign, _window_sums(s0, s1, v_f, mu[:, i]))
+
+    _run_jobs(pool, [partial(windows_job, i) for i in range(n_ax)])
     parts = []
     for i, (s0, s1, sign, sums) in enumerate(found):
         if s0.size == 0:

@@ -1,0 +1,77 @@
+"""Exit codes of the command line and how it reports results that cannot be trusted.
+
+The policy (``docs/CONVENTIONS.md``, "Careless inputs"; ``docs/checks.md``): a command whose
+result is not trustworthy (a fit the quality gate flags, a train that did not stop, NaN
+results, failed sweep points or stops) says why, with the first reason, and exits with
+:data:`EXIT_UNTRUSTED` unless ``--allow-untrusted`` accepts such results knowingly.
+
+=====  ======================================================================================
+code   meaning
+=====  ======================================================================================
+0      done; every result can be trusted (warnings about inputs may have been printed)
+1      an unexpected failure (a bug: please report it)
+2      an error: a bad option, file or input (the message names it); nothing was computed
+3      done, but a result is not trustworthy (the message gives the first reason); outputs
+       are written, so that they can be inspected
+=====  ======================================================================================
+"""
+
+from __future__ import annotations
+
+import math
+
+import typer
+from rich.console import Console
+from rich.markup import escape
+
+#: Exit code of an error (bad option, file or input).
+EXIT_ERROR = 2
+#: Exit code when a result is not trustworthy (and ``--allow-untrusted`` was not given).
+EXIT_UNTRUSTED = 3
+
+ALLOW_HELP = ("Exit with code 0 even if a result is not trustworthy (an untrusted fit, a train "
+              "that did not stop, NaN results, failed points); without it such results exit "
+              "with code 3.")  # fmt: skip
+
+
+def allow_untrusted_option():
+    """The ``--allow-untrusted`` option of the commands that produce results."""
+    return typer.Option(False, "--allow-untrusted", help=ALLOW_HELP)
+
+
+def braking_findings(result, label: str = "") -> list[str]:
+    """Why a braking result is not trustworthy: its ``warnings`` when it is flagged (the
+    ``trusted`` attribute), else a stop that did not end or a non-finite distance."""
+    where = f"{label}: " if label else ""
+    if hasattr(result, "trusted"):
+        if result.trusted:
+            return []
+        found = [where + str(w) for w in getattr(result, "warnings", ())]
+        return found or [where + (getattr(result, "message", "") or "not trusted")]
+    found = []
+    if not getattr(result, "success", True):
+        found.append(where + (getattr(result, "message", "") or "the train did not stop"))
+    distance = getattr(result, "stopping_distance", 0.0)
+    if distance is None or not math.isfinite(float(distance)):
+        found.append(where + f"the stopping distance is {distance} (NaN results)")
+    return found
+
+
+def finish(console: Console, findings, *, allow: bool, what: str = "result") -> None:
+    """Report findings (reasons a result is not trustworthy) and exit accordingly.
+
+    Prints ``<what> not trusted: <first reason>`` (and how many more) and exits with
+    :data:`EXIT_UNTRUSTED`, or only the message when ``allow`` (``--allow-untrusted``).
+    """
+    findings = [str(f) for f in findings if f]
+    if not findings:
+        return
+    more = f" (and {len(findings) - 1} more finding(s))" if len(findings) > 1 else ""
+    console.print(f"[bold red]{escape(what)} not trusted[/bold red]: {escape(findings[0])}"
+                  f"{escape(more)}", highlight=False, soft_wrap=True)  # fmt: skip
+    if allow:
+        console.print("accepted with --allow-untrusted", highlight=False)
+        return
+    console.print(f"exit code {EXIT_UNTRUSTED} (--allow-untrusted accepts such results)",
+                  highlight=False)  # fmt: skip
+    raise typer.Exit(code=EXIT_UNTRUSTED)

@@ -1,0 +1,304 @@
+"""The package's import rules (docs/architecture.md), read from the source with ``ast``.
+
+1. No import circles between modules, counting the imports inside functions.
+2. No private name (``_x``) imported from another module, and no private module imported from
+   outside the package that holds it.
+3. Layers: a module imports only from its own top-level unit or from a lower floor of
+   :data:`FLOORS` (the ground floor's modules may also import each other); every top-level
+   unit has a floor.
+
+Violations that other branches are removing are listed in :data:`PENDING`, with who removes
+them: they are tolerated by the rule tests and expected to vanish by
+:func:`test_pending_violations_are_gone` (an xfail: when it passes, strictly, delete the
+entries it no longer finds and the mark).
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SRC = ROOT / "src"
+PACKAGE = "railadhesion"
+
+#: Floors from the ground up: a top-level unit (a subpackage or a module of the package; ``""``
+#: is the package's ``__init__``) imports only from its own unit or from lower floors.
+FLOORS: tuple[tuple[str, ...], ...] = (
+    ("_validate", "_labelled", "_jit", "plausibility", "numerics"),
+    ("contact",),
+    ("models",),
+    ("", "io"),
+    ("calibration", "braking"),
+    ("identification", "plotting", "export", "sweeps"),
+    ("demo", "cli_checks"),
+    ("cli_braking", "cli_export", "cli_identification", "cli_sweeps", "cli_wsp",
+     "cli_odometry"),
+    ("cli",),
+    ("__main__",),
+)
+
+#: Violations being removed on other branches: (rule, importer, imported, name) -> owner.
+PENDING: dict[tuple[str, str, str, str], str] = {
+    # the circle models.kernels -> models.wilac -> models.polach -> models.kernels
+    ("circle", "railadhesion.models.kernels", "railadhesion.models.polach", ""): "kernels",
+    ("circle", "railadhesion.models.kernels", "railadhesion.models.wilac", ""): "kernels",
+    ("circle", "railadhesion.models.polach", "railadhesion.models.kernels", ""): "kernels",
+    ("circle", "railadhesion.models.polach", "railadhesion.models.wilac", ""): "kernels",
+    ("circle", "railadhesion.models.wilac", "railadhesion.models.kernels", ""): "kernels",
+    ("circle", "railadhesion.models.wilac", "railadhesion.models.polach", ""): "kernels",
+    # contact above models through table.py; models.wilac reading its default file via io
+    ("layer", "railadhesion.contact.table", "railadhesion.models.kernels", ""): "kernels",
+    ("layer", "railadhesion.models.wilac", "railadhesion.io.paramfiles", ""): "kernels",
+    # a braking scenario reads an identified adhesion law: the law's file format must move
+    # below braking (it is in identification/curves.py, which another branch edits)
+    ("layer", "railadhesion.braking.scenario", "railadhesion.identification.curves", ""):
+        "lead, after the merge",
+    **{("private", "railadhesion.braking._kernels", "railadhesion.models.kernels", name):
+       "integrator" for name in ("_factors", "_weights")},
+    **{("private", "railadhesion.contact.fastsim", "railadhesion.contact.kalker", name):
+       "kernels" for name in ("_AOB_MAX", "_AOB_MIN", "_coefficients_scalar")},
+    ("private", "railadhesion.contact.table", "railadhesion.contact.exact",
+     "_check_friction_law"): "kernels",
+    **{("private", "railadhesion.contact.table", "railadhesion.models.kernels", name):
+       "kernels" for name in ("_TASKS_PER_THREAD", "_atan_nonneg", "_chunk", "_exp_into",
+                              "_fill", "_thread_pool")},
+    **{("private", "railadhesion.models.kernels", "railadhesion.contact.kalker", name):
+       "kernels" for name in ("_AOB_MAX", "_AOB_MIN", "_C33_GT_ROWS", "_G_MIN", "_NROW",
+                              "_ROWS")},
+    **{("private", "railadhesion.models.polach", "railadhesion.contact.kalker", name):
+       "kernels" for name in ("_AOB_MAX", "_AOB_MIN")},
+    **{("private", "railadhesion.models.wilac", "railadhesion.models.polach", name):
+       "kernels" for name in ("_kernels", "_polach_reference", "_polach_scalar", "_scalars")},
+    **{("private", "railadhesion.models.wilac", "railadhesion.models.wilac_parameters", name):
+       "kernels" for name in (
+           "_FACTOR_INDEX", "_PAPER_M", "_PAPER_S", "_array_condition", "_as_regression",
+           "_as_transition_key", "_check_pair", "_check_ref", "_compile_condition",
+           "_condition_from_mapping", "_erf_transitions", "_evaluate_condition",
+           "_factor_arrays", "_scalar_condition", "_scalar_factors", "_transition_arrays")},
+}
+
+
+# --- reading the imports ------------------------------------------------------------------
+
+
+def find_modules(src: Path, package: str) -> dict[str, Path]:
+    """Module name -> file, for every ``.py`` file of the package (``__init__`` files give
+    the package's name)."""
+    out = {}
+    for path in sorted((src / package).rglob("*.py")):
+        parts = list(path.relative_to(src).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts.pop()
+        out[".".join(parts)] = path
+    return out
+
+
+def _absolute(module: str, is_package: bool, node: ast.ImportFrom) -> str:
+    if not node.level:
+        return node.module or ""
+    base = module.split(".")
+    if not is_package:
+        base.pop()
+    base = base[: len(base) - (node.level - 1)]
+    return ".".join(base + ([node.module] if node.module else []))
+
+
+def read_imports(modules: dict[str, Path], package: str):
+    """Every import of a module of the package by another, wherever it stands (module level,
+    functions, ``if TYPE_CHECKING``): tuples (importer, imported module, name or "", line).
+    ``from a import b`` with ``a.b`` a module counts as an import of ``a.b``."""
+    found = []
+    for module, path in modules.items():
+        is_package = path.name == "__init__.py"
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
+            if isinstance(node, ast.Import):
+                for alias in node.names:
+                    if alias.name.split(".")[0] == package:
+                        found.append((module, alias.name, "", node.lineno))
+            elif isinstance(node, ast.ImportFrom):
+                target = _absolute(module, is_package, node)
+                if target.split(".")[0] != package:
+                    continue
+                for alias in node.names:
+                    sub = f"{target}.{alias.name}"
+                    if sub in modules:
+                        found.append((module, sub, "", node.lineno))
+                    else:
+                        found.append((module, target, alias.name, node.lineno))
+    return [imp for imp in found if imp[1] != imp[0]]
+
+
+def circles(modules, imports) -> list[set[str]]:
+    """Strongly connected components of more than one module (Tarjan, iterative)."""
+    graph: dict[str, set[str]] = {m: set() for m in modules}
+    for importer, target, _, _ in imports:
+        if target in graph:
+            graph[importer].add(target)
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    out = []
+    for root in graph:
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph[root])))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, children = work[-1]
+            child = next(children, None)
+            if child is None:
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[node])
+                if low[node] == index[node]:
+                    comp = set()
+                    while True:
+                        top = stack.pop()
+                        on_stack.discard(top)
+                        comp.add(top)
+                        if top == node:
+                            break
+                    if len(comp) > 1:
+                        out.append(comp)
+            elif child not in index:
+                index[child] = low[child] = len(index)
+                stack.append(child)
+                on_stack.add(child)
+                work.append((child, iter(sorted(graph[child]))))
+            elif child in on_stack:
+                low[node] = min(low[node], index[child])
+    return out
+
+
+def _private(name: str) -> bool:
+    return name.startswith("_") and not name.startswith("__")
+
+
+def unit(module: str) -> str:
+    """Top-level unit of a module: ``railadhesion.models.polach`` -> ``models``."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else ""
+
+
+def violations(src: Path = SRC, package: str = PACKAGE, floors=FLOORS):
+    """Every breach of the three rules, as (rule, importer, imported, name) -> line."""
+    modules = find_modules(src, package)
+    imports = read_imports(modules, package)
+    found: dict[tuple[str, str, str, str], int] = {}
+    for comp in circles(modules, imports):
+        for importer, target, _, line in imports:
+            if importer in comp and target in comp:
+                found.setdefault(("circle", importer, target, ""), line)
+    floor_of = {u: k for k, row in enumerate(floors) for u in row}
+    for importer, target, name, line in imports:
+        if name and _private(name):
+            found.setdefault(("private", importer, target, name), line)
+        parent, _, last = target.rpartition(".")
+        if _private(last) and not (importer + ".").startswith(parent + "."):
+            found.setdefault(("private", importer, target, ""), line)
+        a, b = unit(importer), unit(target)
+        fa, fb = floor_of.get(a, -1), floor_of.get(b, -1)
+        if a != b and (fb > fa or fb == fa > 0):  # the ground floor's modules may share
+            found.setdefault(("layer", importer, target, ""), line)
+    for module in modules:
+        if unit(module) not in floor_of:
+            found.setdefault(("no floor", module, "", ""), 0)
+    return found
+
+
+def _show(items) -> str:
+    return "\n".join(f"  {rule}: {imp} -> {tgt}{'.' + n if n else ''} (line {line})"
+                     for (rule, imp, tgt, n), line in sorted(items))
+
+
+# --- the rules ----------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def found():
+    return violations()
+
+
+@pytest.mark.parametrize("rule", ["circle", "private", "layer", "no floor"])
+def test_no_violation_beyond_the_pending_ones(found, rule):
+    new = {k: v for k, v in found.items() if k[0] == rule and k not in PENDING}
+    assert not new, f"{rule} violations (docs/architecture.md):\n{_show(new.items())}"
+
+
+@pytest.mark.xfail(strict=True, reason="being removed on the 'kernels' and 'integrator' "
+                   "branches, and braking.scenario -> identification.curves after the merge")
+def test_pending_violations_are_gone(found):
+    left = {k: found[k] for k in PENDING if k in found}
+    assert not left, "still there:\n" + _show(left.items())
+
+
+def test_the_floors_are_those_of_the_architecture_page():
+    # the table of docs/architecture.md lists the same floors, ground floor first
+    text = (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8")
+    rows = re.findall(r"^\| (\d+) \| ([^|]+) \|", text, flags=re.MULTILINE)
+    assert [int(k) for k, _ in rows] == list(range(len(FLOORS)))
+    for (_, cell), row in zip(rows, FLOORS, strict=True):
+        names = {n.strip("`/ ").removesuffix(".py") for n in cell.split(",")}
+        names = {"" if n == "__init__" else n for n in names}
+        assert names == set(row), (cell, row)
+
+
+# --- the checker itself -------------------------------------------------------------------
+
+
+def _tree(tmp_path: Path, files: dict[str, str]) -> Path:
+    for name, text in files.items():
+        path = tmp_path / "src" / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text, encoding="utf-8")
+    return tmp_path / "src"
+
+
+def test_the_checker_finds_each_kind_of_violation(tmp_path):
+    src = _tree(tmp_path, {
+        "pkg/__init__.py": "",
+        "pkg/low/__init__.py": "",
+        "pkg/low/a.py": "def f():\n    from pkg.low import b  # inside a function\n",
+        "pkg/low/b.py": "from .a import f\nfrom pkg.low._c import g\n",
+        "pkg/low/_c.py": "def g():\n    pass\n",
+        "pkg/high.py": "import pkg.low.a\nfrom pkg.low.b import _hidden\nfrom pkg.low import _c\n",
+        "pkg/stray.py": "",
+    })
+    found = violations(src, "pkg", (("low",), ("high",)))
+    assert set(found) == {
+        ("circle", "pkg.low.a", "pkg.low.b", ""),
+        ("circle", "pkg.low.b", "pkg.low.a", ""),
+        ("private", "pkg.high", "pkg.low.b", "_hidden"),
+        ("private", "pkg.high", "pkg.low._c", ""),
+        ("no floor", "pkg.stray", "", ""),
+        ("no floor", "pkg", "", ""),
+    }
+    # the same tree read upside down: every import of high from low is upward
+    found = violations(src, "pkg", (("high", "stray", ""), ("low",)))
+    assert {k for k in found if k[0] == "layer"} == {
+        ("layer", "pkg.high", "pkg.low.a", ""),
+        ("layer", "pkg.high", "pkg.low.b", ""),
+        ("layer", "pkg.high", "pkg.low._c", ""),
+    }
+    # side by side: allowed on the ground floor only
+    for floors, expected in (((("high", "low", "stray", ""),), set()),
+                             (((), ("high", "low", "stray", "")), {"pkg.low.a", "pkg.low.b",
+                                                                    "pkg.low._c"})):
+        found = violations(src, "pkg", floors)
+        assert {k[2] for k in found if k[0] == "layer"} == expected
+
+
+def test_the_package_is_read_whole():
+    modules = find_modules(SRC, PACKAGE)
+    assert {"railadhesion", "railadhesion.models.polach", "railadhesion.cli"} <= set(modules)
+    imports = read_imports(modules, PACKAGE)
+    # a function-level import is seen (cli imports the identification pipeline in a command)
+    assert any(i == "railadhesion.cli_identification" and t.startswith(
+        "railadhesion.identification") for i, t, _, _ in imports)
