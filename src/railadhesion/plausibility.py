@@ -56,6 +56,10 @@ __all__ = [
     "MIN_R_SQUARED_SCATTER",
     "MAX_RELATIVE_STDERR",
     "MIN_REGION_POINTS",
+    "MAX_NOISE_RATIO",
+    "MIN_NOISE_POINTS",
+    "noise_rms",
+    "explains_data",
     "fit_warnings",
     "is_trusted",
     "first_reason",
@@ -537,11 +541,63 @@ MAX_RELATIVE_STDERR = 1.0
 MIN_REGION_POINTS = 3
 
 
+#: Largest ratio of a fit's residual RMS to the data's own noise (:func:`noise_rms`) at which
+#: a low R^2 is put down to a nearly flat curve rather than to the model (an assumption: the
+#: residual of the right model is the noise, and the noise estimate is itself uncertain).
+MAX_NOISE_RATIO = 1.5
+#: Fewest samples from which :func:`noise_rms` estimates the noise (with fewer, the curve's own
+#: change between samples dominates the successive differences; an assumption).
+MIN_NOISE_POINTS = 10
+
+
+def noise_rms(x, y) -> float:
+    """Standard deviation of the noise of samples ``y(x)``, from successive differences.
+
+    ``sqrt(sum((y[k+1] - y[k])^2) / (2 (n - 1)))`` with the samples in order of ``x``: the
+    mean square successive difference of J. von Neumann et al., Ann. Math. Statist. 12
+    (1941) 153-162, which the noise dominates when the curve changes little from one sample
+    to the next. Where the curve itself changes between samples it over-estimates the noise
+    (the check that uses it is then more lenient, never stricter). NaN for fewer than
+    :data:`MIN_NOISE_POINTS` samples.
+
+    >>> import numpy as np
+    >>> rng = np.random.default_rng(0)
+    >>> x = np.linspace(0.0, 1.0, 2000)
+    >>> round(noise_rms(x, 0.15 + 0.01 * x + rng.normal(0.0, 0.004, x.size)), 4)
+    0.004
+    """
+    xs = np.asarray(x, dtype=float).ravel()
+    ys = np.asarray(y, dtype=float).ravel()
+    if ys.size < MIN_NOISE_POINTS or xs.size != ys.size:
+        return math.nan
+    d = np.diff(ys[np.argsort(xs, kind="stable")])
+    return float(np.sqrt(np.mean(d * d) / 2.0))
+
+
+def explains_data(r_squared: float, *, residual_rms: float | None = None,
+                  noise: float | None = None, min_r_squared: float = MIN_R_SQUARED) -> bool:
+    """Whether a fit describes its data: R^2 at least ``min_r_squared``, or else (a nearly flat
+    curve, whose variance is mostly noise, has a low R^2 even when the model is right) a
+    residual RMS within :data:`MAX_NOISE_RATIO` times the data's noise (:func:`noise_rms`).
+
+    >>> explains_data(0.8, residual_rms=0.004, noise=0.004)   # flat wet curve, right model
+    True
+    >>> explains_data(0.0004, residual_rms=0.03, noise=0.004)  # wrong model
+    False
+    """
+    if r_squared >= min_r_squared:
+        return True
+    if residual_rms is None or noise is None:
+        return False
+    return bool(residual_rms <= MAX_NOISE_RATIO * noise)  # NaN: False
+
+
 def fit_warnings(*, r_squared: float, params: Mapping[str, float], fitted: Sequence[str],
                  stderr: Mapping[str, float], at_bound: Sequence[str] = (),
                  region_points: Mapping[str, tuple[int, str]] | None = None,
                  min_r_squared: float = MIN_R_SQUARED, success: bool = True,
-                 ignore_stderr: Sequence[str] = ()) -> tuple[str, ...]:  # fmt: skip
+                 ignore_stderr: Sequence[str] = (), residual_rms: float | None = None,
+                 noise: float | None = None) -> tuple[str, ...]:  # fmt: skip
     """The quality gate of every fit: why its result should not be trusted (empty if none).
 
     Flags a low R^2, fitted parameters ending on a bound of the search, non-finite or very
@@ -562,6 +618,10 @@ def fit_warnings(*, r_squared: float, params: Mapping[str, float], fitted: Seque
         ``{parameter: (points, "description of the region")}``.
     min_r_squared : float
         Smallest acceptable R^2.
+    residual_rms, noise : float, optional
+        The fit's residual RMS and the data's noise (:func:`noise_rms`): a low R^2 is not
+        flagged when the residual is within :data:`MAX_NOISE_RATIO` times the noise
+        (:func:`explains_data`).
     success : bool
         The optimiser converged.
     ignore_stderr : sequence of str
@@ -576,7 +636,8 @@ def fit_warnings(*, r_squared: float, params: Mapping[str, float], fitted: Seque
     out = []
     if not success:
         out.append("the optimiser did not converge")
-    if not (r_squared >= min_r_squared):  # NaN fails too
+    if not explains_data(r_squared, residual_rms=residual_rms, noise=noise,
+                         min_r_squared=min_r_squared):  # NaN fails too
         out.append(f"R^2 = {r_squared:.3g} is below {min_r_squared:g}: the model does not "
                    "describe the data")  # fmt: skip
     for name in fitted:

@@ -19,7 +19,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from railadhesion._validate import check_finite, check_nonnegative, check_positive, check_range
-from railadhesion.plausibility import UntrustedResultWarning, fit_warnings, warn
+from railadhesion.plausibility import UntrustedResultWarning, fit_warnings, noise_rms, warn
 
 __all__ = [
     "FLETCHER_DEFAULT_BOUNDS",
@@ -409,7 +409,8 @@ def _run_fit(model_name, names, residual, starts, lo, hi, fitted, fixed, s, y, c
     )  # fmt: skip
     flags = fit_warnings(
         r_squared=float(r2), params=params, fitted=fitted, stderr=stderr, at_bound=outside,
-        success=bool(best.success), **(gate(params) if gate is not None else {}),
+        success=bool(best.success), residual_rms=float(np.sqrt(ssr / n)),
+        noise=noise_rms(np.abs(s), y), **(gate(params) if gate is not None else {}),
     )  # fmt: skip
     if flags and warn_untrusted:
         warn(f"{model_name} fit not trusted: " + "; ".join(flags), UntrustedResultWarning)

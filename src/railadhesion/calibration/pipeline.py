@@ -47,7 +47,7 @@ from railadhesion.calibration.fitting import POLACH_NAMES, FitResult, fit_polach
 from railadhesion.calibration.regression import RegressionFit, build_regression
 from railadhesion.io.creepcurves import CreepCurve, read_creep_curves
 from railadhesion.models.regression import ParameterRegression
-from railadhesion.plausibility import MIN_R_SQUARED
+from railadhesion.plausibility import MIN_R_SQUARED, explains_data, noise_rms
 
 __all__ = [
     "CalibrationWarning",
@@ -181,8 +181,9 @@ class WilacCalibration:
         The check of each condition on a grid between the data points.
     warnings : tuple of str
         Every problem found: the checks between the data points, and curves whose own Polach
-        fit has R² below :data:`railadhesion.plausibility.MIN_R_SQUARED` (the model does not
-        describe them); empty when the set can be trusted over its calibrated range.
+        fit does not describe them (R² below :data:`railadhesion.plausibility.MIN_R_SQUARED`
+        with a residual above the curve's noise: :func:`railadhesion.plausibility.explains_data`);
+        empty when the set can be trusted over its calibrated range.
     """
 
     parameters: object
@@ -666,7 +667,10 @@ def run_wilac_calibration(
         f"curve {cf.curve.name or Path(cf.curve.source).name} ({cf.condition}): its own Polach "
         f"fit has R^2 = {cf.fit.r_squared:.3g} < {MIN_R_SQUARED:g}"
         + ("" if cf.fit.success else ", not converged")
-        for cf in curve_fits if not (cf.fit.r_squared >= MIN_R_SQUARED and cf.fit.success)
+        for cf in curve_fits
+        if not (cf.fit.success and explains_data(
+            cf.fit.r_squared, residual_rms=cf.fit.rmse,
+            noise=noise_rms(np.abs(cf.fit.creep), cf.fit.adhesion)))
     )  # fmt: skip
     if problems:
         warnings.warn(

@@ -105,6 +105,13 @@ class FirstOrderFilter:
         self._sosfilt = signal.sosfilt
         self._sosfiltfilt = signal.sosfiltfilt
 
+    @property
+    def coefficients(self) -> tuple[float, float, float]:
+        """``(b0, b1, a1)`` of the one-pass difference equation
+        ``y[k] = b0 x[k] + b1 x[k-1] - a1 y[k-1]`` (from :attr:`sos`), for a sample-by-sample
+        filter such as the on-board monitor's."""
+        return float(self.sos[0, 0]), float(self.sos[0, 1]), float(self.sos[0, 4])
+
     def padlen(self, n: int) -> int:
         """Samples of odd extension at each end for a signal of ``n`` samples: three time
         constants of the requested cut-off (``3 fs/fc``), at most ``n - 1``."""
