@@ -59,8 +59,6 @@ PENDING: dict[tuple[str, str, str, str], str] = {
     # below braking (it is in identification/curves.py, which another branch edits)
     ("layer", "railadhesion.braking.scenario", "railadhesion.identification.curves", ""):
         "lead, after the merge",
-    **{("private", "railadhesion.braking._kernels", "railadhesion.models.kernels", name):
-       "integrator" for name in ("_factors", "_weights")},
     **{("private", "railadhesion.contact.fastsim", "railadhesion.contact.kalker", name):
        "kernels" for name in ("_AOB_MAX", "_AOB_MIN", "_coefficients_scalar")},
     ("private", "railadhesion.contact.table", "railadhesion.contact.exact",
@@ -234,8 +232,8 @@ def test_no_violation_beyond_the_pending_ones(found, rule):
     assert not new, f"{rule} violations (docs/architecture.md):\n{_show(new.items())}"
 
 
-@pytest.mark.xfail(strict=True, reason="being removed on the 'kernels' and 'integrator' "
-                   "branches, and braking.scenario -> identification.curves after the merge")
+@pytest.mark.xfail(strict=True, reason="being removed on the 'kernels' branch, and "
+                   "braking.scenario -> identification.curves after the merge")
 def test_pending_violations_are_gone(found):
     left = {k: found[k] for k in PENDING if k in found}
     assert not left, "still there:\n" + _show(left.items())

@@ -320,10 +320,18 @@ def test_demand_above_the_cylinder_limit_is_reported_not_silently_clipped():
 
 
 def test_a_stop_that_does_not_end_is_untrusted():
+    import warnings
+
     from railadhesion.plausibility import UntrustedResultWarning
 
-    with pytest.warns(UntrustedResultWarning, match="did not stop within max_time"):
-        res = simulate(VEHICLE, PolachAdhesion(), 20.0, 2e5, dt=4e-3, max_time=2.0)
+    # a whole stop expected (max_time left at 600 s): flagged and warned
+    with pytest.warns(UntrustedResultWarning, match="did not stop within max_time = 600 s"):
+        res = simulate(VEHICLE, PolachAdhesion(), 40.0, 1e4, dt=4e-3)
     assert not res.trusted and not res.summary["trusted"] and res.status == 1
     assert math.isnan(res.stopping_distance)
-    assert res.summary["warnings"] == res.warnings
+    assert res.summary["warnings"] == res.warnings and len(res.warnings) == 1
+    # the first seconds of a stop asked for: flagged, not warned
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        res = simulate(VEHICLE, PolachAdhesion(), 20.0, 2e5, dt=4e-3, max_time=2.0)
+    assert not res.trusted and "did not stop within max_time = 2 s" in res.warnings[0]

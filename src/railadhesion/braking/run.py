@@ -164,7 +164,8 @@ def summarise(sim: BrakingSimulator, h: pd.DataFrame) -> dict:
 
 def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
              brake=3.0e5, *, cylinders: BrakeCylinders | None = None, wsp=None,
-             control_period: float | None = None, dt: float = 1e-3, max_time: float = 600.0,
+             control_period: float | None = None, dt: float = 1e-3,
+             max_time: float | None = None,
              gradient: float = 0.0, refresh_period: float = 0.01, stop_speed: float = 0.05,
              progress: Callable[[float], None] | None = None,
              compiled: bool = True) -> BrakingResult:
@@ -194,6 +195,13 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
         Simulation step [s]; the control period must be a whole multiple of it. A step too
         large for the wheel dynamics is refused (``ValueError`` naming the largest stable
         step, :func:`~railadhesion.braking.simulator.largest_stable_step`).
+    max_time : float, optional
+        Longest simulated time [s] (default 600 s). A stop that does not end within it is a
+        result flagged untrusted (``trusted`` False, the reason in ``warnings``); with the
+        default the flag comes with an
+        :class:`~railadhesion.plausibility.UntrustedResultWarning` (a whole stop was
+        expected), with a ``max_time`` of your own it does not (you asked for the first
+        seconds of a stop).
     progress : callable, optional
         Called now and then with the fraction of the initial speed lost (0 … 1).
     compiled : bool
@@ -207,9 +215,8 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
     Returns
     -------
     BrakingResult
-        ``trusted`` is False (with an
-        :class:`~railadhesion.plausibility.UntrustedResultWarning`) when the train did not
-        stop within ``max_time`` or a result is NaN.
+        ``trusted`` is False when the train did not stop within ``max_time`` (see there) or
+        a result is NaN (with an :class:`~railadhesion.plausibility.UntrustedResultWarning`).
     """
     demand = BrakeDemand(float(brake)) if isinstance(brake, int | float) else brake
     if not callable(demand):
@@ -227,7 +234,9 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
         if ratio < 1 or abs(ratio * dt - controller.period) > 1e-9 * controller.period:
             raise ValueError(f"the control period ({controller.period} s) must be a whole "
                              f"multiple of dt ({dt} s)")
-    if not (math.isfinite(max_time) and max_time > 0):
+    expected_stop = max_time is None  # a whole stop expected: an unfinished one is warned of
+    max_time = 600.0 if max_time is None else max_time
+    if not (isinstance(max_time, int | float) and math.isfinite(max_time) and max_time > 0):
         raise ValueError(f"max_time must be in (0, inf) s, got {max_time!r}")
     builtin_wsp = controller is None or type(controller) is WheelSlideProtection
     compiled_loop = compiled and type(demand) is BrakeDemand and builtin_wsp
@@ -269,10 +278,10 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
         progress(1.0)
     summary = summarise(sim, h)
     if not sim.stopped:
-        notes.append(warn(
-            f"the train did not stop within max_time = {max_time:g} s (speed {sim.speed:.4g} "
-            f"m/s left): the stopping distance and time are unknown (NaN); the result is "
-            "untrusted", UntrustedResultWarning))
+        note = (f"the train did not stop within max_time = {max_time:g} s (speed "
+                f"{sim.speed:.4g} m/s left): the stopping distance and time are unknown (NaN); "
+                "the result is untrusted")
+        notes.append(warn(note, UntrustedResultWarning) if expected_stop else note)
     elif not (math.isfinite(summary["stopping_distance_m"]) and np.all(np.isfinite(
             h[["time", "distance", "train_speed"]].to_numpy()))):
         notes.append(warn("the simulation gave NaN results; the result is untrusted",
