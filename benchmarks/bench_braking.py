@@ -226,7 +226,7 @@ def main() -> None:
     rest = headline - empty - side - compiled
     print("  components of one advance() call:")
     print(f"    Python loop (for, if)                     {empty * 1e9:6.0f} ns")
-    print(f"    Python side of the call (method + numba dispatcher, 2 arrays, dt, aux) "
+    print(f"    Python side of the call (method + numba dispatcher, one buffer + dt) "
           f"{side * 1e9:6.0f} ns")
     print(f"    compiled step (same steps in one compiled loop) {compiled * 1e9:6.0f} ns, of "
           f"which the 10 ms refresh {refresh * 1e9 / 10:.0f} ns "
