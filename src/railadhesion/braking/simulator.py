@@ -596,9 +596,10 @@ class BrakingSimulator:
         tau, where = largest_stable_step(self.vehicle, self.adhesion, self.initial_speed)
         if self.max_step > tau:
             raise ValueError(
-                f"max_step (the time step) {self.max_step:g} s is too large for the wheel "
-                f"dynamics: the largest stable step is {tau:.3g} s. On the falling branch of "
-                f"the creep curve ({where['condition']}: dμ/dξ = {where['slope']:.3g} at "
+                f"the time step {self.max_step:g} s (dt of simulate and of a study, "
+                f"time_step_s of a scenario, max_step of BrakingSimulator) is too large for "
+                f"the wheel dynamics: the largest stable step is {tau:.3g} s. On the falling "
+                f"branch of the creep curve ({where['condition']}: dμ/dξ = {where['slope']:.3g} at "
                 f"creepage {where['creep']:.3g}, speed {where['speed_m_s']:.3g} m/s, axle load "
                 f"{where['axle_load_N']:.4g} N) a wheel's slide grows with the time constant "
                 f"J v/(R² N |dμ/dξ|) = {tau:.3g} s; use a step of at most {tau:.3g} s")
