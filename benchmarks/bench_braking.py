@@ -11,16 +11,20 @@
    driver writing into those arrays would. Real-time factor = simulated time / wall time.
    The same loop is also timed with all 8 inputs copied in every call, and with recording.
 2. The per-call cost broken into components: the Python loop, the Python side of the call
-   (the closure and the numba entry point, measured on a stopped simulator, which returns at
+   (the method and numba's dispatcher, measured on a stopped simulator, which returns at
    once), the compiled step itself (the same steps run inside one compiled loop), its
    refresh share, and the rest (the cost of entering compiled code from the interpreter:
    cold caches and branch predictors).
 3. ``step(dt, {"pressure_command": ..., "valves": ...})``: the mapping API (inputs checked
    in Python, a snapshot returned), for comparison.
 4. A whole 200 km/h -> 0 emergency stop with WSP on the damp rail (``simulate``), compiled
-   loop, 1 ms step, 5 ms WSP period; and the same in the Python loop (``compiled=False``).
+   loop, 1 ms step, 5 ms WSP period; and the same with ``compiled=False`` (a Python loop
+   calling the WSP between steps, and the adhesion model's Python methods called back from
+   the step).
 
 Timings are the minimum over repeats (the machine is shared; the load average is printed).
+The headline loop is also timed in CPU time (``time.process_time``), which waiting for a
+core on a loaded machine does not inflate.
 """
 
 from __future__ import annotations
@@ -41,7 +45,6 @@ from railadhesion.braking import (
     WilacAdhesion,
     simulate,
 )
-from railadhesion.braking import _layout as L
 
 VEHICLE = Vehicle()
 PROFILE = WaterFlowProfile.sections([(50.0, 5000.0, 25.0)])
@@ -62,17 +65,17 @@ def valve_state(k):
     return 2.0 if (k // PERIOD) % 4 == 3 else 0.0
 
 
-def hil_loop(steps, record=False):
+def hil_loop(steps, record=False, clock=time.perf_counter):
     """The headline loop: inputs written in place when they change, one advance per 1 ms."""
     sim = new_sim(record)
     valves = sim.inputs.valves
     advance = sim.advance
-    t0 = time.perf_counter()
+    t0 = clock()
     for k in range(steps):
         if k % PERIOD == 0:
             valves[:] = valve_state(k)
         advance(DT)
-    return (time.perf_counter() - t0) / steps, sim
+    return (clock() - t0) / steps, sim
 
 
 def hil_loop_copying(steps):
@@ -115,9 +118,9 @@ def empty_loop(steps):
 
 
 def python_side(steps):
-    """advance() on a stopped simulator: the closure and the numba entry, no step."""
+    """advance() on a stopped simulator: the method and numba's dispatcher, no step."""
     sim = new_sim()
-    sim._buf[L.STOPPED_] = 1.0
+    sim._machine[0]["state"]["stopped"] = 1
     advance = sim.advance
     t0 = time.perf_counter()
     for _ in range(steps):
@@ -128,25 +131,25 @@ def python_side(steps):
 def compiled_loop_kernel():
     from numba import njit
 
-    from railadhesion.braking import _kernels as kern
+    from railadhesion.braking import step
 
     @njit
-    def loop(buf, work, steps, dt):
+    def loop(machine, tables, steps, dt):
+        valves = machine[0].inputs.valves
         for k in range(steps):
             if k % PERIOD == 0:
                 v = 2.0 if (k // PERIOD) % 4 == 3 else 0.0
-                for i in range(work.shape[1] if work.shape[1] < 4 else 4):
-                    work[L.R_VIN, i] = v
-            kern.step_free(buf, work, dt)
+                for i in range(4):
+                    valves[i] = v
+            step.advance_unrecorded(machine, tables, dt, 0)
 
     return loop
 
 
 def compiled_steps(loop, steps, refresh_period=0.01):
     sim = new_sim(refresh_period=refresh_period)
-    buf, work = sim._buf, sim._work
     t0 = time.perf_counter()
-    loop(buf, work, steps, DT)
+    loop(sim._machine, sim._tables, steps, DT)
     return (time.perf_counter() - t0) / steps, sim
 
 
@@ -154,23 +157,24 @@ def refresh_cost(repeats):
     """One refresh of the adhesion inputs (loads, water, WILAC parameters, lanes) [s]."""
     from numba import njit
 
-    from railadhesion.braking import _kernels as kern
+    from railadhesion.braking import step
 
     @njit
-    def loop(buf, work, n):
+    def loop(machine, tables, n):
+        m = machine[0]
         for _ in range(n):
-            buf[L.V_] += 1e-9
-            kern._refresh(buf, work)
+            m.state.speed += 1e-9
+            step._refresh(m.state, m.settings, tables, 0)
 
     sim = new_sim()
     for _ in range(1000):  # into the damp section: all four WILAC conditions active
         sim.advance(DT)
-    buf, work = sim._buf.copy(), sim._work.copy()
-    loop(buf, work, 10)
+    machine, tables = sim._machine.copy(), sim._tables
+    loop(machine, tables, 10)
     best = math.inf
     for _ in range(repeats):
         t0 = time.perf_counter()
-        loop(buf, work, 5000)
+        loop(machine, tables, 5000)
         best = min(best, (time.perf_counter() - t0) / 5000)
     return best
 
@@ -197,6 +201,7 @@ def main() -> None:
         return min(fn(*args) for _ in range(repeats))
 
     headline = min(hil_loop(steps)[0] for _ in range(repeats))
+    headline_cpu = min(hil_loop(steps, clock=time.process_time)[0] for _ in range(repeats))
     _, sim = hil_loop(steps)
     counts = sim.solver_counts
     copying = best(hil_loop_copying, steps)
@@ -210,6 +215,8 @@ def main() -> None:
           f"{steps * DT:.0f} s simulated:")
     print(f"  per call {headline * 1e9:6.0f} ns -> real-time factor {DT / headline:6.0f}x "
           "(inputs written in place when they change)")
+    print(f"  per call {headline_cpu * 1e9:6.0f} ns of CPU time -> {DT / headline_cpu:6.0f}x "
+          "(the same loop in CPU time)")
     print(f"  per call {copying * 1e9:6.0f} ns -> real-time factor {DT / copying:6.0f}x "
           "(all 8 inputs copied in every call)")
     print(f"  per call {recording * 1e9:6.0f} ns -> real-time factor {DT / recording:6.0f}x "
@@ -219,7 +226,7 @@ def main() -> None:
     rest = headline - empty - side - compiled
     print("  components of one advance() call:")
     print(f"    Python loop (for, if)                     {empty * 1e9:6.0f} ns")
-    print(f"    Python side of the call (closure + numba entry point, 2 arrays + dt) "
+    print(f"    Python side of the call (method + numba dispatcher, one buffer + dt) "
           f"{side * 1e9:6.0f} ns")
     print(f"    compiled step (same steps in one compiled loop) {compiled * 1e9:6.0f} ns, of "
           f"which the 10 ms refresh {refresh * 1e9 / 10:.0f} ns "

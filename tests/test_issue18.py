@@ -1,9 +1,8 @@
 """The careless inputs of issue 18, one by one: each gives an error, a warning naming the field
 and the likely cause, or a non-zero exit code.
 
-The braking run-time items (the pressure cap at run time, the standstill clamp, the largest
-stable step, the flags of a stop that did not end) are built on the integrator branch: their
-tests are here too, marked ``xfail(strict=False, reason="integrator branch")``.
+The braking run-time items are here too: the pressure cap at run time, the standstill clamp,
+the largest stable step, the flags of a stop that did not end.
 """
 
 from __future__ import annotations
@@ -33,7 +32,6 @@ sys.path.insert(0, str(ROOT / "tests" / "identification"))
 import minisim  # noqa: E402
 
 runner = CliRunner()
-INTEGRATOR = pytest.mark.xfail(strict=False, reason="integrator branch")
 
 SCENARIO = """
 format = "railadhesion-brake-scenario"
@@ -113,7 +111,6 @@ def test_scenario_demand_above_the_default_limit_warns(tmp_path):
     load_scenario(_scenario(tmp_path, 5.5e5, 6.0e5))  # given a limit above the demand: quiet
 
 
-@INTEGRATOR
 def test_simulate_reports_the_pressure_cap_at_run_time():
     from railadhesion.braking import WheelSlideProtection, WilacAdhesion, load_vehicle, simulate
 
@@ -391,7 +388,6 @@ def test_identified_law_on_the_tests_own_log_is_trusted(mini_log):
 # ------------------------------------------------- 7. the physics review's findings
 
 
-@INTEGRATOR
 def test_speed_never_negative_at_standstill():
     from railadhesion.braking import PolachAdhesion, load_vehicle, simulate
 
@@ -402,7 +398,6 @@ def test_speed_never_negative_at_standstill():
     assert np.nanmax(np.abs(creep)) <= 1.0
 
 
-@INTEGRATOR
 def test_a_step_too_large_for_the_wheels_is_refused_naming_the_largest_stable_step():
     from railadhesion.braking import PolachAdhesion, load_vehicle, simulate
 
@@ -411,7 +406,6 @@ def test_a_step_too_large_for_the_wheels_is_refused_naming_the_largest_stable_st
                  dt=0.05)  # fmt: skip
 
 
-@INTEGRATOR
 def test_a_stop_that_did_not_end_is_flagged():
     from railadhesion.braking import PolachAdhesion, load_vehicle, simulate
 

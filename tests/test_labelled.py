@@ -207,7 +207,7 @@ W1 = ra.fletcher_condition("W1")
 # qualified name -> (call with the varying labelled argument x, x, expected units by field:
 # "" for a single result, the index for plain tuples, the field name otherwise)
 UNITS = {
-    "railadhesion.adhesion": (CASES["adhesion"][0], CASES["adhesion"][1], {"": "1"}),
+    "railadhesion.contact.traction.adhesion": (*CASES["adhesion"], {"": "1"}),
     "railadhesion.models.polach.polach_forces": (*CASES["polach_forces"], {"0": "N", "1": "N"}),
     "railadhesion.models.polach.Polach.forces": (*CASES["Polach.forces"], {"0": "N", "1": "N"}),
     "railadhesion.models.polach.Polach.adhesion": (
@@ -299,7 +299,6 @@ def _labelled_functions():
                 code = getattr(fn, "__code__", None)
                 if code is not None and code.co_filename.startswith("<labelled "):
                     found.add(f"{module.__name__}.{qual}")
-    found.add("railadhesion.adhesion")
     return found
 
 

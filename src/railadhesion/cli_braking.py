@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
 import typer
@@ -11,6 +12,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from railadhesion.cli_checks import allow_untrusted_option, braking_findings, finish
+from railadhesion.plausibility import RailadhesionWarning
 
 console = Console()
 
@@ -86,13 +88,15 @@ def register(app: typer.Typer) -> None:
             console.print(f"[red]error:[/red] {escape(str(exc))}")
             raise typer.Exit(code=2) from None
         try:
-            if quiet:
-                result, dry = run_scenario(sc, dt=dt)
-            else:
-                with Progress(console=console, transient=True) as bar:
-                    task = bar.add_task("braking (speed lost)", total=1.0)
-                    result, dry = run_scenario(
-                        sc, dt=dt, progress=lambda f: bar.update(task, completed=f))
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", RailadhesionWarning)
+                if quiet:
+                    result, dry = run_scenario(sc, dt=dt)
+                else:
+                    with Progress(console=console, transient=True) as bar:
+                        task = bar.add_task("braking (speed lost)", total=1.0)
+                        result, dry = run_scenario(
+                            sc, dt=dt, progress=lambda f: bar.update(task, completed=f))
             findings = braking_findings(result)
             if dry is not None:
                 findings += braking_findings(dry, "the dry-rail comparison")
@@ -100,6 +104,12 @@ def register(app: typer.Typer) -> None:
         except (SimulationError, ValueError) as exc:
             console.print(f"[red]error:[/red] {escape(str(exc))}")
             raise typer.Exit(code=2) from None
+        for w in caught:  # the package's warnings, each once; others as Python shows them
+            if not issubclass(w.category, RailadhesionWarning):
+                warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+        for message in dict.fromkeys(str(w.message) for w in caught
+                                     if issubclass(w.category, RailadhesionWarning)):
+            console.print(f"[yellow]warning:[/yellow] {escape(message)}")
         s = result.summary
         table = Table(title=escape(sc.name or str(scenario)))
         table.add_column("quantity")
@@ -120,6 +130,10 @@ def register(app: typer.Typer) -> None:
         table.add_row("mean adhesion utilisation", f"{s['mean_adhesion_utilisation']:.3f}")
         table.add_row(escape("WSP vent actions / vented air [l]"),
                       f"{s['vent_actions']} / {s['vented_air_l']:.0f}")
+        if s.get("pressure_clipped"):
+            demand, cap = s["highest_command_Pa"] / 1e5, s["max_pressure_Pa"] / 1e5
+            table.add_row(escape("brake demand clipped to max_pressure [bar]"),
+                          f"{demand:.3g} -> {cap:.3g}")
         table.add_row("trusted", "yes" if not findings else f"NO ({len(findings)} finding(s))")
         console.print(table)
         console.print(f"outputs written to {escape(str(out))}")

@@ -4,6 +4,8 @@ hardware-in-the-loop stepping API (``advance``, in-place inputs, live state)."""
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from railadhesion.braking import (
     BrakeCylinders,
@@ -14,8 +16,6 @@ from railadhesion.braking import (
     WheelSlideProtection,
     WilacAdhesion,
 )
-from railadhesion.braking import _layout as L
-from railadhesion.braking.adhesion import polach_family_curve
 from railadhesion.braking.run import BrakeDemand
 
 VEHICLE = Vehicle(name="test coach")
@@ -26,12 +26,10 @@ DAMP = WaterFlowProfile.sections([(10.0, 400.0, 25.0)])
 def _stop(newton_tol, compiled=True, v0=15.0, dt=2e-3):
     """A damp-rail stop with WSP; ``newton_tol`` 0 forces the safeguarded solve every step."""
     sim = BrakingSimulator(VEHICLE, WilacAdhesion(DAMP), v0, cylinders=CYL, max_step=dt,
-                           compiled=compiled)
-    sim._buf[L.NEWTON_TOL_] = newton_tol
-    wsp = WheelSlideProtection(period=4e-3)
-    wsp.reset(4, VEHICLE.wheel_radius)
-    sim._configure_run(wsp, BrakeDemand(5.5e5), int(round(wsp.period / dt)))
-    sim._run_compiled(int(100 / dt), dt, None, v0)
+                           compiled=compiled, wsp=WheelSlideProtection(period=4e-3))
+    sim._machine[0]["settings"]["newton_tol"] = newton_tol
+    sim.configure_run(BrakeDemand(5.5e5))
+    sim.run_compiled(int(100 / dt), dt)
     return sim
 
 
@@ -117,14 +115,14 @@ def test_python_path_takes_the_same_newton_iterations():
                             "valves": [0, 0, 0, 0] if (k // 60) % 2 == 0 else [2, 2, 1, 0]})
         runs.append(sim)
     fast, slow = runs
-    assert fast._use_compiled and not slow._use_compiled
+    assert fast.runs_compiled and not slow.runs_compiled
     assert fast.solver_counts == slow.solver_counts
     assert fast.solver_counts["newton_iterations"] > fast.solver_counts["steps"]
     np.testing.assert_allclose(fast.omega, slow.omega, rtol=1e-10)
     assert fast.distance == pytest.approx(slow.distance, rel=1e-12)
 
 
-def test_adhesion_available_tracking_matches_a_full_search():
+def test_adhesion_available_tracking_matches_a_full_search(polach_curve):
     # slowly changing conditions: the tracked peak stays within 1e-7 of a fresh full search
     q = np.array([31e3, 31e3, 26e3, 26e3])
     tracked = WilacAdhesion(25.0)
@@ -137,32 +135,37 @@ def test_adhesion_available_tracking_matches_a_full_search():
         fresh.bind(4, 0.46)
         fresh.prepare(speed, loads, np.zeros(4), 0.01 * k)
         np.testing.assert_allclose(got, fresh.available(speed), rtol=1e-7)
-    assert tracked._work[L.R_PK_N, 0] == 30  # 29 of 30 calls tracked
+    assert tracked._workspace[0]["peak_calls"] == 30  # 29 of 30 calls tracked
     # and a brute-force maximum on a fine grid agrees
     grid = np.geomspace(1e-4, 1.0, 20001)
-    mu, _ = polach_family_curve(np.repeat(grid, 4), speed, np.tile(fresh.weights, (grid.size, 1)),
-                                np.tile(fresh.params, (grid.size, 1, 1)),
-                                np.tile(fresh.stiffness, grid.size))
+    mu, _ = polach_curve(np.repeat(grid, 4), speed, np.tile(fresh.weights, (grid.size, 1)),
+                         np.tile(fresh.params, (grid.size, 1, 1)),
+                         np.tile(fresh.stiffness, grid.size))
     np.testing.assert_allclose(got, mu.reshape(grid.size, 4).max(axis=0), rtol=1e-6)
 
 
-def test_wilac_parameters_equal_the_library_regressions():
-    from railadhesion.braking._kernels import wilac_table
-    from railadhesion.models.kernels import pack_wilac
-    from railadhesion.models.wilac import WILAC_CONDITIONS, default_wilac_parameters
+def test_wilac_axle_parameters_equal_the_library_regressions():
+    """Per axle, the WILAC kernel's weights and regressions; a bogie pair (same load) and
+    equal water flows reuse the axle before, and must give the same numbers."""
+    from railadhesion.braking.curves import wilac_axle_parameters
+    from railadhesion.models.kernels import (
+        pack_wilac,
+        wilac_condition_parameters,
+        wilac_weights_scalar,
+    )
+    from railadhesion.models.wilac import default_wilac_parameters
 
-    wilac = default_wilac_parameters()
-    packed = pack_wilac(wilac)
-    program = L.wilac_program(packed)
+    packed = pack_wilac(default_wilac_parameters())
     loads = np.array([36e3, 36e3, 21e3, 52e3])  # a bogie pair (reused), then distinct
-    water = np.array([0.0, 12.0, 25.0, 60.0])
+    water = np.array([12.0, 12.0, 25.0, 60.0])
     weights, params = np.empty((4, 4)), np.empty((4, 4, 5))
-    wilac_table(packed, program, loads, 31.0, water, weights, params, np.empty(7),
-                np.empty(int(program[0])))
+    wilac_axle_parameters(packed, loads, 31.0, water, weights, params, np.empty(7),
+                          np.empty(20))
+    ref = np.empty(20)
     for a in range(4):
-        ref = [list(wilac.polach_parameters(c, loads[a], 31.0).values()) for c in WILAC_CONDITIONS]
-        np.testing.assert_allclose(params[a], np.ravel(ref).reshape(4, 5), rtol=1e-13,
-                                   atol=1e-15)  # fmt: skip
+        wilac_condition_parameters(loads[a], 31.0, packed, np.empty(7), ref)
+        np.testing.assert_array_equal(params[a].ravel(), ref)
+        np.testing.assert_array_equal(weights[a], wilac_weights_scalar(water[a], packed))
 
 
 def test_new_parameters_before_the_first_step_rebuild_the_simulator():
@@ -207,27 +210,157 @@ def test_numba_adhesion_function_runs_compiled_with_the_python_path_numbers():
 
     with pytest.warns(UserWarning, match="Python path"):
         sim = BrakingSimulator(VEHICLE, CallableAdhesion(arrays_only), 10.0)
-    assert not sim._use_compiled
+    assert not sim.runs_compiled
 
 
-def test_stale_layout_cache_is_purged(tmp_path):
-    """The kernels freeze _layout's constants at compile time while numba keys its cache on
-    _kernels.py alone: cached code built against another layout must be dropped."""
-    from railadhesion._jit import source_checksum
-    from railadhesion.braking import _kernels as kern
-    from railadhesion.braking import _layout
-    from railadhesion.models import kernels as models_kernels
+def test_builtin_wsp_in_the_stepping_api_equals_the_whole_stop():
+    """The WSP runs inside the step for the stepping API too (valve inputs then ignored)."""
+    from railadhesion.braking import simulate
 
-    # the cached code was built with the current layout and models.kernels source
-    current = _layout.fingerprint() ^ source_checksum(models_kernels)
-    assert kern._LAYOUT_FINGERPRINT == current
-    assert kern._compiled_layout_fingerprint() == current
-    names = ["_kernels.step-1072.py311.nbi", "_kernels.step-1072.py311.1.nbc",
-             "_kernels._advance-918.py311.nbi", "simulator.cpython-311.pyc",
-             "kernels.polach-10.py311.nbi"]
-    for name in names:
-        (tmp_path / name).write_text("x")
-    assert kern.purge_stale_cache(tmp_path, 7, 7) == []  # same layout: nothing touched
-    gone = kern.purge_stale_cache(tmp_path, 7, 8)
-    assert sorted(p.name for p in gone) == sorted(names[:3])
-    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(names[3:])
+    wsp = WheelSlideProtection(period=4e-3)
+    ref = simulate(VEHICLE, WilacAdhesion(DAMP), 15.0, 5.5e5, cylinders=CYL, wsp=wsp, dt=2e-3)
+    sim = BrakingSimulator(VEHICLE, WilacAdhesion(DAMP), 15.0, cylinders=CYL, max_step=2e-3,
+                           wsp=WheelSlideProtection(period=4e-3))
+    sim.inputs.pressure_command[:] = 5.5e5
+    sim.inputs.valves[:] = 2.0  # ignored: the built-in WSP commands the valves
+    while not sim.stopped:
+        sim.advance(4e-3)  # two sub-steps per call, the WSP every 4 ms
+    assert ref.summary["vent_actions"] > 3
+    assert sim.stop_distance == pytest.approx(ref.stopping_distance, rel=1e-12)
+    np.testing.assert_array_equal(sim.vent_actions, [a["vent_actions"] for a in
+                                                    ref.summary["axles"]])
+    np.testing.assert_allclose(sim.histories().to_numpy(), ref.histories.to_numpy(),
+                               rtol=1e-12, atol=1e-12)
+
+
+def test_the_step_runs_as_a_c_function_on_the_records():
+    """The native-FMU route: the step compiled as a C callback over record pointers gives the
+    stepping API's numbers (same code, no Python in between)."""
+    import ctypes
+
+    from numba import carray, cfunc, types
+    from numba.np.numpy_support import from_dtype
+
+    from railadhesion.braking import step
+
+    machine_type = from_dtype(step.MACHINE)
+    sig = types.int64(types.CPointer(machine_type), types.CPointer(types.float64),
+                      types.int64, types.float64)
+
+    @cfunc(sig, error_model="numpy")
+    def c_step(machine_ptr, tables_ptr, n_tables, dt):
+        m = carray(machine_ptr, (1,))[0]
+        return step.step(m.state, m.settings, m.inputs, m.wsp_settings, m.wsp_state,
+                         m.sensor_settings, m.sensor_state, carray(tables_ptr, (n_tables,)),
+                         None, dt, 0)
+
+    call = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_int64,
+                            ctypes.c_double)(c_step.address)
+    a, b = (BrakingSimulator(VEHICLE, WilacAdhesion(DAMP), 12.0, cylinders=CYL, max_step=1e-3,
+                             record=False) for _ in range(2))
+    for sim in (a, b):
+        sim.inputs.pressure_command[:] = 5.5e5
+    for k in range(2000):
+        valves = 2.0 if (k // 150) % 3 == 2 else 0.0
+        a.inputs.valves[:] = b.inputs.valves[:] = valves
+        status = call(a._machine.ctypes.data, a._tables.ctypes.data, a._tables.size, 1e-3)
+        b.advance(1e-3)
+        assert status in (0, 1)
+    assert a.distance == b.distance and a.speed == b.speed
+    np.testing.assert_array_equal(a.omega, b.omega)
+    np.testing.assert_array_equal(a.vent_actions, b.vent_actions)
+
+
+def test_stale_compiled_code_is_refused():
+    """A machine built for other sources than the compiled step's is refused (numba's cache
+    keys the step on step.py alone), not run with other offsets."""
+    sim = BrakingSimulator(VEHICLE, PolachAdhesion("polach2005_dry"), 10.0)
+    sim._machine[0]["fingerprint"] += 1
+    with pytest.raises(RuntimeError, match="stale cache"):
+        sim.advance(1e-3)
+    assert sim.time == 0.0
+
+
+def test_errors_of_a_python_adhesion_model_reach_the_caller():
+    def law(creep, speed):
+        if speed < 9.9:
+            raise ZeroDivisionError("the user's law failed")
+        return 0.3 * np.tanh(100.0 * creep)
+
+    from railadhesion.braking import CallableAdhesion, simulate
+
+    with pytest.raises(ZeroDivisionError, match="user's law"):
+        simulate(VEHICLE, CallableAdhesion(law), 10.0, 3e5, dt=2e-3)
+
+
+def test_records_name_every_input_of_the_c_interface():
+    """The records a C host fills: fixed sizes, C layout, the fingerprint first."""
+    from railadhesion.braking import records, step
+
+    assert step.MACHINE.names[:4] == ("fingerprint", "state", "settings", "inputs")
+    assert step.MACHINE.fields["fingerprint"][1] == 0
+    assert step.MACHINE.isalignedstruct
+    for dtype in (records.STATE, records.SETTINGS, records.INPUTS, records.CURVE):
+        assert dtype.isalignedstruct and dtype.itemsize % 8 == 0
+    assert records.INPUTS.names == ("pressure_command", "valves", "torque")
+    assert records.STATE["omega"].shape == (records.MAX_AXLES,)
+
+
+@pytest.mark.parametrize("n_axles", [2, 6, 12])
+def test_every_axle_count_up_to_the_record_size(n_axles):
+    """12 axles under WILAC's four conditions fill every lane of the records."""
+    from railadhesion.braking import simulate
+
+    veh = Vehicle(name=f"{n_axles} axles", n_axles=n_axles)
+    cyl = BrakeCylinders(max_pressure=6e5, valves="bogie" if n_axles == 2 else "axle")
+    res = simulate(veh, WilacAdhesion(WaterFlowProfile.constant(18.0)), 12.0, 5.5e5,
+                   cylinders=cyl, wsp=WheelSlideProtection(period=4e-3), dt=2e-3)
+    assert res.success and len(res.summary["axles"]) == n_axles
+    h = res.histories
+    assert np.all(np.isfinite(h.to_numpy()[1:]))
+    assert abs(res.summary["energy"]["balance_error"]) < 5e-3
+    # the stepping API and its Python-model path give the same stop
+    sims = [BrakingSimulator(veh, WilacAdhesion(WaterFlowProfile.constant(18.0)), 12.0,
+                             cylinders=cyl, max_step=2e-3, compiled=flag, record=False)
+            for flag in (True, False)]
+    for sim in sims:
+        sim.inputs.pressure_command[:] = 5.5e5
+        for _ in range(300):
+            sim.advance(2e-3)
+    np.testing.assert_allclose(sims[0].omega, sims[1].omega, rtol=1e-9)
+    assert sims[0].speed == pytest.approx(sims[1].speed, rel=1e-12)
+
+
+@settings(max_examples=25, deadline=None)
+@given(n_axles=st.sampled_from([2, 4, 8]), mu0=st.floats(0.05, 0.6),
+       big_a=st.floats(0.2, 1.0), big_b=st.floats(0.0, 1.0),
+       commands=st.lists(st.tuples(st.floats(0.0, 8e5), st.integers(0, 2)), min_size=4,
+                         max_size=12),
+       dt=st.sampled_from([5e-4, 1e-3, 2.5e-3]), v0=st.floats(1.0, 40.0))  # fmt: skip
+def test_step_invariants_under_any_valve_and_command_sequence(n_axles, mu0, big_a, big_b,
+                                                              commands, dt, v0):
+    """Speeds never negative, distance never decreasing, and the kinetic energy of train and
+    wheels never rising (brakes and creep only dissipate on a level track), whatever the
+    inputs; a long call equals the same sub-steps called one by one."""
+    from railadhesion.models.parameters import PolachParameters
+
+    veh = Vehicle(name="v", n_axles=n_axles)
+    law = PolachParameters(mu0=mu0, A=big_a, B=big_b, k_A=0.6, k_S=0.3, name="random")
+    make = lambda: BrakingSimulator(veh, PolachAdhesion(law), v0, max_step=dt,  # noqa: E731
+                                    cylinders=BrakeCylinders(max_pressure=9e5), record=False)
+    a, b = make(), make()
+    ke = a.kinetic_energy
+    distance = 0.0
+    for command, valve in commands:
+        for sim in (a, b):
+            sim.inputs.pressure_command[:] = command
+            sim.inputs.valves[:] = valve
+        a.advance(25 * dt)
+        for _ in range(25):
+            b.advance(dt)
+        assert a.speed >= 0.0 and np.all(a.omega >= 0.0)
+        assert a.distance >= distance
+        assert a.kinetic_energy <= ke * (1 + 1e-12) + 1e-9
+        ke, distance = a.kinetic_energy, a.distance
+        assert a.distance == b.distance and a.speed == b.speed
+        np.testing.assert_array_equal(a.omega, b.omega)

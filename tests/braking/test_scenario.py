@@ -212,3 +212,25 @@ def test_cli_brake_writes_outputs(tmp_path):
     bad.write_text(DAMP.replace("pressure_Pa = 5.5e5", "pressure_Pa = -1.0"))
     res = CliRunner().invoke(app, ["brake", str(bad), "--out", str(out)])
     assert res.exit_code == 2 and "brake.pressure_Pa" in res.output
+
+
+def test_cli_brake_reports_a_clipped_demand_and_refuses_a_too_large_step(tmp_path):
+    path = tmp_path / "capped.toml"
+    path.write_text(DAMP.replace("max_pressure_Pa = 6.0e5", "max_pressure_Pa = 3.8e5")
+                    .replace("initial_speed_m_s = 25.0", "initial_speed_m_s = 8.0"))
+    out = tmp_path / "out"
+    res = CliRunner().invoke(app, ["brake", str(path), "--out", str(out), "--quiet",
+                                   "--no-figures"])
+    assert res.exit_code == 0, res.output
+    text = " ".join(res.output.split())
+    assert "warning: the brake demand 550000 Pa (5.5 bar) is above" in text
+    assert "clipped to max_pressure" in text and "5.5 -> 3.8" in text
+    summary = json.loads((out / "summary.json").read_text())
+    # clipped (an altered result, flagged), not untrusted: no untrust reasons in the file
+    assert summary["pressure_clipped"] and summary["trusted"] and summary["warnings"] == []
+    # the 40 ms step on a damp rail (a WSP period of 40 ms too): refused, the
+    # largest stable step named
+    path.write_text(DAMP.replace("period_s = 0.005", "period_s = 0.04"))
+    res = CliRunner().invoke(app, ["brake", str(path), "--out", str(out), "--quiet",
+                                   "--dt", "0.04"])
+    assert res.exit_code == 2 and "largest stable step" in " ".join(res.output.split())

@@ -17,7 +17,6 @@ from railadhesion.braking import (
     WilacAdhesion,
     simulate,
 )
-from railadhesion.braking.adhesion import polach_family_curve
 from railadhesion.models import polach_forces, wilac_forces
 from railadhesion.models.wilac import default_wilac_parameters
 
@@ -81,8 +80,9 @@ def test_energy_balance_from_histories_damp_with_wsp():
     assert abs(res.summary["energy"]["balance_error"]) < 5e-3
 
 
-def test_python_path_matches_compiled_path():
-    # the same Polach curve through the generic (NumPy) path and the compiled kernel
+def test_python_path_matches_compiled_path(polach_curve):
+    # the same Polach curve as a model in Python (an independent NumPy oracle, called back
+    # by the step) and as the step's compiled law
     family = PolachAdhesion("polach2005_wet")
 
     class Wrapped(CallableAdhesion):
@@ -90,8 +90,8 @@ def test_python_path_matches_compiled_path():
             family.prepare(speed, normal_loads, positions, time, dissipation)
 
         def evaluate(self, creep, speed):
-            return polach_family_curve(creep, speed, family.weights, family.params,
-                                       family.stiffness)
+            return polach_curve(creep, speed, family.weights, family.params,
+                                family.stiffness)
 
         def available(self, speed):
             return family.available(speed)
@@ -205,7 +205,7 @@ def test_stepping_api_compiled_matches_python():
         return sim, state
 
     (fast, a), (slow, b) = run(True), run(False)
-    assert fast.compiled and fast._use_compiled and not slow._use_compiled
+    assert fast.compiled and fast.runs_compiled and not slow.runs_compiled
     np.testing.assert_allclose(a.wheel_speeds, b.wheel_speeds, rtol=1e-10)
     assert a.distance == pytest.approx(b.distance, rel=1e-12)
     np.testing.assert_allclose(fast.histories().to_numpy(), slow.histories().to_numpy(),
@@ -229,3 +229,109 @@ def test_fletcher_condition_as_user_callable_and_xarray_result():
     np.testing.assert_allclose(ds["train_speed"].values, res.histories["train_speed"])
     # the slip adhesion used never exceeds the friction coefficient of the condition
     assert ds["adhesion_used"].max() <= water.mu + 1e-9
+
+
+# --- careless inputs (issue 18): standstill, step size, pressure cap, unfinished stops --------
+
+COACH_DAMP = WaterFlowProfile.sections([(50.0, 900.0, 25.0)])
+
+
+@pytest.mark.parametrize("wsp", [False, True])
+def test_speed_never_goes_negative_at_standstill(wsp):
+    # the issue's case: stop_speed 1e-6 made the train speed -1.7 mm/s and a creep of -1657
+    from railadhesion.braking import WheelSlideProtection
+
+    kwargs = dict(cylinders=BrakeCylinders(max_pressure=6e5), dt=2.5e-3,
+                  wsp=WheelSlideProtection() if wsp else None)
+    res = simulate(VEHICLE, WilacAdhesion(COACH_DAMP), 20.0, 5.5e5, stop_speed=1e-6, **kwargs)
+    ref = simulate(VEHICLE, WilacAdhesion(COACH_DAMP), 20.0, 5.5e5, **kwargs)
+    h = res.histories
+    omega = h[[f"wheel_speed_{i}" for i in range(1, 5)]].to_numpy()
+    creep = h[[f"creep_{i}" for i in range(1, 5)]].to_numpy()
+    assert res.success and res.trusted
+    assert h["train_speed"].min() >= 0.0 and omega.min() >= 0.0
+    assert np.all(np.abs(creep) <= 1.0)  # braking creep in [0, 1]; never beyond
+    last = h.iloc[-1]
+    if last["train_speed"] == 0.0:  # at rest: the creepage is defined as 0, wheels at rest
+        assert np.all(creep[-1] == 0.0) and np.all(omega[-1] == 0.0)
+    # the last 5 cm/s add v²/(2d) to the default stop: the two stops agree to a few cm
+    assert res.stopping_distance == pytest.approx(ref.stopping_distance, abs=0.05)
+    assert res.stopping_time >= ref.stopping_time - 0.01
+
+
+def test_train_at_rest_within_a_step_stops_where_friction_stops_it():
+    # large steps, locked wheels, the train comes to rest inside a step: v = 0, not below
+    res = simulate(VEHICLE, PolachAdhesion("polach2005_wet"), 3.0, 6e5,
+                   cylinders=BrakeCylinders(max_pressure=6e5), dt=0.05, stop_speed=1e-9)
+    h = res.histories
+    assert h["train_speed"].iloc[-1] == 0.0 and h["train_speed"].min() == 0.0
+    assert res.stopping_time <= h["time"].iloc[-1] + 1e-12
+    assert res.stopping_time > h["time"].iloc[-2]
+    assert np.all(np.isfinite(h.to_numpy()[1:]))
+
+
+def test_a_step_too_large_for_the_wheel_dynamics_is_refused_with_the_largest_stable_step():
+    from railadhesion.braking.simulator import largest_stable_step
+
+    coach = Vehicle(name="coach")
+    tau, where = largest_stable_step(coach, WilacAdhesion(COACH_DAMP), 44.44)
+    # the reported step is the slide time constant J v / (R² N |dμ/dξ|) at the reported point
+    expected = coach.wheelset_inertia * where["speed_m_s"] / (
+        coach.wheel_radius**2 * where["axle_load_N"] * abs(where["slope"]))
+    assert tau == pytest.approx(expected, rel=1e-12)
+    assert 0.005 < tau < 0.03 and where["condition"] == "WILAC at 25 µl/s"
+    for dt in (0.04, 0.05):  # the issue's steps: now refused up front, the cause named
+        with pytest.raises(ValueError, match=rf"largest stable step is {tau:.3g} s"):
+            simulate(coach, WilacAdhesion(COACH_DAMP), 44.44, 5.5e5, dt=dt)
+    # just below it the stop is computed, and close to the 1 ms stop
+    step = math.floor(tau * 1e3) / 1e3
+    a = simulate(coach, WilacAdhesion(COACH_DAMP), 44.44, 5.5e5, dt=step,
+                 cylinders=BrakeCylinders(max_pressure=6e5))
+    b = simulate(coach, WilacAdhesion(COACH_DAMP), 44.44, 5.5e5, dt=1e-3,
+                 cylinders=BrakeCylinders(max_pressure=6e5))
+    assert a.stopping_distance == pytest.approx(b.stopping_distance, rel=2e-3)
+    # a curve that never falls allows any step
+    assert largest_stable_step(coach, CallableAdhesion(ample), 44.44)[0] == math.inf
+
+
+def test_demand_above_the_cylinder_limit_is_reported_not_silently_clipped():
+    import warnings
+
+    from railadhesion.braking import WheelSlideProtection, load_vehicle
+    from railadhesion.plausibility import AlteredResultWarning
+
+    coach = load_vehicle("coach_default")
+    with pytest.warns(AlteredResultWarning, match=r"550000 Pa \(5.5 bar\).*380000 Pa"):
+        res = simulate(coach, WilacAdhesion(COACH_DAMP), 44.44, 5.5e5,
+                       wsp=WheelSlideProtection())
+    assert res.summary["pressure_clipped"] and res.summary["max_pressure_Pa"] == 3.8e5
+    assert res.warnings and "5.5 bar" in res.warnings[0] and res.summary["warnings"]
+    assert res.trusted  # altered, not untrusted: the stop at 3.8 bar is computed correctly
+    assert res.stopping_distance == pytest.approx(728.3, abs=0.05)  # the issue's number
+    # a function of time above the limit: reported after the run
+    with pytest.warns(AlteredResultWarning, match="clipped to it in"):
+        simulate(VEHICLE, PolachAdhesion(), 5.0, lambda t: 4e5 if t > 0.5 else 1e5,
+                 dt=4e-3)
+    with warnings.catch_warnings():  # within the limit: no warning, no flag
+        warnings.simplefilter("error")
+        res = simulate(coach, WilacAdhesion(COACH_DAMP), 44.44, 5.5e5,
+                       cylinders=BrakeCylinders(max_pressure=6e5), wsp=WheelSlideProtection())
+    assert not res.summary["pressure_clipped"] and res.warnings == []
+
+
+def test_a_stop_that_does_not_end_is_untrusted():
+    import warnings
+
+    from railadhesion.plausibility import UntrustedResultWarning
+
+    # a whole stop expected (max_time left at 600 s): flagged and warned
+    with pytest.warns(UntrustedResultWarning, match="did not stop within max_time = 600 s"):
+        res = simulate(VEHICLE, PolachAdhesion(), 40.0, 1e4, dt=4e-3)
+    assert not res.trusted and not res.summary["trusted"] and res.status == 1
+    assert math.isnan(res.stopping_distance)
+    assert res.summary["warnings"] == res.warnings and len(res.warnings) == 1
+    # the first seconds of a stop asked for: flagged, not warned
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        res = simulate(VEHICLE, PolachAdhesion(), 20.0, 2e5, dt=4e-3, max_time=2.0)
+    assert not res.trusted and "did not stop within max_time = 2 s" in res.warnings[0]

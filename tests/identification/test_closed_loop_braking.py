@@ -13,7 +13,7 @@ import pytest
 from typer.testing import CliRunner
 
 from railadhesion.braking import BrakingFileError, Vehicle, write_braking_log
-from railadhesion.braking.adhesion import CallableAdhesion, PolachAdhesion, polach_family_curve
+from railadhesion.braking.adhesion import CallableAdhesion, PolachAdhesion
 from railadhesion.braking.run import simulate
 from railadhesion.braking.scenario import load_scenario
 from railadhesion.cli import app
@@ -23,10 +23,14 @@ from railadhesion.identification import (
     load_adhesion_law,
     read_braking_log,
 )
+from railadhesion.models import polach_forces
 from railadhesion.models.parameters import PolachParameters
 
 LOW = dict(k_A=0.3, k_S=0.1, mu0=0.13, A=0.4, B=0.3)
 NOISE = {"train_speed": 0.01, "wheel_speed": 0.02, "brake_pressure": 0.01}
+# the logs are the first seconds of a stop (max_time): an unfinished stop, knowingly
+pytestmark = pytest.mark.filterwarnings(
+    "ignore:the train did not stop:railadhesion.plausibility.UntrustedResultWarning")
 
 
 @pytest.fixture(scope="module")
@@ -37,18 +41,20 @@ def loop(tmp_path_factory):
     path = tmp_path_factory.mktemp("loop") / "log.csv"
     write_braking_log(result, path, period=2.4e-3, noise=NOISE, seed=11)
     ident = identify_adhesion(read_braking_log(path), veh)
-    return veh, adhesion, ident, fit_adhesion_curves(ident)
+    # The WSP keeps the wheels near the peak, so few samples lie beyond it: the quality gate
+    # may flag the falling part (A, B) as not carried by the data; the law is checked below
+    # over the slip range the log covers.
+    return veh, adhesion, ident, fit_adhesion_curves(ident, warn_untrusted=False)
 
 
 def _true_mu(adhesion, ident):
     rows, axles = np.nonzero(ident.use)
     v = ident.speed[rows]
     dv = ident.slip[rows, axles]
-    stiff = adhesion.contact.stiffness_over_load(ident.normal_load[rows, axles] / 2)
-    params = np.broadcast_to(np.array([[LOW[k] for k in ("k_A", "k_S", "mu0", "A", "B")]]),
-                             (rows.size, 1, 5))
-    mu, _ = polach_family_curve(dv / v, v[:, None], np.ones((rows.size, 1)), params, stiff)
-    return v, dv, mu
+    q = ident.normal_load[rows, axles] / 2  # one wheel
+    a, b = adhesion.contact.semi_axes(q)
+    fx, _ = polach_forces(dv / v, 0.0, 0.0, q, v, a, b, **LOW)
+    return v, dv, -fx / q
 
 
 def test_brake_coefficient_within_two_percent(loop):
@@ -69,6 +75,9 @@ def test_identified_law_matches_the_simulated_one(loop):
     assert abs(np.mean(raw) - np.mean(mu_true)) < 0.002
 
 
+# loading a law the gate flagged warns (tested in tests/test_issue18.py); here it is the
+# driving of the simulator that is checked
+@pytest.mark.filterwarnings("ignore::railadhesion.plausibility.UntrustedResultWarning")
 def test_identified_law_drives_the_braking_simulator(loop, tmp_path):
     veh, _, _, law = loop
     path = law.save(tmp_path / "law.toml")
@@ -84,6 +93,9 @@ def test_identified_law_drives_the_braking_simulator(loop, tmp_path):
     assert np.allclose(direct.histories.train_speed, h.train_speed)
 
 
+# loading a law the gate flagged warns (tested in tests/test_issue18.py); here it is the
+# driving of the simulator that is checked
+@pytest.mark.filterwarnings("ignore::railadhesion.plausibility.UntrustedResultWarning")
 def test_identified_law_file_in_a_brake_scenario(loop, tmp_path):
     """From test data to simulation without Python: the law file that ``identify`` writes is
     the adhesion model of a scenario TOML, run by ``railadhesion brake``."""

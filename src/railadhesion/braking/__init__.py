@@ -37,7 +37,12 @@ from railadhesion.braking.sensors import (
     ExternalSpeedSettings,
     SensorModel,
 )
-from railadhesion.braking.simulator import BrakingSimulator, BrakingState, SimulationError
+from railadhesion.braking.simulator import (
+    BrakingSimulator,
+    BrakingState,
+    SimulationError,
+    largest_stable_step,
+)
 from railadhesion.braking.vehicle import GRAVITY, Vehicle, load_vehicle
 from railadhesion.braking.wsp import WheelSlideProtection, WSPSettings
 
@@ -80,6 +85,7 @@ __all__ = [
     "slide_metrics",
     "Vehicle",
     "braking_log_frame",
+    "largest_stable_step",
     "load_vehicle",
     "write_braking_log",
 ]

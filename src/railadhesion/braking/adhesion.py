@@ -26,11 +26,14 @@ Shipped models:
 * :class:`CallableAdhesion` — a user function ``mu(creep, speed)`` (e.g. a Fletcher-type
   2D curve or a measured table); a numba ``@njit`` one runs compiled.
 
-Polach-family curves (pure longitudinal creep, no spin, no lateral creep) are the closed form
-of :func:`railadhesion.models.polach.polach_forces` (Polach 2005, section 2): with s = |ξ|,
-``μ_k = μ0 [(1 − A) exp(−B s V) + A]``, ``ε = (π/4) G a b C11 s / (Q μ_k)`` and
-``μ = (2/π) μ_k [k_A ε/(1 + (k_A ε)²) + arctan(k_S ε)]``; WILAC blends four such sets with the
-weights of Trummer et al. section 5.3. Tests check it against the library functions.
+Polach-family curves (pure longitudinal creep, no spin, no lateral creep) are Polach's model
+(2005, section 2) as :func:`railadhesion.models.kernels.polach_longitudinal` computes it, with
+its analytic slopes: with s = |ξ|, ``μ_k = μ0 [(1 − A) exp(−B s V) + A]``,
+``ε = (π/4) G a b C11 s / (Q μ_k)`` and ``μ = (2/π) μ_k [k_A ε/(1 + (k_A ε)²) + arctan(k_S ε)]``;
+WILAC blends four such sets with the weights of Trummer et al. section 5.3 (the WILAC
+kernel's own weights and regressions). The compiled functions of
+:mod:`railadhesion.braking.curves` evaluate them, for the braking step and for the methods
+below alike. Tests check them against the library functions.
 """
 
 from __future__ import annotations
@@ -56,10 +59,7 @@ __all__ = [
     "WaterFlowProfile",
     "AdhesionRecovery",
     "ContactGeometry",
-    "polach_family_curve",
 ]
-
-_TWO_OVER_PI = 2.0 / math.pi
 
 
 class ContactGeometry:
@@ -90,69 +90,17 @@ class ContactGeometry:
         self.a0, self.b0 = float(h.a), float(h.b)
         c11 = float(kalker_coefficients(self.a0 / self.b0, self.poisson)[0])
         self.c11 = c11
-        # (π/4) G a b C11 at the reference load [N per unit creepage]
-        self._k0 = math.pi / 4.0 * self.shear_modulus * self.a0 * self.b0 * c11
+        #: (π/4) G a b C11 at the reference load [N per unit creepage]
+        self.k0 = math.pi / 4.0 * self.shear_modulus * self.a0 * self.b0 * c11
 
     def semi_axes(self, load):
         s = (np.asarray(load, float) / self.reference_load) ** (1.0 / 3.0)
         return self.a0 * s, self.b0 * s
 
     def stiffness_over_load(self, load):
-        """(π/4) G a b C11 / Q [-] per unit creepage, at wheel load Q [N]."""
+        """(π/4) G a b C11 / Q [-] per unit creepage, at wheel load Q [N] (a b ∝ Q^(2/3))."""
         q = np.asarray(load, float)
-        return self._k0 * (q / self.reference_load) ** (2.0 / 3.0) / q
-
-
-def polach_family_curve(creep, speed, weights, params, stiffness, speed_slope=False):
-    """μ(ξ) and dμ/dξ of a weighted sum of Polach sets (pure longitudinal creepage).
-
-    Parameters
-    ----------
-    creep : ndarray (n,)
-        Braking creepage ξ per axle [-].
-    speed : float
-        Rolling speed V [m/s].
-    weights : ndarray (n, K)
-        Weight of each set per axle (sum 1).
-    params : ndarray (n, K, 5)
-        k_A, k_S, mu0, A, B per axle and set.
-    stiffness : ndarray (n,)
-        (π/4) G a b C11 / Q per axle [-].
-    speed_slope : bool
-        Also return dμ/dV.
-
-    Returns
-    -------
-    mu, dmu : ndarray (n,)
-        Adhesion coefficient (retarding, sign of ξ) and its slope with respect to ξ; with
-        ``speed_slope``, a third array dμ/dV [s/m].
-    """
-    xi = np.asarray(creep, float)
-    s = np.abs(xi)[:, None]
-    k_a, k_s, mu0, big_a, big_b = (params[..., j] for j in range(5))
-    e = np.exp(-big_b * s * speed)
-    mu_k = mu0 * ((1.0 - big_a) * e + big_a)
-    dmu_k = -mu0 * (1.0 - big_a) * big_b * speed * e
-    st = stiffness[:, None]
-    eps = np.minimum(st * s / mu_k, 1e50)
-    deps = st / mu_k - st * s * dmu_k / mu_k**2
-    x = k_a * eps
-    y = k_s * eps
-    bracket = x / (1.0 + x * x) + np.arctan(y)
-    dbracket = (k_a * (1.0 - x * x) / (1.0 + x * x) ** 2 + k_s / (1.0 + y * y)) * deps
-    f = _TWO_OVER_PI * mu_k * bracket
-    df = _TWO_OVER_PI * (dmu_k * bracket + mu_k * dbracket)
-    mu = np.sum(weights * f, axis=1)
-    dmu = np.sum(weights * df, axis=1)
-    if not speed_slope:
-        return np.sign(xi) * mu, dmu
-    # dμ_k/dV = dμ_k/ds · s/V (μ_k depends on s V only); ε = K s/μ_k
-    dmu_k_dv = -mu0 * (1.0 - big_a) * big_b * s * e
-    deps_dmu = -eps / mu_k  # ∂ε/∂μ_k
-    dbr_deps = k_a * (1.0 - x * x) / (1.0 + x * x) ** 2 + k_s / (1.0 + y * y)
-    dfv = _TWO_OVER_PI * (bracket + mu_k * dbr_deps * deps_dmu) * dmu_k_dv
-    dmv = np.sum(weights * dfv, axis=1)
-    return np.sign(xi) * mu, dmu, np.sign(xi) * dmv
+        return self.k0 * (q / self.reference_load) ** (2.0 / 3.0) / q
 
 
 def _peak(curve, speed, n):
@@ -241,13 +189,16 @@ class WaterFlowProfile:
         return cls(x, v, over, "step")
 
     def __call__(self, position, time):
-        q = np.asarray(position if self.over == "distance" else time, float)
-        if self.kind == "linear":
-            return np.interp(q, self.x, self.values)
-        idx = np.searchsorted(self.x, q, side="right") - 1
-        return self.values[np.clip(idx, 0, self.values.size - 1)] * (idx >= 0) + (
-            self.values[0] * (idx < 0)
-        )
+        """Water flow [µl/s] at the positions [m] (``over="distance"``) or at the time [s]
+        (``over="time"``): :func:`railadhesion.braking.curves.water_flow_at`, the function
+        the compiled step uses."""
+        from railadhesion.braking.curves import water_flow_at
+
+        where = np.asarray(position if self.over == "distance" else time, float)
+        linear = self.kind == "linear"
+        out = [water_flow_at.py_func(self.x, self.values, linear, float(q))
+               for q in where.ravel()]
+        return np.asarray(out, float).reshape(where.shape)
 
 
 class AdhesionRecovery:
@@ -272,48 +223,69 @@ class AdhesionRecovery:
 
 
 class _PolachFamily(AxleAdhesion):
-    """Shared machinery: a (n, K) weight table and (n, K, 5) parameter table."""
+    """Shared machinery: a (n, K) weight table, a (n, K, 5) parameter table and the contact
+    stiffness per axle; the curves of :mod:`railadhesion.braking.curves`."""
 
     def __init__(self, contact: ContactGeometry | None = None):
         self.contact = contact
         self.weights = None
         self.params = None
         self.stiffness = None
-        self._work = None
+        self._workspace = None
 
     def bind(self, n_axles, wheel_radius):
+        from railadhesion.braking.records import MAX_AXLES
+
+        if n_axles > MAX_AXLES:
+            raise ValueError(f"n_axles must be at most {MAX_AXLES}, got {n_axles}")
         super().bind(n_axles, wheel_radius)
         if self.contact is None:
             self.contact = ContactGeometry(wheel_radius=wheel_radius)
 
-    def _scratch(self):
-        from railadhesion.braking._layout import new_work
+    def _tables(self):
+        if self._workspace is None:
+            from railadhesion.braking.curves import new_workspace
 
-        n, k = self.weights.shape
-        if self._work is None or self._work.shape[1] < max(n * k, n, 1):
-            self._work = new_work(n, k)
-        return self._work
+            self._workspace = new_workspace()
+        return (np.ascontiguousarray(self.weights, dtype=float),
+                np.ascontiguousarray(self.params, dtype=float),
+                np.ascontiguousarray(self.stiffness, dtype=float), self._workspace)
 
     def slopes(self, creep, speed):
-        """μ, dμ/dξ and dμ/dV per axle (the compiled lane evaluation of the simulator)."""
-        from railadhesion.braking._kernels import family_evaluate
+        """μ, dμ/dξ and dμ/dV per axle at the creepages ``creep`` (one per axle)."""
+        from railadhesion.braking.curves import family_slopes
 
-        return family_evaluate(np.ascontiguousarray(creep, dtype=float), float(speed),
-                               np.ascontiguousarray(self.weights, dtype=float),
-                               np.ascontiguousarray(self.params, dtype=float),
-                               np.ascontiguousarray(self.stiffness, dtype=float),
-                               self._scratch())
+        creep = np.ascontiguousarray(creep, dtype=float)
+        weights, params, stiffness, workspace = self._tables()
+        if creep.shape != (weights.shape[0],):
+            raise ValueError(f"creep must have one value per axle ({weights.shape[0]}), got "
+                             f"shape {creep.shape}")
+        mu, dmu, dmv = np.empty(creep.size), np.empty(creep.size), np.empty(creep.size)
+        family_slopes(creep, float(speed), weights, params, stiffness, workspace, mu, dmu, dmv)
+        return mu, dmu, dmv
 
     def evaluate(self, creep, speed):
         mu, dmu, _ = self.slopes(creep, speed)
         return mu, dmu
 
-    def available(self, speed):
-        from railadhesion.braking._kernels import family_peak
+    def slope_table(self, creeps, speed):
+        """dμ/dξ of every axle (columns) at each of ``creeps`` (rows), at the prepared
+        conditions."""
+        from railadhesion.braking.curves import family_slope_table
 
-        return family_peak(float(speed), np.ascontiguousarray(self.weights, dtype=float),
-                           np.ascontiguousarray(self.params, dtype=float),
-                           np.ascontiguousarray(self.stiffness, dtype=float), self._scratch())
+        creeps = np.ascontiguousarray(creeps, dtype=float)
+        weights, params, stiffness, workspace = self._tables()
+        out = np.empty((creeps.size, weights.shape[0]))
+        family_slope_table(creeps, float(speed), weights, params, stiffness, workspace, out)
+        return out
+
+    def available(self, speed):
+        from railadhesion.braking.curves import family_peak
+
+        weights, params, stiffness, workspace = self._tables()
+        out = np.empty(weights.shape[0])
+        family_peak(float(speed), weights, params, stiffness, workspace, out)
+        return out
 
 
 def _as_polach(p) -> PolachParameters:
@@ -349,7 +321,8 @@ class PolachAdhesion(_PolachFamily):
             if p not in self.sets:
                 self.sets.append(p)
             self.section_list.append((float(start), float(end), self.sets.index(p)))
-        self._table = np.array([[s.k_A, s.k_S, s.mu0, s.A, s.B] for s in self.sets])
+        #: the sets' (k_A, k_S, mu0, A, B), one row per set
+        self.set_table = np.array([[s.k_A, s.k_S, s.mu0, s.A, s.B] for s in self.sets])
 
     def prepare(self, speed, normal_loads, positions, time, dissipation=None):
         n = self.n_axles
@@ -360,7 +333,7 @@ class PolachAdhesion(_PolachFamily):
         w = np.zeros((n, len(self.sets)))
         w[np.arange(n), k] = 1.0
         self.weights = w
-        self.params = np.broadcast_to(self._table, (n, *self._table.shape))
+        self.params = np.broadcast_to(self.set_table, (n, *self.set_table.shape))
         self.stiffness = self.contact.stiffness_over_load(normal_loads)
 
     def describe(self):
@@ -396,32 +369,32 @@ class WilacAdhesion(_PolachFamily):
         self.recovery = recovery
         self.current_water_flow = None
         self._packed = None
-        self._program = None
+
+    @property
+    def packed(self) -> np.ndarray:
+        """The parameter set packed for the compiled kernels
+        (:func:`railadhesion.models.kernels.pack_wilac`)."""
+        if self._packed is None:
+            from railadhesion.models.kernels import pack_wilac
+
+            self._packed = pack_wilac(self.parameters)
+        return self._packed
 
     def prepare(self, speed, normal_loads, positions, time, dissipation=None):
+        from railadhesion.braking.curves import wilac_axle_parameters
+
         w = np.broadcast_to(np.asarray(self.water_flow(positions, time), float),
                             (self.n_axles,)).copy()
         if self.recovery is not None and dissipation is not None:
             w = w * self.recovery.factor(dissipation)
         self.current_water_flow = w
-        from railadhesion.braking._kernels import wilac_table
-
-        if self._packed is None:
-            from railadhesion.models.kernels import pack_wilac
-
-            self._packed = pack_wilac(self.parameters)
-        if self._program is None:
-            from railadhesion.braking._layout import wilac_program
-
-            self._program = wilac_program(self._packed)
         n = self.n_axles
         if self.weights is None:
             self.weights = np.empty((n, len(WILAC_CONDITIONS)))
             self.params = np.empty((n, len(WILAC_CONDITIONS), 5))
         q = np.ascontiguousarray(normal_loads, dtype=float)
-        wilac_table(self._packed, self._program, q, max(float(speed), 0.0), w, self.weights,
-                    self.params, np.empty(7),
-                    np.empty(max(1, int(self._program[0]))))
+        wilac_axle_parameters(self.packed, q, max(float(speed), 0.0), w, self.weights,
+                              self.params, np.empty(7), np.empty(20))
         self.stiffness = self.contact.stiffness_over_load(q)
 
     def describe(self):

@@ -16,6 +16,10 @@ Air consumption: every change APPLY/HOLD → VENT counts one vent action; the ai
 WSP is reported as free air at atmospheric pressure, ``V_cyl Δp / p_atm`` [m³], with
 ``cylinder_volume`` the brake-cylinder volume per axle (an input; 2 l by default, an
 assumption for the cylinders of one disc-braked axle).
+
+The lag and the valve grouping are written once, as compiled functions
+(:func:`lag_factors`, :func:`cylinder_step`, :func:`set_valves`) that the braking step calls
+and :meth:`BrakeCylinders.advance` runs for NumPy callers.
 """
 
 from __future__ import annotations
@@ -24,12 +28,67 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
-__all__ = ["BrakeCylinders", "APPLY", "HOLD", "VENT", "VALVE_STATES", "ATMOSPHERIC_PRESSURE"]
+__all__ = ["BrakeCylinders", "APPLY", "HOLD", "VENT", "VALVE_STATES", "ATMOSPHERIC_PRESSURE",
+           "lag_factors", "cylinder_step", "set_valves"]
 
 APPLY, HOLD, VENT = 0, 1, 2
 VALVE_STATES = {"apply": APPLY, "hold": HOLD, "vent": VENT}
 ATMOSPHERIC_PRESSURE = 101325.0
+
+
+@njit(cache=True, error_model="numpy")
+def lag_factors(dt, fill_time_constant, vent_time_constant):
+    """The first-order lag over a step dt, for filling and for venting: the decay factors
+    ``exp(-dt/τ)`` and the mean factors ``(τ/dt)(1 - exp(-dt/τ))`` of the exact mean over
+    the step. Returns (fill_decay, fill_mean, vent_decay, vent_mean)."""
+    fill = math.exp(-dt / fill_time_constant)
+    vent = math.exp(-dt / vent_time_constant)
+    return (fill, (fill_time_constant / dt) * (1.0 - fill), vent,
+            (vent_time_constant / dt) * (1.0 - vent))
+
+
+@njit(cache=True, error_model="numpy")
+def cylinder_step(p0, valve, command, max_pressure, fill_decay, fill_mean, vent_decay,
+                  vent_mean):
+    """One cylinder over one step with its valve state and command held: returns the end
+    pressure, the exact mean pressure over the step and the pressure vented [Pa]
+    (see the module docstring; factors from :func:`lag_factors`)."""
+    if valve == VENT:
+        target = 0.0
+    elif valve == HOLD:
+        target = p0
+    else:
+        target = min(max(command, 0.0), max_pressure)
+    if target > p0:
+        decay, mean = fill_decay, fill_mean
+    else:
+        decay, mean = vent_decay, vent_mean
+    p1 = target + (p0 - target) * decay
+    return p1, target + (p0 - target) * mean, p0 - p1 if valve == VENT else 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def set_valves(valves, new, per_bogie, vent_actions):
+    """Make ``new`` (one state per axle) the valve states ``valves``; with valves per bogie
+    every axle of a bogie takes the most severe state of the bogie (vent > hold > apply);
+    each change to VENT counts one vent action. ``new`` is grouped in place."""
+    n = valves.shape[0]
+    if per_bogie:
+        half = n // 2
+        first = 0.0
+        second = 0.0
+        for i in range(half):
+            first = max(first, new[i])
+            second = max(second, new[half + i])
+        for i in range(half):
+            new[i] = first
+            new[half + i] = second
+    for i in range(n):
+        if new[i] == VENT and valves[i] != VENT:
+            vent_actions[i] += 1
+        valves[i] = new[i]
 
 
 @dataclass(frozen=True)
@@ -43,7 +102,8 @@ class BrakeCylinders:
     vent_time_constant : float
         Time constant of the pressure fall [s] (default 0.15 s, an assumption).
     max_pressure : float
-        Pressure limit [Pa] (default 3.8 bar).
+        Pressure limit [Pa] (default 3.8 bar). A command above it is clipped to it (the
+        simulation reports it: ``BrakingResult.summary["pressure_clipped"]``).
     cylinder_volume : float
         Brake-cylinder volume per axle [m³], for the vented air (default 2e-3).
     valves : {"axle", "bogie"}
@@ -82,22 +142,12 @@ class BrakeCylinders:
         return np.repeat([v[:k].max(), v[k:].max()], k)
 
     def advance(self, pressure, valves, command, dt):
-        """New pressures, mean pressures over the step, and pressure vented [Pa] per axle.
-
-        The same operations as the compiled step (``exp`` of the two time constants, the mean
-        factor ``(τ/dt)(1 − e)``), so both give the same numbers.
-        """
+        """New pressures, mean pressures over the step, and pressure vented [Pa] per axle
+        (:func:`cylinder_step` for every axle)."""
         p0 = np.asarray(pressure, float)
         cmd = np.broadcast_to(np.asarray(command, float), p0.shape)
-        cmd = np.minimum(np.maximum(cmd, 0.0), self.max_pressure)
-        target = np.where(valves == VENT, 0.0, np.where(valves == HOLD, p0, cmd))
-        fill = target > p0
-        e_fill = math.exp(-dt / self.fill_time_constant)
-        e_vent = math.exp(-dt / self.vent_time_constant)
-        e = np.where(fill, e_fill, e_vent)
-        mean_factor = np.where(fill, (self.fill_time_constant / dt) * (1.0 - e_fill),
-                               (self.vent_time_constant / dt) * (1.0 - e_vent))
-        p1 = target + (p0 - target) * e
-        mean = target + (p0 - target) * mean_factor
-        vented = np.where(valves == VENT, p0 - p1, 0.0)
-        return p1, mean, vented
+        valves = np.broadcast_to(np.asarray(valves, float), p0.shape)
+        factors = lag_factors(float(dt), self.fill_time_constant, self.vent_time_constant)
+        out = np.array([cylinder_step(p0[i], valves[i], cmd[i], self.max_pressure, *factors)
+                        for i in range(p0.size)]).reshape(p0.size, 3)
+        return out[:, 0], out[:, 1], out[:, 2]

@@ -9,39 +9,16 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from railadhesion.braking.adhesion import (
-    AxleAdhesion,
-)
+from railadhesion.braking.adhesion import AxleAdhesion
 from railadhesion.braking.cylinders import BrakeCylinders
+from railadhesion.braking.demand import BrakeDemand
 from railadhesion.braking.metrics import slide_metrics
 from railadhesion.braking.simulator import BrakingSimulator
 from railadhesion.braking.vehicle import Vehicle
 from railadhesion.braking.wsp import WheelSlideProtection, as_controller, call_controller
+from railadhesion.plausibility import AlteredResultWarning, UntrustedResultWarning, warn
 
 __all__ = ["BrakeDemand", "BrakingResult", "simulate", "summarise"]
-
-
-@dataclass(frozen=True)
-class BrakeDemand:
-    """Commanded brake-cylinder pressure over time: 0 before ``start_time``, then a linear
-    ramp over ``ramp_time`` [s] up to ``pressure`` [Pa] (a step when ``ramp_time`` is 0)."""
-
-    pressure: float = 3.0e5
-    start_time: float = 0.0
-    ramp_time: float = 0.0
-
-    def __post_init__(self):
-        for name in ("pressure", "start_time", "ramp_time"):
-            x = getattr(self, name)
-            if not (isinstance(x, int | float) and math.isfinite(x) and x >= 0):
-                raise ValueError(f"{name} must be a finite number >= 0, got {x!r}")
-
-    def __call__(self, time: float) -> float:
-        if time < self.start_time:
-            return 0.0
-        if self.ramp_time <= 0:
-            return self.pressure
-        return self.pressure * min(1.0, (time - self.start_time) / self.ramp_time)
 
 
 @dataclass
@@ -62,9 +39,17 @@ class BrakingResult:
     success : bool
     summary : dict
         Stopping distance and time, per-axle maximum slip and longest lock, adhesion
-        utilisation, air consumption, energy balance (see :func:`summarise`).
+        utilisation, air consumption, energy balance (see :func:`summarise`); the flags
+        ``pressure_clipped`` (a command above the cylinders' ``max_pressure`` was clipped to
+        it), ``trusted`` and ``warnings``.
     settings : dict
         What was simulated (vehicle, adhesion model, step, WSP).
+    warnings : list of str
+        What was altered or cannot be trusted (each also issued as a warning:
+        :class:`~railadhesion.plausibility.AlteredResultWarning`,
+        :class:`~railadhesion.plausibility.UntrustedResultWarning`).
+    trusted : bool
+        False when the train did not stop within ``max_time`` or a result is NaN.
     """
 
     histories: pd.DataFrame
@@ -72,6 +57,8 @@ class BrakingResult:
     message: str
     summary: dict
     settings: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
+    trusted: bool = True
 
     @property
     def success(self) -> bool:
@@ -177,7 +164,8 @@ def summarise(sim: BrakingSimulator, h: pd.DataFrame) -> dict:
 
 def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
              brake=3.0e5, *, cylinders: BrakeCylinders | None = None, wsp=None,
-             control_period: float | None = None, dt: float = 1e-3, max_time: float = 600.0,
+             control_period: float | None = None, dt: float = 1e-3,
+             max_time: float | None = None,
              gradient: float = 0.0, refresh_period: float = 0.01, stop_speed: float = 0.05,
              progress: Callable[[float], None] | None = None,
              compiled: bool = True) -> BrakingResult:
@@ -192,7 +180,10 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
         [m/s].
     brake : float or callable
         Commanded brake-cylinder pressure [Pa]: a constant applied at t = 0, a
-        :class:`BrakeDemand`, or a function of time.
+        :class:`BrakeDemand`, or a function of time. A command above the cylinders'
+        ``max_pressure`` is clipped to it: an
+        :class:`~railadhesion.plausibility.AlteredResultWarning` says so, and the summary
+        flags it (``pressure_clipped``).
     cylinders : BrakeCylinders, optional
     wsp : None, True, WheelSlideProtection, or controller
         ``None``: no WSP (valves always apply); ``True``: the default
@@ -201,48 +192,80 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
     control_period : float, optional
         Period of a plain-function controller [s] (objects carry their own ``period``).
     dt : float
-        Simulation step [s]; the control period must be a whole multiple of it.
+        Simulation step [s]; the control period must be a whole multiple of it. A step too
+        large for the wheel dynamics is refused (``ValueError`` naming the largest stable
+        step, :func:`~railadhesion.braking.simulator.largest_stable_step`).
+    max_time : float, optional
+        Longest simulated time [s] (default 600 s). A stop that does not end within it is a
+        result flagged untrusted (``trusted`` False, the reason in ``warnings``); with the
+        default the flag comes with an
+        :class:`~railadhesion.plausibility.UntrustedResultWarning` (a whole stop was
+        expected), with a ``max_time`` of your own it does not (you asked for the first
+        seconds of a stop).
     progress : callable, optional
         Called now and then with the fraction of the initial speed lost (0 … 1).
     compiled : bool
-        Use the compiled whole-run loop when possible (Polach, WILAC with a
+        Evaluate the adhesion model in compiled code when it can be (Polach, WILAC with a
         :class:`WaterFlowProfile` or a :class:`CallableAdhesion` of a numba ``@njit``
-        function; a :class:`BrakeDemand`; no WSP); with another demand or a controller
-        (the default :class:`WheelSlideProtection` included, until the compiled step calls
-        :func:`~railadhesion.braking.wsp.wsp_update`) the compiled step runs inside a Python
-        loop; with ``False`` the same steps run in Python (any adhesion
-        model, any controller). All give the same results.
+        function). The whole stop runs in one compiled loop with a :class:`BrakeDemand` and
+        no WSP or the default :class:`WheelSlideProtection` (which then runs inside the
+        step); with another demand or controller (or ``compiled=False``) a Python loop calls
+        the demand and the controller between compiled steps. All give the same results.
 
     Returns
     -------
     BrakingResult
+        ``trusted`` is False when the train did not stop within ``max_time`` (see there) or
+        a result is NaN (with an :class:`~railadhesion.plausibility.UntrustedResultWarning`).
     """
-    sim = BrakingSimulator(vehicle, adhesion, initial_speed, cylinders=cylinders,
-                           gradient=gradient, refresh_period=refresh_period,
-                           stop_speed=stop_speed, max_step=dt, record=True,
-                           compiled=compiled)
     demand = BrakeDemand(float(brake)) if isinstance(brake, int | float) else brake
     if not callable(demand):
         raise ValueError(f"brake must be a pressure [Pa] or a function of time, got {brake!r}")
     if wsp is True:
         wsp = WheelSlideProtection()
     if isinstance(wsp, WheelSlideProtection):
-        wsp.configure(vehicle, sim.cylinders)
+        wsp.configure(vehicle, cylinders if cylinders is not None else BrakeCylinders())
     controller = as_controller(wsp, control_period)
+    if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
+        raise ValueError(f"dt must be in (0, inf) s, got {dt!r}")
     ratio = 1
     if controller is not None:
         ratio = int(round(controller.period / dt))
         if ratio < 1 or abs(ratio * dt - controller.period) > 1e-9 * controller.period:
             raise ValueError(f"the control period ({controller.period} s) must be a whole "
                              f"multiple of dt ({dt} s)")
-        controller.reset(vehicle.n_axles, vehicle.wheel_radius)
-    if not (math.isfinite(max_time) and max_time > 0):
+    expected_stop = max_time is None  # a whole stop expected: an unfinished one is warned of
+    max_time = 600.0 if max_time is None else max_time
+    if not (isinstance(max_time, int | float) and math.isfinite(max_time) and max_time > 0):
         raise ValueError(f"max_time must be in (0, inf) s, got {max_time!r}")
+    builtin_wsp = controller is None or type(controller) is WheelSlideProtection
+    compiled_loop = compiled and type(demand) is BrakeDemand and builtin_wsp
+    sim = BrakingSimulator(vehicle, adhesion, initial_speed, cylinders=cylinders,
+                           gradient=gradient, refresh_period=refresh_period,
+                           stop_speed=stop_speed, max_step=dt, record=True,
+                           compiled=compiled, wsp=controller if compiled_loop else None)
+    notes = []
+    cap = sim.cylinders.max_pressure
+    if isinstance(demand, BrakeDemand) and demand.pressure > cap:
+        notes.append(warn(
+            f"the brake demand {demand.pressure:.6g} Pa ({demand.pressure / 1e5:.3g} bar) is "
+            f"above the brake cylinders' max_pressure {cap:.6g} Pa ({cap / 1e5:.3g} bar): the "
+            f"cylinders brake at {cap / 1e5:.3g} bar (raise BrakeCylinders(max_pressure=...) "
+            "if the demand is meant)", AlteredResultWarning))
     nmax = int(math.ceil(max_time / dt))
-    if compiled and sim._use_compiled and _fast_path_possible(demand, controller):
-        _run_compiled(sim, demand, controller, ratio, nmax, dt, progress, initial_speed)
+    if compiled_loop:
+        sim.configure_run(demand)
+        sim.run_compiled(nmax, dt, progress)
     else:
+        if controller is not None:
+            controller.reset(vehicle.n_axles, vehicle.wheel_radius)
         _run_python(sim, demand, controller, ratio, nmax, dt, progress, initial_speed)
+    report = sim.command_report
+    if report["clipped_steps"] and not notes:
+        notes.append(warn(
+            f"the brake demand reached {report['highest_command_Pa']:.6g} Pa, above the brake "
+            f"cylinders' max_pressure {cap:.6g} Pa: clipped to it in "
+            f"{report['clipped_steps']} steps", AlteredResultWarning))
     h = sim.histories()
     status = 0 if sim.stopped else 1
     message = ("the train stopped" if sim.stopped
@@ -253,10 +276,27 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
                 else type(controller).__name__, "initial_speed_m_s": initial_speed}
     if progress is not None:
         progress(1.0)
-    return BrakingResult(h, status, message, summarise(sim, h), settings)
+    summary = summarise(sim, h)
+    if not sim.stopped:
+        note = (f"the train did not stop within max_time = {max_time:g} s (speed "
+                f"{sim.speed:.4g} m/s left): the stopping distance and time are unknown (NaN); "
+                "the result is untrusted")
+        notes.append(warn(note, UntrustedResultWarning) if expected_stop else note)
+    elif not (math.isfinite(summary["stopping_distance_m"]) and np.all(np.isfinite(
+            h[["time", "distance", "train_speed"]].to_numpy()))):
+        notes.append(warn("the simulation gave NaN results; the result is untrusted",
+                          UntrustedResultWarning))
+    trusted = not any("untrusted" in note for note in notes)
+    summary["pressure_clipped"] = bool(report["clipped_steps"])
+    summary["highest_command_Pa"] = report["highest_command_Pa"]
+    summary["max_pressure_Pa"] = cap
+    summary["trusted"] = trusted
+    summary["warnings"] = list(notes)
+    return BrakingResult(h, status, message, summary, settings, notes, trusted)
 
 
 def _run_python(sim, demand, controller, ratio, nmax, dt, progress, initial_speed):
+    """The loop of a whole stop in Python: demand and controller called between steps."""
     n = sim.vehicle.n_axles
     report_every = max(1, int(round(1.0 / dt)))
     command = sim.inputs.pressure_command
@@ -279,15 +319,3 @@ def _run_python(sim, demand, controller, ratio, nmax, dt, progress, initial_spee
             progress(1.0 - sim.speed / initial_speed)
         if sim.stopped:
             break
-
-
-def _fast_path_possible(demand, controller) -> bool:
-    """The compiled loop runs the brake demand itself (the WSP of ``braking.wsp`` runs in the
-    Python loop until the compiled step calls it)."""
-    return type(demand) is BrakeDemand and controller is None
-
-
-def _run_compiled(sim, demand, controller, ratio, nmax, dt, progress, initial_speed):
-    """The loop of _run_python in one compiled kernel (same operations, same results)."""
-    sim._configure_run(controller, demand, ratio)
-    sim._run_compiled(nmax, dt, progress, initial_speed)

@@ -23,33 +23,43 @@ Integration (stiff wheels: the creep-force slope gives wheel time constants
    slopes dμ/dξ and dμ/dV, started from the previous step extrapolated linearly. A wheel at
    rest stays at rest while static brake friction holds it (``c p̄ ≥ R N μ(ξ = 1)``); a wheel
    whose update would turn it backwards is held at rest (active set). The iteration stops
-   when an update moves no speed (v, ω_i R) by more than 1e-6 m/s; by the quadratic
-   convergence the accepted state then solves the equations to about 1e-10 m/s, and the
+   when an update moves no speed (v, ω_i R) by more than 5e-6 v; by the quadratic
+   convergence the accepted state then solves the equations far below that, and the
    adhesion used is taken from the linearisation of the last iterate, so the train equation
    and the energy bookkeeping hold exactly for the accepted state. In smooth phases this is
    **one** creep-curve evaluation per axle per step;
 3. if Newton cannot finish (no convergence in 8 iterations, a non-positive pivot, a wheel
    that keeps changing between rolling and locked, speeds near zero), the step is done
-   again by the **safeguarded solve**: for a trial end speed v each wheel's implicit
+   again by the **safeguarded solve**: for a trial end speed v ≥ 0 each wheel's implicit
    equation is solved by a Newton iteration kept inside a bracket (bisection), a wheel whose
    equation has no root with ω ≥ 0 locks (ω = 0), and the train speed is the fixed point of
    ``v = v0 − dt (Σ T_i(ω(v), v) + F)/M``, found by secant steps to 1e-10 m/s. Both solvers
    converge to the same backward-Euler solution;
-4. distance by the trapezoidal rule.
+4. **standstill**: speeds never go negative. When even at v → 0⁺ (every locked wheel sliding
+   at creepage 1) the forces stop the train within the step, the train comes to rest: v = 0,
+   every wheel at rest, the stop lies where the sliding friction brings v0 to 0, and the
+   adhesion used in that step is the share of the sliding friction that stops the train. At
+   rest the creepage, (v − ωR)/v, is defined as 0 (wheel and rail at rest);
+5. distance by the trapezoidal rule.
 
-The scheme is L-stable for the wheel modes at any step, deterministic (no randomness, fixed
-iteration order), and first-order accurate; results converge as the step halves (tested).
-Stop: when v falls below ``stop_speed`` (default 0.05 m/s) the run ends; the remaining
-distance ``v²/(2d)`` and time ``v/d`` at the current deceleration are added.
+The scheme is L-stable for the wheel modes on the rising branch of the creep curve at any
+step, deterministic (no randomness, fixed iteration order), and first-order accurate; results
+converge as the step halves (tested). On the falling branch a wheel's slide grows with the
+time constant ``J v / (R² N |dμ/dξ|)``; a step longer than it is refused (see
+:func:`largest_stable_step`). Stop: when v falls below ``stop_speed`` (default 0.05 m/s) the
+run ends; the remaining distance ``v²/(2d)`` and time ``v/d`` at the current deceleration are
+added.
 
 Energy: the simulator accumulates the brake work ``∫ Σ c p ω dt``, the creep (contact) work
 ``∫ Σ T_i (v − ω_i R) dt`` and the running-resistance and gradient work, with the same
 discretisation (so the balance with the kinetic energy closes to the scheme's numerical
 dissipation, O(dt)).
 
-Two implementations perform these operations: a compiled one (numba, for Polach and WILAC
-with a :class:`~railadhesion.braking.adhesion.WaterFlowProfile`) and a NumPy/Python one for
-any adhesion model (``compiled=False``); tests hold them together.
+One integrator performs these operations: :func:`railadhesion.braking.step.step`, compiled
+with numba, on the named records of :mod:`railadhesion.braking.records`. It evaluates the
+built-in models (Polach, WILAC with a :class:`~railadhesion.braking.adhesion.WaterFlowProfile`)
+and a user's numba law in compiled code, and any other adhesion model by calling its Python
+methods back (``compiled=False`` asks for that with every model).
 """
 
 from __future__ import annotations
@@ -60,14 +70,30 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from railadhesion.braking import _layout as L
 from railadhesion.braking.adhesion import AxleAdhesion, CallableAdhesion
-from railadhesion.braking.cylinders import APPLY, VENT, BrakeCylinders
+from railadhesion.braking.cylinders import APPLY, BrakeCylinders
+from railadhesion.braking.records import (
+    BAD_COMMAND,
+    BAD_DT,
+    BAD_TORQUE,
+    BAD_VALVE,
+    MAX_AXLES,
+    NONFINITE,
+    POLACH,
+    PYTHON,
+    ROWS_FULL,
+    STALE,
+    USER,
+    USER_GRID,
+    WILAC,
+    history_columns,
+    machine_dtype,
+)
 from railadhesion.braking.vehicle import GRAVITY, Vehicle
 
-__all__ = ["BrakingSimulator", "BrakingState", "LiveState", "StepInputs", "SimulationError"]
+__all__ = ["BrakingSimulator", "BrakingState", "LiveState", "StepInputs", "SimulationError",
+           "largest_stable_step"]
 
-_TOL = 1e-10  # m/s: tolerance of the safeguarded solve
 NEWTON_TOL = 5e-6  # a Newton update below this fraction of v (in v and every ω R) is accepted
 _ROWS_BLOCK = 4096  # history rows per block
 
@@ -95,6 +121,12 @@ class BrakingState:
     stopped: bool
 
 
+# LiveState array -> field of the state record
+_LIVE_ARRAYS = {"wheel_speeds": "omega", "brake_pressures": "pressure", "valves": "valve",
+                "creep": "creep", "creep_forces": "force", "normal_loads": "load",
+                "adhesion_used": "mu"}
+
+
 class LiveState:
     """The simulator's current state, read live (what :meth:`BrakingSimulator.advance` returns).
 
@@ -105,47 +137,45 @@ class LiveState:
     :meth:`snapshot`. Nothing is allocated per step.
     """
 
-    __slots__ = ("_buf", "wheel_speeds", "brake_pressures", "valves", "creep", "creep_forces",
-                 "normal_loads", "adhesion_used")
+    __slots__ = ("_scalars", "wheel_speeds", "brake_pressures", "valves", "creep",
+                 "creep_forces", "normal_loads", "adhesion_used")
 
-    def __init__(self, buf, work, n):
-        self._buf = buf
-        for name, row in (("wheel_speeds", L.R_OMEGA), ("brake_pressures", L.R_PRESS),
-                          ("valves", L.R_VALVE), ("creep", L.R_CREEP),
-                          ("creep_forces", L.R_FORCE), ("normal_loads", L.R_LOAD),
-                          ("adhesion_used", L.R_MU)):
-            view = work[row, :n]
+    def __init__(self, machine: np.ndarray, n: int):
+        state = machine["state"]
+        self._scalars = {name: state[name] for name in
+                         ("time", "distance", "speed", "deceleration", "stopped")}
+        for name, field in _LIVE_ARRAYS.items():
+            view = state[field][0, :n]
             view.flags.writeable = False
             setattr(self, name, view)
 
     @property
     def time(self) -> float:
-        return float(self._buf[L.T_])
+        return float(self._scalars["time"][0])
 
     @property
     def distance(self) -> float:
-        return float(self._buf[L.X_])
+        return float(self._scalars["distance"][0])
 
     @property
     def train_speed(self) -> float:
-        return float(self._buf[L.V_])
+        return float(self._scalars["speed"][0])
 
     @property
     def deceleration(self) -> float:
-        return float(self._buf[L.D_])
+        return float(self._scalars["deceleration"][0])
 
     @property
     def stopped(self) -> bool:
-        return bool(self._buf[L.STOPPED_])
+        return bool(self._scalars["stopped"][0])
 
     def snapshot(self) -> BrakingState:
         """A :class:`BrakingState` with copies of the current values."""
-        b = self._buf
         block = np.array([self.wheel_speeds, self.brake_pressures, self.creep,
                           self.creep_forces, self.normal_loads, self.adhesion_used])
-        return BrakingState(float(b[L.T_]), float(b[L.X_]), float(b[L.V_]), float(b[L.D_]),
+        return BrakingState(self.time, self.distance, self.train_speed, self.deceleration,
                             block[0], block[1], self.valves.astype(np.int64), block[2],
-                            block[3], block[4], block[5], bool(b[L.STOPPED_]))
+                            block[3], block[4], block[5], self.stopped)
 
     def __repr__(self) -> str:
         return (f"LiveState(time={self.time:.6g} s, train_speed={self.train_speed:.6g} m/s, "
@@ -158,19 +188,20 @@ class StepInputs:
     ``pressure_command`` (n,) float [Pa]: commanded brake-cylinder pressure per axle, in
     [0, inf); ``valves`` (n,) float: WSP valve state per axle, 0 apply, 1 hold, 2 vent (with
     ``BrakeCylinders(valves="bogie")`` the axles of a bogie follow the most severe state of
-    the bogie); ``torque`` (n,) float [N m]: traction torque per axle, positive driving the
-    wheel forward (``J dω/dt = R T − c p + τ``), any finite value, default 0. All are views of
-    the simulator's memory: write into them (``inputs.valves[2] = 2``,
+    the bogie; ignored while the simulator's built-in WSP runs); ``torque`` (n,) float
+    [N m]: traction torque per axle, positive driving the wheel forward
+    (``J dω/dt = R T − c p + τ``), any finite value, default 0. All are views of the
+    simulator's memory: write into them (``inputs.valves[2] = 2``,
     ``inputs.pressure_command[:] = p``, ``inputs.torque[:] = 4e3``, or a data-acquisition
     driver's ``out=``); values persist until overwritten and are checked at each step.
     """
 
     __slots__ = ("pressure_command", "valves", "torque")
 
-    def __init__(self, work, n):
-        self.pressure_command = work[L.R_CMD, :n]
-        self.valves = work[L.R_VIN, :n]
-        self.torque = work[L.R_TORQUE, :n]
+    def __init__(self, machine: np.ndarray, n: int):
+        self.pressure_command = machine["inputs"]["pressure_command"][0, :n]
+        self.valves = machine["inputs"]["valves"][0, :n]
+        self.torque = machine["inputs"]["torque"][0, :n]
 
     def __repr__(self) -> str:
         return (f"StepInputs(pressure_command={self.pressure_command}, valves={self.valves}, "
@@ -178,16 +209,18 @@ class StepInputs:
 
 
 _FIXED = frozenset(("vehicle", "adhesion", "cylinders", "gradient", "refresh_period",
-                    "stop_speed", "max_step", "record"))
+                    "stop_speed", "max_step", "record", "wsp", "sensors"))
 
-# state held in the work array: attribute name -> row
-_ROWS = {"omega": L.R_OMEGA, "pressure": L.R_PRESS, "valves": L.R_VALVE, "forces": L.R_FORCE,
-         "mu": L.R_MU, "creep": L.R_CREEP, "loads": L.R_LOAD, "available": L.R_AVAIL,
-         "vented_pressure": L.R_VENTED, "vent_actions": L.R_VACT}
-# scalars held in buf: attribute name -> slot
-_SCALARS = {"time": L.T_, "distance": L.X_, "speed": L.V_, "deceleration": L.D_,
-            "stop_time": L.STOP_T_, "stop_distance": L.STOP_X_, "brake_work": L.WB_,
-            "creep_work": L.WC_, "resistance_work": L.WR_, "gradient_work": L.WG_}
+# simulator attribute -> field of the state record
+_STATE_ARRAYS = {"omega": "omega", "pressure": "pressure", "valves": "valve",
+                 "forces": "force", "mu": "mu", "creep": "creep", "loads": "load",
+                 "available": "available", "vented_pressure": "vented_pressure",
+                 "vent_actions": "vent_actions"}
+_STATE_SCALARS = {"time": "time", "distance": "distance", "speed": "speed",
+                  "deceleration": "deceleration", "stop_time": "stop_time",
+                  "stop_distance": "stop_distance", "brake_work": "brake_work",
+                  "creep_work": "creep_work", "resistance_work": "resistance_work",
+                  "gradient_work": "gradient_work"}
 
 
 def _is_jitted(adhesion) -> bool:
@@ -200,48 +233,130 @@ def _is_jitted(adhesion) -> bool:
             and type(adhesion).available is CallableAdhesion.available)
 
 
-def _user_cfunc(adhesion):
-    """The user's jitted adhesion function as a numba cfunc ``μ(creep >= 0, speed, wheel
-    load)``, kept on the adhesion object (the kernels call it by its address); None if it
+def _user_entries(adhesion):
+    """The step's entry points for a user's numba law ``μ(creep >= 0, speed[, wheel load])``:
+    the law as a C callback (a numba cfunc, a first-class function of the step), and small
+    wrappers that pass it to the (cached) step. Kept on the adhesion object; None if the law
     does not compile for scalars (then the Python path runs)."""
-    f = adhesion.__dict__.get("_cfunc")
-    if f is not None:
-        return f
+    entries = adhesion.__dict__.get("_entries")
+    if entries is not None:
+        return entries
     import warnings
 
-    from numba import cfunc, types
+    from numba import cfunc, njit, types
+
+    from railadhesion.braking import step
 
     user = adhesion.function
     if adhesion.needs_load:
-        def wrapped(s, v, q):
+        def law(s, v, q):
             return user(s, v, q)
     else:
-        def wrapped(s, v, q):
+        def law(s, v, q):
             return user(s, v)
     try:
-        f = cfunc(types.float64(types.float64, types.float64, types.float64))(wrapped)
+        fn = cfunc(types.float64(types.float64, types.float64, types.float64))(law)
     except Exception as exc:  # numba's typing errors: the function is not for scalars
         warnings.warn(f"the adhesion function {adhesion.label!r} does not compile as a function "
                       f"of scalars (creep, speed{', load' if adhesion.needs_load else ''}) -> "
                       f"float ({type(exc).__name__}); it runs in the Python path", stacklevel=4)
         return None
-    adhesion.__dict__["_cfunc"] = f
-    return f
+
+    @njit
+    def advance_unrecorded(machine, tables, dt, aux):
+        return step.advance_unrecorded(machine, tables, dt, fn)
+
+    @njit
+    def advance(machine, tables, rows, dt, aux):
+        return step.advance(machine, tables, rows, dt, fn)
+
+    @njit
+    def advance_buffer_unrecorded(buffer, dt):
+        return step.advance_buffer_unrecorded(buffer, dt, fn)
+
+    @njit
+    def advance_buffer(buffer, rows, dt):
+        return step.advance_buffer(buffer, rows, dt, fn)
+
+    @njit
+    def run(machine, tables, rows, dt, k_end, aux):
+        return step.run(machine, tables, rows, dt, k_end, fn)
+
+    @njit
+    def available(machine, tables, aux):
+        return step.available(machine, tables, fn)
+
+    entries = (advance_unrecorded, advance, run, available, advance_buffer_unrecorded,
+               advance_buffer)
+    adhesion.__dict__["_entries"] = entries
+    return entries
 
 
-def _kernel_entry(dispatcher, args):
-    """The compiled entry point of a numba kernel for the types of ``args``: calling it skips
-    the dispatcher's type resolution (about 100 ns per call instead of 300 ns); falls back to
-    the dispatcher. ``args`` must make a call without effect (it compiles the kernel, or loads
-    it from the cache)."""
-    dispatcher(*args)
-    try:
-        from numba import typeof
+def largest_stable_step(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float):
+    """The longest step [s] the integrator accepts for this vehicle and adhesion model.
 
-        entry = dispatcher.overloads[tuple(typeof(a) for a in args)].entry_point
-    except Exception:  # pragma: no cover - numba internals changed: use the dispatcher
-        entry = None
-    return entry if callable(entry) else dispatcher
+    On the falling branch of a creep curve (dμ/dξ < 0) a braked wheel's slide grows with the
+    time constant ``τ = J v / (R² N |dμ/dξ|)`` (the linearised wheel equation
+    ``J dω/dt = R N μ(ξ) − c p`` with ``ξ = (v − ωR)/v``; for friction falling with the slip
+    velocity Δv = ξ v it is ``J / (R² N |dμ/dΔv|)``, nearly the same at every speed).
+    Backward Euler with a step longer than τ turns that growth into a decay and its implicit
+    wheel equation loses its unique root (its pivot ``J/dt − R² N |dμ/dξ|/v`` changes sign):
+    the steps no longer follow a slide, nor a WSP's release of it. The largest stable step is
+    the smallest τ over the axle loads (static, and under a deceleration of 3 m/s²), speeds
+    from ``initial_speed`` down to 1 m/s and creepages from 1e-4 to 1, for every adhesion
+    condition the model holds (each Polach set; WILAC dry and at the water flows of its
+    profile; a :class:`CallableAdhesion` law). It is inf when no curve falls, and for models
+    defined in Python otherwise (not examined).
+
+    Returns ``(tau, where)``: the step [s] and a dict saying where it is reached (condition,
+    speed, creepage, slope, axle load).
+    """
+    import warnings
+
+    from railadhesion.braking.adhesion import PolachAdhesion, WaterFlowProfile, WilacAdhesion
+
+    radius, inertia = vehicle.wheel_radius, vehicle.wheelset_inertia
+    loads = np.unique(np.concatenate([vehicle.axle_normal_loads(0.0),
+                                      vehicle.axle_normal_loads(3.0)]))
+    loads = loads[loads > 0]
+    m = loads.size
+    speeds = np.geomspace(max(float(initial_speed), 1.0), 1.0, 12)
+    creeps = np.geomspace(1e-4, 1.0, 161)
+    if type(adhesion) is PolachAdhesion:
+        probes = [(p.name, PolachAdhesion(p, contact=adhesion.contact)) for p in adhesion.sets]
+    elif type(adhesion) is WilacAdhesion and isinstance(adhesion.water_flow, WaterFlowProfile):
+        probes = [(f"WILAC at {w:g} µl/s", WilacAdhesion(w, adhesion.parameters,
+                                                         contact=adhesion.contact))
+                  for w in sorted({0.0, *map(float, adhesion.water_flow.values)})]
+    elif isinstance(adhesion, CallableAdhesion) and (
+            type(adhesion).evaluate is CallableAdhesion.evaluate):
+        probes = [(adhesion.label, CallableAdhesion(adhesion.function, adhesion.needs_load,
+                                                    adhesion.h, adhesion.label))]
+    else:
+        return math.inf, {}
+    best, where = math.inf, {}
+    for label, model in probes:
+        model.bind(m, radius)
+        for v in speeds:
+            model.prepare(float(v), 0.5 * loads, np.zeros(m), 0.0)
+            if isinstance(model, CallableAdhesion):
+                try:  # the user's law on every (creepage, load) at once
+                    with warnings.catch_warnings(), np.errstate(all="ignore"):
+                        warnings.simplefilter("ignore")
+                        _, slope = model.evaluate(np.repeat(creeps, m), float(v))
+                    slope = np.asarray(slope, float).reshape(creeps.size, m)
+                except Exception:  # the law rejects these arrays: the run will tell
+                    return math.inf, {}
+            else:
+                slope = model.slope_table(creeps, float(v))
+            rate = np.where(slope < 0.0, -slope, 0.0) * (radius**2 * loads) / float(v)
+            rate = np.where(np.isfinite(rate), rate, 0.0)
+            j, a = np.unravel_index(np.argmax(rate), rate.shape)
+            if rate[j, a] > 0 and inertia / rate[j, a] < best:
+                best = inertia / rate[j, a]
+                where = {"condition": label, "speed_m_s": float(v), "creep": float(creeps[j]),
+                         "slope": float(slope[j, a]), "axle_load_N": float(loads[a])}
+    return best, where
 
 
 class BrakingSimulator:
@@ -275,21 +390,32 @@ class BrakingSimulator:
         Speed [m/s] at which the run ends (default 0.05 m/s).
     max_step : float
         Longest internal step [s]; a longer step is split into equal sub-steps (default
-        2e-3 s).
+        2e-3 s). A step longer than :func:`largest_stable_step` is refused (ValueError).
     record : bool
         Keep the history of every step (for :meth:`histories`); with recording the adhesion
         available (peak of each axle's curve) is computed at every refresh, without it on
         request (:meth:`adhesion_available`).
     compiled : bool
-        Run the steps in the compiled kernel when the adhesion model allows it (Polach, or
-        WILAC with a :class:`~railadhesion.braking.adhesion.WaterFlowProfile`); the Python
-        path performs the same operations and accepts any model.
+        Evaluate the adhesion model in compiled code when it allows it (Polach, WILAC with a
+        :class:`~railadhesion.braking.adhesion.WaterFlowProfile`, a
+        :class:`~railadhesion.braking.adhesion.CallableAdhesion` of a numba ``@njit`` law);
+        with ``False`` (or any other model) the step calls the model's Python methods.
+    wsp : WheelSlideProtection, optional
+        Run this (built-in) WSP controller inside the step, every ``wsp.period``, on the
+        wheel speeds and pressures of the sensor model: the valve inputs are then ignored
+        (its settings left at None are taken from the vehicle and cylinders:
+        :meth:`~railadhesion.braking.wsp.WheelSlideProtection.configure`). Default: none
+        (the valves come from :attr:`inputs`).
+    sensors : SensorModel, optional
+        The sensor model between the vehicle and the built-in WSP (default
+        :func:`~railadhesion.braking.sensors.ideal_sensors`).
     """
 
     def __init__(self, vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float, *,
                  cylinders: BrakeCylinders | None = None, gradient: float = 0.0,
                  refresh_period: float = 0.01, stop_speed: float = 0.05,
-                 max_step: float = 2e-3, record: bool = True, compiled: bool = True):
+                 max_step: float = 2e-3, record: bool = True, compiled: bool = True,
+                 wsp=None, sensors=None):
         if not isinstance(vehicle, Vehicle):
             raise ValueError(f"vehicle must be a Vehicle, got {type(vehicle).__name__}")
         if not isinstance(adhesion, AxleAdhesion):
@@ -306,8 +432,10 @@ class BrakingSimulator:
             raise ValueError(f"gradient must be in [-0.1, 0.1] (rise over run), got {gradient!r}")
         if initial_speed <= stop_speed:
             raise ValueError(f"initial_speed must exceed stop_speed ({stop_speed} m/s)")
+        if vehicle.n_axles > MAX_AXLES:  # pragma: no cover - the vehicle file allows 12
+            raise ValueError(f"n_axles must be at most {MAX_AXLES}, got {vehicle.n_axles}")
         d = self.__dict__
-        d["_buf"] = None
+        d["_machine"] = None
         self.vehicle = vehicle
         self.adhesion = adhesion
         self.cylinders = cylinders if cylinders is not None else BrakeCylinders()
@@ -317,164 +445,170 @@ class BrakingSimulator:
         self.max_step = float(max_step)
         self.record = bool(record)
         self.initial_speed = float(initial_speed)
+        self.wsp = wsp
+        self.sensors = sensors
         self._want_compiled = bool(compiled)
         self._build()
 
-    # -- the machine: buf, work, rows -------------------------------------------------------
+    # -- the records ------------------------------------------------------------------------
     def _build(self):
-        """(Re)build the state arrays from the parameters (at construction, or when a
-        parameter changes before the first step)."""
-        from railadhesion.braking.adhesion import PolachAdhesion
+        """(Re)build the records from the parameters (at construction, or when a parameter
+        changes before the first step)."""
+        from railadhesion.braking.sensors import ideal_sensors
+        from railadhesion.braking.wsp import WheelSlideProtection
 
+        self._check_step()
         d = self.__dict__
         veh = self.vehicle
         n = veh.n_axles
         a = self.adhesion
         cyl = self.cylinders
         a.bind(n, veh.wheel_radius)
-        compiled = self._want_compiled and self.compiled
-        kind, kc = -1, 1
-        sections = np.zeros((0, 3))
-        table = np.zeros((1, 5))
-        packed = prof_x = prof_v = np.zeros(0)
-        over_time = linear = False
-        recovery = 0.0
-        fn = None
-        grid = np.zeros(0)
-        if compiled and isinstance(a, CallableAdhesion):
-            fn = _user_cfunc(a)
-            if fn is None:
-                compiled = False
-            else:
-                kind, grid = 2, np.geomspace(1e-4, 1.0, L.USER_GRID)
-        if compiled and type(a) is PolachAdhesion:
-            kind, kc = 0, len(a.sets)
-            table = a._table
-            sections = np.array(a.section_list, float).reshape(-1, 3)
-        elif compiled and kind != 2:  # WILAC with a WaterFlowProfile
-            from railadhesion.models.kernels import pack_wilac
+        if self.wsp is not None:  # the settings left at None come from the vehicle
+            wsp = self.wsp.configure(veh, cyl)
+        else:  # records of the right layout; the WSP does not run
+            wsp = WheelSlideProtection()
+        wsp.reset(n, veh.wheel_radius)
+        sensors = self.sensors if self.sensors is not None else ideal_sensors()
+        records = (wsp.settings_record(), wsp.state_record(n), sensors.settings_record(n),
+                   sensors.state_record(n))
+        from railadhesion.braking.step import FINGERPRINT, MACHINE
 
-            kind, kc = 1, 4
-            if a._packed is None:
-                a._packed = pack_wilac(a.parameters)
-            packed = a._packed
-            prof = a.water_flow
-            prof_x, prof_v = prof.x, prof.values
-            over_time, linear = prof.over == "time", prof.kind == "linear"
-            recovery = 0.0 if a.recovery is None else a.recovery.energy_scale
-        program = L.wilac_program(packed) if kind == 1 else np.zeros(1)
-        o_cond = L.HEADER
-        o_sec = o_cond + 6 * n * kc
-        o_table = o_sec + sections.size
-        o_prof = o_table + table.size
-        o_ws = o_prof + 2 * prof_x.size
-        o_packed = o_ws + 15
-        o_prog = o_packed + packed.size
-        o_scr = o_prog + program.size
-        o_grid = o_scr + 8
-        buf = np.zeros(o_grid + grid.size)
-        buf[o_grid:] = grid
-        buf[o_sec:o_table] = sections.ravel()
-        buf[o_table:o_prof] = np.ravel(table)
-        buf[o_prof:o_prof + prof_x.size] = prof_x
-        buf[o_prof + prof_x.size:o_ws] = prof_v
-        buf[o_packed:o_prog] = packed
-        buf[o_prog:o_scr] = program
-        for slot, value in ((L.O_COND_, o_cond), (L.O_SEC_, o_sec), (L.NSEC_, len(sections)),
-                            (L.O_TABLE_, o_table), (L.O_PACKED_, o_packed), (L.O_PROF_, o_prof),
-                            (L.O_PROG_, o_prog), (L.O_SCR_, o_scr), (L.O_GRID_, o_grid),
-                            (L.FD_H_, getattr(a, "h", 0.0)),
-                            (L.FN_ADDR_, 0 if fn is None else fn.address),
-                            (L.N_PROF_, prof_x.size), (L.O_WS_, o_ws), (L.N_, n), (L.KC_, kc),
-                            (L.KIND_, kind), (L.RADIUS_, veh.wheel_radius),
-                            (L.INERTIA_, veh.wheelset_inertia),
-                            (L.BRAKE_, veh.brake_coefficient), (L.MASS_, veh.total_mass),
-                            (L.DAVIS_A_, veh.davis_a), (L.DAVIS_B_, veh.davis_b),
-                            (L.DAVIS_C_, veh.davis_c),
-                            (L.GRADE_, veh.total_mass * GRAVITY
-                             * math.sin(math.atan(self.gradient))),
-                            (L.STOP_SPEED_, self.stop_speed), (L.PERIOD_, self.refresh_period),
-                            (L.TAU_FILL_, cyl.fill_time_constant),
-                            (L.TAU_VENT_, cyl.vent_time_constant),
-                            (L.P_MAX_, cyl.max_pressure), (L.RECOVERY_, recovery),
-                            (L.OVER_TIME_, over_time), (L.LINEAR_, linear),
-                            (L.BOGIE_, cyl.valves == "bogie"), (L.RECORD_, self.record),
-                            (L.AVAIL_ON_, self.record), (L.MAX_STEP_, self.max_step),
-                            (L.RATIO_, 1), (L.NEWTON_TOL_, NEWTON_TOL),
-                            (L.V_, self.initial_speed), (L.STOP_T_, math.nan),
-                            (L.STOP_X_, math.nan), (L.DT_CACHE_, math.nan)):
-            buf[slot] = value
+        dtype = machine_dtype(*(r.dtype for r in records))
+        d["_machine"] = None
+        machine = np.zeros(1, dtype)
+        for name, rec in zip(("wsp_settings", "wsp_state", "sensor_settings", "sensor_state"),
+                             records, strict=True):
+            machine[0][name] = rec
+        machine[0]["fingerprint"] = FINGERPRINT
+        st = machine[0]["settings"]
+        s = machine[0]["state"]
+        model, aux, entries, tables = self._adhesion_tables(st, n)
+        st["n_axles"] = n
+        st["wheel_radius"] = veh.wheel_radius
+        st["wheelset_inertia"] = veh.wheelset_inertia
+        st["brake_coefficient"] = veh.brake_coefficient
+        st["total_mass"] = veh.total_mass
+        st["davis_a"], st["davis_b"], st["davis_c"] = veh.davis_a, veh.davis_b, veh.davis_c
+        st["gradient_force"] = veh.total_mass * GRAVITY * math.sin(math.atan(self.gradient))
+        static = veh.axle_normal_loads(0.0)
+        st["static_load"][:n] = static
+        st["load_transfer"][:n] = veh.axle_normal_loads(1.0) - static
+        st["axle_offset"][:n] = veh.axle_offsets()
+        st["stop_speed"] = self.stop_speed
+        st["refresh_period"] = self.refresh_period
+        st["max_step"] = self.max_step
+        st["newton_tol"] = NEWTON_TOL
+        st["fill_time_constant"] = cyl.fill_time_constant
+        st["vent_time_constant"] = cyl.vent_time_constant
+        st["max_pressure"] = cyl.max_pressure
+        st["bogie_valves"] = cyl.valves == "bogie"
+        st["model"] = model
+        st["record"] = self.record
+        st["track_available"] = self.record
+        st["wsp_on"] = self.wsp is not None
+        st["control_period"] = wsp.period
+        s["speed"] = self.initial_speed
+        s["omega"][:n] = self.initial_speed / veh.wheel_radius
+        s["load"][:n] = static
+        s["available"][:n] = np.nan
+        s["stop_time"] = s["stop_distance"] = np.nan
+        if dtype == MACHINE:  # machine and tables in one buffer: the per-step calls pass it
+            size = MACHINE.itemsize
+            buffer = np.zeros(size + 8 * tables.size, np.uint8)
+            buffer[:size] = machine.view(np.uint8)
+            buffer[size:] = tables.view(np.uint8)
+            machine = buffer[:size].view(MACHINE)
+            tables = buffer[size:].view(np.float64)
+            step_entries = entries[4:6]
+        else:  # another controller or sensor model: its records' dtypes, the typed entries
+            buffer = None
+            step_entries = (
+                lambda _, dt, f=entries[0]: f(machine, tables, dt, aux),
+                lambda _, rows, dt, f=entries[1]: f(machine, tables, rows, dt, aux))
+        d["_machine"], d["_tables"], d["_n"], d["_aux"] = machine, tables, n, aux
+        d["_buffer"] = buffer
+        d["_advance"], d["_advance_recorded"] = step_entries
+        d["_run"], d["_available"] = entries[2:4]
+        d["_model"] = model
+        d["_state"] = machine["state"]  # shape (1,) views of the state's fields
+        d["_ncols"] = len(self.history_columns())
+        d["_rows"] = np.empty((_ROWS_BLOCK, self._ncols)) if self.record else None
+        d["_blocks"] = []
+        d["_live"] = LiveState(machine, n)
+        d["_inputs"] = StepInputs(machine, n)
+
+    def _adhesion_tables(self, st, n):
+        """The adhesion model's settings and constant tables, the model family and the
+        step's entry points for it."""
+        from railadhesion.braking import step
+        from railadhesion.braking.adhesion import PolachAdhesion, WilacAdhesion
+        from railadhesion.braking.curves import register_python_model
+
+        a = self.adhesion
+        parts = []
+
+        def table(name, values):
+            values = np.ascontiguousarray(values, dtype=float).ravel()
+            st[f"{name}_at"] = sum(p.size for p in parts)
+            parts.append(values)
+
+        compiled = self._want_compiled and self.compiled
+        entries = (step.advance_unrecorded, step.advance, step.run, step.available,
+                   step.advance_builtin, step.advance_builtin_recorded)
         contact = getattr(a, "contact", None)
         if contact is not None:
-            buf[L.K0_], buf[L.QREF_] = contact._k0, contact.reference_load
-        work = L.new_work(n, kc, int(program[0]))
-        static = veh.axle_normal_loads(0.0)
-        work[L.R_STATIC, :n] = static
-        work[L.R_TRANSFER, :n] = veh.axle_normal_loads(1.0) - static
-        work[L.R_OFFSET, :n] = veh.axle_offsets()
-        work[L.R_OMEGA, :n] = self.initial_speed / veh.wheel_radius
-        work[L.R_LOAD, :n] = static
-        work[L.R_AVAIL, :n] = np.nan
-        work[L.R_RELEASED, :n] = np.nan
-        work[L.R_FORCED, :n] = -np.inf
-        d["_buf"], d["_work"], d["_n"] = buf, work, n
-        d["_ncols"] = len(self.history_columns())
-        d["_rows"] = np.empty((_ROWS_BLOCK if self.record else 1, self._ncols))
-        d["_blocks"] = []
-        d["_use_compiled"] = compiled
-        d["_fn"] = fn
-        d["_live"] = LiveState(buf, work, n)
-        d["_inputs"] = StepInputs(work, n)
-        d["_controller"] = None
-        # compiled lazily, at the first step (constructing a simulator compiles nothing)
-        d["_kernel_step"] = self._first_step if compiled else self._python_step
-        d["advance"] = self._make_advance()
-
-    def _make_advance(self):
-        """:meth:`advance` as a closure over the state arrays (no attribute look-ups per call);
-        without recording, the compiled kernel that takes no history rows."""
-        sim, buf, work, live, handle = self, self._buf, self._work, self._live, self._handle
-        if self.record or not self._use_compiled:
-            def advance(dt):
-                status = sim._kernel_step(buf, work, sim._rows, dt)
-                if status > 1:
-                    handle(status, dt)
-                return live
+            st["contact_k0"] = contact.k0
+            st["contact_reference_load"] = contact.reference_load
+        user = _user_entries(a) if compiled and isinstance(a, CallableAdhesion) else None
+        if user is not None:
+            model, aux, entries = USER, 0, user
+            st["creep_step"] = a.h
+            grid = np.geomspace(1e-4, 1.0, USER_GRID)
+            table("grid", grid)
+            st["grid_count"] = grid.size
+        elif compiled and type(a) is PolachAdhesion:
+            model, aux = POLACH, 0
+            table("polach_sets", a.set_table)
+            st["polach_sets_count"] = len(a.sets)
+            sections = np.array(a.section_list, float).reshape(-1, 3)
+            table("sections", sections)
+            st["sections_count"] = len(sections)
+        elif compiled and type(a) is WilacAdhesion:
+            model, aux = WILAC, 0
+            prof = a.water_flow
+            table("profile", np.concatenate([prof.x, prof.values]))
+            st["profile_count"] = prof.x.size
+            st["profile_over_time"] = prof.over == "time"
+            st["profile_linear"] = prof.kind == "linear"
+            st["recovery_energy"] = 0.0 if a.recovery is None else a.recovery.energy_scale
+            packed = a.packed
+            table("wilac", packed)
+            st["wilac_count"] = packed.size
         else:
-            fast = None
+            model, aux = PYTHON, None
+            st["python_key"] = register_python_model(a, self)
+            entries = entries[:4] + (step.advance_python, step.advance_python_recorded)
+        tables = np.concatenate(parts) if parts else np.zeros(1)
+        return model, aux, entries, tables
 
-            def advance(dt):  # first call: compile (or load), then hand over to ``fast``
-                nonlocal fast
-                if fast is None:
-                    from railadhesion.braking import _kernels as kern
-
-                    entry = _kernel_entry(kern.step_free, (buf, work, math.nan))
-
-                    def fast(dt):
-                        status = entry(buf, work, dt)
-                        if status > 1:
-                            handle(status, dt)
-                        return live
-
-                    fast.__doc__ = BrakingSimulator.advance.__doc__
-                    sim.__dict__["advance"] = fast
-                return fast(dt)
-        advance.__doc__ = BrakingSimulator.advance.__doc__
-        return advance
-
-    def _first_step(self, buf, work, rows, dt):
-        from railadhesion.braking import _kernels as kern
-
-        # a call with dt = NaN returns BAD_DT before touching anything
-        entry = _kernel_entry(kern.step, (buf, work, rows, math.nan))
-        self.__dict__["_kernel_step"] = entry
-        return entry(buf, work, rows, dt)
+    def _check_step(self):
+        tau, where = largest_stable_step(self.vehicle, self.adhesion, self.initial_speed)
+        if self.max_step > tau:
+            raise ValueError(
+                f"the time step {self.max_step:g} s (dt of simulate and of a study, "
+                f"time_step_s of a scenario, max_step of BrakingSimulator) is too large for "
+                f"the wheel dynamics: the largest stable step is {tau:.3g} s. On the falling "
+                f"branch of the creep curve ({where['condition']}: dμ/dξ = {where['slope']:.3g} at "
+                f"creepage {where['creep']:.3g}, speed {where['speed_m_s']:.3g} m/s, axle load "
+                f"{where['axle_load_N']:.4g} N) a wheel's slide grows with the time constant "
+                f"J v/(R² N |dμ/dξ|) = {tau:.3g} s; use a step of at most {tau:.3g} s")
 
     @property
     def compiled(self) -> bool:
-        """True if the adhesion model can run in the compiled kernel (Polach, WILAC with a
+        """True if the adhesion model can be evaluated in compiled code (Polach, WILAC with a
         WaterFlowProfile, or a :class:`CallableAdhesion` of a numba ``@njit`` function);
-        steps then run there unless ``compiled=False`` was asked."""
+        it then is unless ``compiled=False`` was asked."""
         from railadhesion.braking.adhesion import PolachAdhesion, WaterFlowProfile, WilacAdhesion
 
         kind = type(self.adhesion)
@@ -484,11 +618,17 @@ class BrakingSimulator:
             return _is_jitted(self.adhesion)
         return kind is PolachAdhesion
 
+    @property
+    def runs_compiled(self) -> bool:
+        """True if the adhesion model is evaluated in compiled code (False: its Python
+        methods are called back from the step)."""
+        return self._model != PYTHON
+
     # -- FMI-like guard, state access -------------------------------------------------------
     def __setattr__(self, name, value):
-        buf = self.__dict__.get("_buf")
-        if name in _FIXED and buf is not None:
-            if buf[L.STEPS_] > 0:
+        machine = self.__dict__.get("_machine")
+        if name in _FIXED and machine is not None:
+            if machine[0]["state"]["steps"] > 0:
                 raise AttributeError(
                     f"{name} is a parameter; it cannot change after the first step")
             super().__setattr__(name, value)
@@ -496,18 +636,9 @@ class BrakingSimulator:
             return
         super().__setattr__(name, value)
 
-    def __getattr__(self, name):  # state held in the arrays (only called for missing names)
-        row = _ROWS.get(name)
-        if row is not None:
-            return self.__dict__["_work"][row, :self.__dict__["_n"]]
-        slot = _SCALARS.get(name)
-        if slot is not None:
-            return float(self.__dict__["_buf"][slot])
-        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
-
     @property
     def stopped(self) -> bool:
-        return bool(self._buf[L.STOPPED_])
+        return bool(self._state["stopped"][0])
 
     @property
     def inputs(self) -> StepInputs:
@@ -529,9 +660,18 @@ class BrakingSimulator:
     @property
     def solver_counts(self) -> dict:
         """Steps taken, Newton iterations, and steps done again by the safeguarded solve."""
-        b = self._buf
-        return {"steps": int(b[L.STEPS_]), "newton_iterations": int(b[L.NEWTON_]),
-                "safeguarded_steps": int(b[L.FALLBACK_])}
+        s = self._machine[0]["state"]
+        return {"steps": int(s["steps"]), "newton_iterations": int(s["newton_iterations"]),
+                "safeguarded_steps": int(s["safeguarded_steps"])}
+
+    @property
+    def command_report(self) -> dict:
+        """The highest pressure commanded so far [Pa], the cylinders' limit, and the number
+        of steps in which a command above the limit was clipped to it."""
+        s = self._machine[0]["state"]
+        return {"highest_command_Pa": float(s["highest_command"]),
+                "max_pressure_Pa": self.cylinders.max_pressure,
+                "clipped_steps": int(s["clipped_steps"])}
 
     def state(self) -> BrakingState:
         """The current state as a :class:`BrakingState` (a snapshot with copies)."""
@@ -539,16 +679,10 @@ class BrakingSimulator:
 
     def adhesion_available(self) -> np.ndarray:
         """Peak adhesion coefficient of each axle's curve at the current conditions."""
-        if self._use_compiled:
-            from railadhesion.braking import _kernels as kern
-
-            if self._buf[L.NLANES_] == 0 and self._buf[L.STEPS_] == 0:
-                return np.full(self._n, np.nan)
-            kern.available(self._buf, self._work)
-        else:
-            if self._buf[L.STEPS_] == 0:
-                return np.full(self._n, np.nan)
-            self._work[L.R_AVAIL, :self._n] = self.adhesion.available(self.speed)
+        if self._state["steps"][0] == 0:
+            return np.full(self._n, np.nan)
+        if self._available(self._machine, self._tables, self._aux) == STALE:
+            self._stale()
         return self.available.copy()
 
     # -- stepping ---------------------------------------------------------------------------
@@ -562,40 +696,63 @@ class BrakingSimulator:
         A step longer than ``max_step`` is split into equal sub-steps. At rest (after the
         stop) nothing changes any more.
         """
-        # replaced per instance by the same code as a closure (see _make_advance)
-        status = self._kernel_step(self._buf, self._work, self._rows, dt)
+        if dt.__class__ is not float:
+            dt = _as_float(dt)
+        if self._rows is None:
+            status = self._advance(self._buffer, dt)
+        else:
+            status = self._advance_recorded(self._buffer, self._rows, dt)
         if status > 1:
             self._handle(status, dt)
         return self._live
 
     def _handle(self, status, dt):
         """Statuses other than OK/STOPPED of a step call: new rows block, or an error."""
-        buf = self._buf
-        if status == L.ROWS_FULL:
+        s = self._machine[0]["state"]
+        if status == ROWS_FULL:
             nsub = max(1, int(math.ceil(dt / self.max_step - 1e-9)))
-            nrow = int(buf[L.NROW_])
+            nrow = int(s["rows_written"])
             self._blocks.append(self._rows[:nrow].copy())
             self.__dict__["_rows"] = np.empty((max(_ROWS_BLOCK, nsub), self._ncols))
-            buf[L.NROW_] = 0
-            status = self._kernel_step(buf, self._work, self._rows, dt)
+            s["rows_written"] = 0
+            status = self._advance_recorded(self._buffer, self._rows, _as_float(dt))
             if status <= 1:
                 return
-        if status == L.BAD_DT:
+        if status == BAD_DT:
             raise ValueError(f"dt must be in (0, inf) s, got {dt!r}")
-        axle = int(buf[L.ERR_AXLE_])
-        value = float(buf[L.ERR_VALUE_])
-        if status == L.BAD_COMMAND:
+        axle = int(s["error_axle"])
+        value = float(s["error_value"])
+        if status == BAD_COMMAND:
             raise ValueError(f"pressure_command must be in [0, inf) Pa; axle {axle + 1} has "
                              f"{value!r}")
-        if status == L.BAD_VALVE:
+        if status == BAD_VALVE:
             raise ValueError(f"valves must be 0 (apply), 1 (hold) or 2 (vent); axle {axle + 1} "
                              f"has {value!r}")
-        if status == L.BAD_TORQUE:
+        if status == BAD_TORQUE:
             raise ValueError(f"torque must be a finite number [N m]; axle {axle + 1} has "
                              f"{value!r}")
-        if status == L.NONFINITE:
+        if status == NONFINITE:
             self._fail(axle, f" (creep {value:.6g})")
-        raise RuntimeError(f"unexpected status {status} of the braking kernel")  # pragma: no cover
+        if status == STALE:
+            self._stale()
+        raise RuntimeError(f"unexpected status {status} of the braking step")  # pragma: no cover
+
+    def _stale(self):
+        from railadhesion.braking import step
+
+        raise RuntimeError(
+            "the compiled braking step in numba's cache was built from other sources than "
+            "the installed ones (a stale cache: numba keys it on step.py alone). Delete the "
+            f"numba cache files (*.nbi, *.nbc) of {step.__file__.rsplit('/', 1)[0]}/__pycache__ "
+            "and of railadhesion/models/__pycache__, or set NUMBA_CACHE_DIR to a new "
+            "directory, and run again")
+
+    def _fail(self, axle, detail):
+        raise SimulationError(
+            f"adhesion model {self.adhesion.describe()} returned a non-finite value for "
+            f"axle {axle + 1} at t = {self.time:.6g} s (distance {self.distance:.6g} m, "
+            f"speed {self.speed:.6g} m/s){detail}; the simulation cannot proceed"
+        )
 
     def step(self, dt: float, inputs=None) -> BrakingState:
         """Advance by ``dt`` [s] with the inputs held; return the new state (a snapshot).
@@ -647,7 +804,7 @@ class BrakingSimulator:
             u.valves.fill(APPLY)
         else:
             try:
-                if self._buf[L.BOGIE_] != 0.0 and len(valves) == 2:
+                if self.cylinders.valves == "bogie" and len(valves) == 2:
                     u.valves[:n // 2] = valves[0]
                     u.valves[n // 2:] = valves[1]
                 else:
@@ -655,357 +812,46 @@ class BrakingSimulator:
             except (ValueError, TypeError):
                 raise ValueError(f"valves must have {n} entries (2 with valves per bogie), "
                                  f"each 0 (apply), 1 (hold) or 2 (vent), got {valves!r}") from None
-        self.advance(dt)
+        self.advance(float(dt))
         return self._live.snapshot()
 
-    # -- Python reference path (any adhesion model) -------------------------------------------
-    def _python_step(self, buf, work, rows, dt):
-        """:func:`railadhesion.braking._kernels.step` in Python (same checks and statuses)."""
-        if not (isinstance(dt, int | float) and dt > 0.0 and dt < math.inf):
-            return L.BAD_DT
-        if buf[L.STOPPED_] != 0.0:
-            return L.STOPPED
-        n = self._n
-        for i in range(n):
-            c = work[L.R_CMD, i]
-            if not (c >= 0.0 and c < math.inf):
-                buf[L.ERR_AXLE_], buf[L.ERR_VALUE_] = i, c
-                return L.BAD_COMMAND
-            s = work[L.R_VIN, i]
-            if s not in (0.0, 1.0, 2.0):
-                buf[L.ERR_AXLE_], buf[L.ERR_VALUE_] = i, s
-                return L.BAD_VALVE
-            q = work[L.R_TORQUE, i]
-            if not (-math.inf < q < math.inf):
-                buf[L.ERR_AXLE_], buf[L.ERR_VALUE_] = i, q
-                return L.BAD_TORQUE
-        nsub = max(1, int(math.ceil(dt / buf[L.MAX_STEP_] - 1e-9)))
-        if buf[L.RECORD_] != 0.0 and buf[L.NROW_] + nsub > rows.shape[0]:
-            return L.ROWS_FULL
-        self._set_valves(work[L.R_VIN, :n])
-        h = dt / nsub
-        for _ in range(nsub):
-            status = self._advance_python(h)
-            if status != L.OK:
-                return status
-        return L.OK
-
-    def _set_valves(self, new):
-        """Per-bogie grouping (if configured), vent-action count, new valve states."""
-        n = self._n
-        work = self._work
-        new = np.array(new, float)
-        if self._buf[L.BOGIE_] != 0.0:
-            half = n // 2
-            new[:half] = new[:half].max()
-            new[half:] = new[half:].max()
-        work[L.R_VACT, :n] += (new == VENT) & (work[L.R_VALVE, :n] != VENT)
-        work[L.R_VALVE, :n] = new
-
-    def _refresh_python(self):
-        buf, work, n = self._buf, self._work, self._n
-        loads = np.maximum(work[L.R_STATIC, :n] + work[L.R_TRANSFER, :n] * buf[L.D_], 0.0)
-        work[L.R_LOAD, :n] = loads
-        # frictional energy per metre dissipated by the axles ahead of each axle [J/m]
-        heat = np.cumsum(work[L.R_FORCE, :n] * np.abs(work[L.R_CREEP, :n]))
-        dissipation = np.concatenate([[0.0], heat[:-1]])
-        speed = float(buf[L.V_])
-        self.adhesion.prepare(speed, 0.5 * loads, buf[L.X_] - work[L.R_OFFSET, :n],
-                              float(buf[L.T_]), dissipation)
-        if buf[L.AVAIL_ON_] != 0.0:
-            work[L.R_AVAIL, :n] = self.adhesion.available(speed)
-
-    def _advance_python(self, dt):
-        """``_kernels._advance`` in Python/NumPy, for any adhesion model."""
-        buf, work, n = self._buf, self._work, self._n
-        radius, inertia = buf[L.RADIUS_], buf[L.INERTIA_]
-        brake, mass = buf[L.BRAKE_], buf[L.MASS_]
-        if buf[L.T_] >= buf[L.NEXT_] - 1e-12:
-            self._refresh_python()
-            period = buf[L.PERIOD_]
-            buf[L.NEXT_] = (math.floor(buf[L.T_] / period + 1e-9) + 1) * period
-        v0, d0 = float(buf[L.V_]), float(buf[L.D_])
-        work[L.R_LOAD, :n] = np.maximum(work[L.R_STATIC, :n] + work[L.R_TRANSFER, :n] * d0,
-                                        0.0)
-        p1, pbar, vented = self.cylinders.advance(work[L.R_PRESS, :n], work[L.R_VALVE, :n],
-                                                  work[L.R_CMD, :n], dt)
-        work[L.R_P1, :n], work[L.R_PBAR, :n], work[L.R_VSTEP, :n] = p1, pbar, vented
-        buf[L.CMD_MAX_] = max(0.0, float(np.max(work[L.R_CMD, :n])))
-        resistance = 0.0
-        if v0 > 0.0:
-            resistance = buf[L.DAVIS_A_] + buf[L.DAVIS_B_] * v0 + buf[L.DAVIS_C_] * v0 * v0
-        external = resistance + buf[L.GRADE_]
-        h_prev = buf[L.H_PREV_]
-        r_pred = dt / h_prev if h_prev > 0.0 else 0.0
-        v = self._newton_python(v0, dt, external, r_pred)
-        if v is None:
-            buf[L.FALLBACK_] += 1.0
-            v, omega, mu = self._safeguarded_python(v0, dt, external)
-        else:
-            omega, mu = work[L.R_W, :n].copy(), work[L.R_EMU, :n].copy()
-        wb = 0.0
-        wc = 0.0
-        torque = work[L.R_TORQUE, :n]
-        for i in range(n):  # summed in axle order, as the compiled kernel does
-            wb += (brake * pbar[i] - torque[i]) * omega[i] * dt
-            wc += mu[i] * work[L.R_LOAD, i] * (v - omega[i] * radius) * dt
-        buf[L.WB_] += wb
-        buf[L.WC_] += wc
-        buf[L.WR_] += resistance * v * dt + 0.0
-        buf[L.WG_] += buf[L.GRADE_] * v * dt
-        vr = max(v, 1e-6)
-        ke = 0.5 * mass * v * v
-        for i in range(n):
-            ke += 0.5 * inertia * omega[i] * omega[i]
-        work[L.R_DOMEGA, :n] = omega - work[L.R_OMEGA, :n]
-        work[L.R_VENTED, :n] += vented
-        work[L.R_OMEGA, :n] = omega
-        work[L.R_PRESS, :n] = p1
-        work[L.R_MU, :n] = mu
-        work[L.R_FORCE, :n] = mu * work[L.R_LOAD, :n]
-        work[L.R_CREEP, :n] = (v - omega * radius) / vr
-        buf[L.DV_PREV_] = v - v0
-        buf[L.H_PREV_] = dt
-        buf[L.D_] = (v0 - v) / dt
-        buf[L.X_] += 0.5 * (v0 + v) * dt
-        buf[L.T_] += dt
-        buf[L.V_] = v
-        buf[L.STEPS_] += 1.0
-        status = L.OK
-        if v <= buf[L.STOP_SPEED_]:
-            d = buf[L.D_]
-            if v > 0 and d > 0:
-                buf[L.STOP_X_] = buf[L.X_] + v * v / (2 * d)
-                buf[L.STOP_T_] = buf[L.T_] + v / d
-            else:
-                buf[L.STOP_X_] = buf[L.X_]
-                buf[L.STOP_T_] = buf[L.T_]
-            buf[L.STOPPED_] = 1.0
-            status = L.STOPPED
-        if buf[L.RECORD_] != 0.0:
-            r = self._rows[int(buf[L.NROW_])]
-            r[:4] = buf[L.T_], buf[L.X_], v, buf[L.D_]
-            for k, row in enumerate((L.R_OMEGA, L.R_PRESS, L.R_VALVE, L.R_CREEP, L.R_FORCE,
-                                     L.R_LOAD, L.R_MU, L.R_AVAIL)):
-                r[4 + k * n:4 + (k + 1) * n] = work[row, :n]
-            b = 4 + 8 * n
-            r[b:b + 5] = (buf[L.CMD_MAX_], ke, buf[L.WB_], buf[L.WC_],
-                          buf[L.WR_] + buf[L.WG_])
-            buf[L.NROW_] += 1.0
-        return status
-
-    def _newton_python(self, v0, dt, external, r_pred):
-        """``_kernels._newton`` in Python (the same operations in the same order)."""
-        buf, work, n = self._buf, self._work, self._n
-        radius, inertia = buf[L.RADIUS_], buf[L.INERTIA_]
-        brake, mass = buf[L.BRAKE_], buf[L.MASS_]
-        tol = buf[L.NEWTON_TOL_]
-        j_dt = inertia / dt
-        m_dt = mass / dt
-        omega0 = work[L.R_OMEGA, :n].tolist()
-        pbar = work[L.R_PBAR, :n].tolist()
-        loads = work[L.R_LOAD, :n].tolist()
-        dom = work[L.R_DOMEGA, :n].tolist()
-        torque = work[L.R_TORQUE, :n].tolist()
-        v = v0 + r_pred * buf[L.DV_PREV_]
-        clamp = [w0 == 0.0 for w0 in omega0]
-        w = [0.0 if clamp[i] else (omega0[i] + r_pred * dom[i]
-                                   if omega0[i] + r_pred * dom[i] > 0.0 else omega0[i])
-             for i in range(n)]
-        g, a, b, dw = [0.0] * n, [0.0] * n, [0.0] * n, [0.0] * n
-        for _ in range(L.NEWTON_MAX):
-            buf[L.NEWTON_] += 1.0
-            if not v > 1e-6:
-                return None
-            iv = 1.0 / v
-            iv2 = iv * iv
-            xi = np.array([(v - w[i] * radius) * iv for i in range(n)])
-            mu, dmu, dmv = (np.asarray(x, float).tolist()
-                            for x in self.adhesion.slopes(xi, v))
-            h = m_dt * (v - v0) + external
-            dd = m_dt
-            s_acc = 0.0
-            rhs = 0.0
-            for i in range(n):
-                if not (math.isfinite(mu[i]) and math.isfinite(dmu[i])
-                        and math.isfinite(dmv[i])):
-                    return None
-                h += loads[i] * mu[i]
-                dsdv = w[i] * radius * iv2
-                dd += loads[i] * (dmu[i] * dsdv + dmv[i])
-                if clamp[i]:
-                    continue
-                rn = radius * loads[i]
-                g[i] = j_dt * (w[i] - omega0[i]) - rn * mu[i] + brake * pbar[i] - torque[i]
-                a_i = j_dt + rn * dmu[i] * radius * iv
-                b[i] = -rn * (dmu[i] * dsdv + dmv[i])
-                c = -loads[i] * dmu[i] * radius * iv
-                if not a_i > 0.0:
-                    return None
-                a[i] = 1.0 / a_i
-                s_acc += c * b[i] * a[i]
-                rhs += c * g[i] * a[i]
-            schur = dd - s_acc
-            if not schur > 0.0:
-                return None
-            dv = (-h + rhs) / schur
-            err = abs(dv)
-            changed = False
-            for i in range(n):
-                if clamp[i]:
-                    dw[i] = 0.0
-                    static = (-j_dt * omega0[i] - radius * loads[i] * mu[i] + brake * pbar[i]
-                              - torque[i])
-                    if static < 0.0:
-                        clamp[i] = False
-                        changed = True
-                    continue
-                dw[i] = (-g[i] - b[i] * dv) * a[i]
-                err = max(err, abs(dw[i]) * radius)
-                if w[i] + dw[i] <= 0.0:
-                    clamp[i] = True
-                    changed = True
-            if not changed and err <= tol * v:
-                for i in range(n):
-                    dxi = -radius * dw[i] * iv + w[i] * radius * iv2 * dv
-                    work[L.R_EMU, i] = mu[i] + dmu[i] * dxi + dmv[i] * dv
-                    work[L.R_W, i] = w[i] + dw[i]
-                return v + dv
-            v = v + dv
-            for i in range(n):
-                w[i] = 0.0 if clamp[i] else max(w[i] + dw[i], 0.0)
-        return None
-
-    def _safeguarded_python(self, v0, dt, external):
-        """``_kernels._safeguarded`` in Python: secant steps on the train speed around the
-        safeguarded wheel solve, to 1e-10 m/s."""
-        buf, work, n = self._buf, self._work, self._n
-        mass = buf[L.MASS_]
-        v = v0 - dt * buf[L.D_]
-        omega = work[L.R_OMEGA, :n].copy()
-        mu = np.zeros(n)
-        v_prev, r_prev = v, 0.0
-        for it in range(30):
-            omega, mu = self._solve_wheels_python(v, dt, omega)
-            total = 0.0
-            for i in range(n):  # summed in axle order, as the compiled kernel does
-                total += mu[i] * work[L.R_LOAD, i]
-            v_new = v0 - dt * (total + external) / mass
-            r = v_new - v
-            if abs(r) < _TOL:
-                v = v_new
-                break
-            # secant step on r(v) = F(v) - v (plain fixed point on the first pass)
-            v_next = v_new if it == 0 or r == r_prev else v - r * (v - v_prev) / (r - r_prev)
-            v_prev, r_prev = v, r
-            v = v_next
-        return v, omega, mu
-
-    def _fail(self, axle, detail):
-        raise SimulationError(
-            f"adhesion model {self.adhesion.describe()} returned a non-finite value for "
-            f"axle {axle + 1} at t = {self.time:.6g} s (distance {self.distance:.6g} m, "
-            f"speed {self.speed:.6g} m/s){detail}; the simulation cannot proceed"
-        )
-
-    def _evaluate(self, creep, v):
-        mu, dmu = self.adhesion.evaluate(creep, v)
-        mu = np.asarray(mu, float)
-        dmu = np.asarray(dmu, float)
-        bad = ~(np.isfinite(mu) & np.isfinite(dmu))
-        if np.any(bad):
-            i = int(np.argmax(bad))
-            self._fail(i, f" (creep {creep[i]:.6g})")
-        return mu, dmu
-
-    def _solve_wheels_python(self, v, dt, guess):
-        """Vectorised over axles: the same algorithm as ``_kernels._solve_wheels``."""
-        buf, work, n = self._buf, self._work, self._n
-        radius, inertia, c = buf[L.RADIUS_], buf[L.INERTIA_], buf[L.BRAKE_]
-        omega0 = work[L.R_OMEGA, :n]
-        vr = max(v, 1e-6)
-        rn = radius * work[L.R_LOAD, :n]
-        traction = work[L.R_TORQUE, :n]
-        torque = c * work[L.R_PBAR, :n]
-        mu1, _ = self._evaluate(np.ones(n), v)
-        locked = (-inertia * omega0 / dt - rn * mu1 + torque - traction) >= 0
-        lo = np.zeros(n)
-        hi = omega0 + dt * (rn * 2.0 + np.maximum(traction, 0.0)) / inertia + 1e-9
-        w = np.minimum(np.maximum(guess, lo), hi)
-        active = ~locked
-        for _ in range(100):
-            xi = (v - w * radius) / vr
-            mu, dmu = self._evaluate(xi, v)
-            g = inertia * (w - omega0) / dt - rn * mu + torque - traction
-            dg = inertia / dt + rn * dmu * radius / vr
-            with np.errstate(divide="ignore", invalid="ignore"):
-                step = g / dg
-            converged = (dg > 0) & (np.abs(step) * radius < _TOL)
-            neg = g < 0
-            lo = np.where(neg, w, lo)
-            hi = np.where(neg, hi, w)
-            new = w - step
-            bad = ~(dg > 0) | ~(new > lo) | ~(new < hi)
-            new = np.where(bad, 0.5 * (lo + hi), new)
-            new = np.where(converged, w - step, new)
-            done = converged | ((hi - lo) * radius < _TOL)
-            w = np.where(active, new, w)
-            active &= ~done
-            if not np.any(active):
-                break
-        w = np.where(locked, 0.0, w)
-        mu, _ = self._evaluate((v - w * radius) / vr, v)
-        return w, mu
-
     # -- whole runs (used by simulate) ------------------------------------------------------
-    def _configure_run(self, controller, demand, ratio):
-        """Settings of the compiled whole-run loop: brake demand and the default WSP."""
-        buf = self._buf
-        buf[L.DEM_P_], buf[L.DEM_T0_], buf[L.DEM_RAMP_] = (
-            demand.pressure, demand.start_time, demand.ramp_time)
-        buf[L.RATIO_] = ratio
-        buf[L.WSP_ON_] = controller is not None
-        if controller is not None:
-            st = controller.settings
-            o = int(buf[L.O_WS_])
-            buf[o:o + 15] = (st.period, st.reference_deceleration, st.hold_slip_ratio,
-                             st.hold_slip_min, st.vent_slip_ratio, st.vent_slip_min,
-                             st.reapply_slip_ratio, st.reapply_slip_min, st.hold_deceleration,
-                             st.vent_deceleration, st.recovery_acceleration,
-                             st.deceleration_filter, st.watchdog_time,
-                             st.watchdog_refill_time, 1.0)  # legacy kernel WSP: see run.py
+    def configure_run(self, demand) -> None:
+        """The brake demand of the compiled whole-run loop (:meth:`run_compiled`)."""
+        st = self._machine[0]["settings"]
+        st["demand_pressure"] = demand.pressure
+        st["demand_start"] = demand.start_time
+        st["demand_ramp"] = demand.ramp_time
 
-    def _run_compiled(self, nmax, dt, progress, initial_speed):
-        """The loop of simulate() in the compiled kernel, in blocks of rows."""
-        from railadhesion.braking import _kernels as kern
-
-        buf, work = self._buf, self._work
+    def run_compiled(self, nmax, dt, progress=None):
+        """Steps of a whole stop in the compiled loop (brake demand of :meth:`configure_run`,
+        the built-in WSP if any), in blocks of history rows, until the stop or ``nmax``
+        steps."""
+        s = self._machine[0]["state"]
+        run = self._run
         chunk = int(min(nmax, max(1000, round(5.0 / dt))))
         while True:
-            if buf[L.NROW_] > 0:
-                self._blocks.append(self._rows[:int(buf[L.NROW_])].copy())
+            if s["rows_written"] > 0:
+                self._blocks.append(self._rows[:int(s["rows_written"])].copy())
             if self._rows.shape[0] != chunk:
                 self.__dict__["_rows"] = np.empty((chunk, self._ncols))
-            buf[L.NROW_] = 0
-            k_end = min(nmax, int(buf[L.K_]) + chunk)
-            status = kern.run(buf, work, self._rows, dt, k_end)
+            s["rows_written"] = 0
+            k_end = min(nmax, int(s["run_step"]) + chunk)
+            status = run(self._machine, self._tables, self._rows, float(dt), k_end, self._aux)
             if progress is not None:
-                progress(1.0 - buf[L.V_] / initial_speed)
-            if status == L.NONFINITE:
-                self._fail(int(buf[L.ERR_AXLE_]), f" (creep {buf[L.ERR_VALUE_]:.6g})")
-            if status == L.STOPPED or int(buf[L.K_]) >= nmax:
+                progress(1.0 - self.speed / self.initial_speed)
+            if status == NONFINITE:
+                self._fail(int(s["error_axle"]), f" (creep {float(s['error_value']):.6g})")
+            if status == STALE:
+                self._stale()
+            if status == BAD_DT:  # pragma: no cover - checked by simulate
+                raise ValueError(f"dt must be in (0, inf) s, got {dt!r}")
+            if self.stopped or int(s["run_step"]) >= nmax:
                 break
 
     # -- results ----------------------------------------------------------------------------
     def history_columns(self) -> list[str]:
-        n = self.vehicle.n_axles
-        cols = ["time", "distance", "train_speed", "deceleration"]
-        for name in ("wheel_speed", "brake_pressure", "valve", "creep", "creep_force",
-                     "normal_load", "adhesion_used", "adhesion_available"):
-            cols += [f"{name}_{i}" for i in range(1, n + 1)]
-        cols += ["pressure_command", "kinetic_energy", "brake_work", "creep_work",
-                 "resistance_work"]
-        return cols
+        return history_columns(self.vehicle.n_axles)
 
     def initial_row(self) -> tuple:
         n = self.vehicle.n_axles
@@ -1022,9 +868,8 @@ class BrakingSimulator:
         import pandas as pd
 
         cols = self.history_columns()
-        nrow = int(self._buf[L.NROW_]) if self.record else 0
-        data = np.vstack([np.asarray(self.initial_row(), float)[None, :], *self._blocks,
-                          self._rows[:nrow]])
+        last = [] if self._rows is None else [self._rows[:int(self._state["rows_written"][0])]]
+        data = np.vstack([np.asarray(self.initial_row(), float)[None, :], *self._blocks, *last])
         frame = pd.DataFrame(data, columns=cols)
         n = self.vehicle.n_axles
         for i in range(1, n + 1):
@@ -1036,6 +881,32 @@ class BrakingSimulator:
         kwargs = dict(vehicle=self.vehicle, adhesion=self.adhesion,
                       initial_speed=self.initial_speed, cylinders=self.cylinders,
                       gradient=self.gradient, refresh_period=self.refresh_period,
-                      stop_speed=self.stop_speed, max_step=self.max_step, record=self.record)
+                      stop_speed=self.stop_speed, max_step=self.max_step, record=self.record,
+                      wsp=self.wsp, sensors=self.sensors)
         kwargs.update(changes)
         return BrakingSimulator(**kwargs)
+
+
+def _state_array(field, doc):
+    def get(self):
+        return self._state[field][0, :self._n]
+    return property(get, doc=doc)
+
+
+def _state_scalar(field, doc):
+    def get(self):
+        return float(self._state[field][0])
+    return property(get, doc=doc)
+
+
+for _name, _field in _STATE_ARRAYS.items():  # views of the state record, per axle
+    setattr(BrakingSimulator, _name, _state_array(_field, f"state.{_field} per axle (a view)"))
+for _name, _field in _STATE_SCALARS.items():
+    setattr(BrakingSimulator, _name, _state_scalar(_field, f"state.{_field}"))
+
+
+def _as_float(dt) -> float:
+    try:
+        return float(dt)
+    except (TypeError, ValueError):
+        raise ValueError(f"dt must be in (0, inf) s, got {dt!r}") from None

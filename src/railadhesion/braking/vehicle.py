@@ -17,8 +17,11 @@ suspension / pivots) up to the body's centre of gravity. ``half_pivot_spacing`` 
 horizontal distance from the body's centre of gravity to *each* connection point, i.e. half the
 bogie-centre distance. With this reading eq. 11's load transfer ``M_c h d / (2 l)`` is exactly
 the moment balance of the body: the inertia force ``M_c d`` acting at height h is balanced by
-``±ΔN`` on two supports ``2 l`` apart, ``ΔN · 2l = M_c d h``. (Read as the full pivot distance,
-l would give twice the moment balance's transfer.)
+``±ΔN`` on two supports ``2 l`` apart, ``ΔN · 2l = M_c d h``. The paper's text calls l "the
+horizontal distance between connection points"; read as that full pivot distance L, eq. 11
+would give ``M_c h d / (2 L)``, *half* the moment balance's transfer ``M_c h d / L``. Eq. 13 also
+needs the half distance: the suspension of each bogie deflects ``ΔN / k_2`` at a lever l from
+the centre of gravity, so ``θ = ΔN / (k_2 l) = M_c h d / (2 k_2 l²)``, the paper's eq. 13.
 
 **Axle 1 is the leading axle** (first in the direction of travel); axles ``1 … n/2`` belong to
 the leading bogie. Under deceleration ``d > 0`` the body pitches forward and the leading bogie

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from railadhesion.numerics import exp, jitable
 
-__all__ = ["falling_friction_factor"]
+__all__ = ["falling_friction_factor", "falling_friction_slope"]
 
 
 @jitable
@@ -31,3 +31,11 @@ def falling_friction_factor(slip_velocity, ratio, decay):
     """
     factor = (1.0 - ratio) * exp(-decay * slip_velocity) + ratio
     return 1.0 if (decay == 0.0) | (ratio == 1.0) else factor
+
+
+@jitable
+def falling_friction_slope(slip_velocity, ratio, decay):
+    """d(mu/mu0)/dw = -(1 - A) B exp(-B w) [s/m] of :func:`falling_friction_factor` (the
+    derivative of the same law, for Newton iterations); exactly 0.0 for constant friction."""
+    slope = -(1.0 - ratio) * decay * exp(-decay * slip_velocity)
+    return 0.0 if (decay == 0.0) | (ratio == 1.0) else slope

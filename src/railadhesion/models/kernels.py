@@ -87,6 +87,7 @@ from railadhesion.models.wilac_parameters import (
     wilac_blend_weights,
     wilac_factors,
     wilac_normalise,
+    wilac_regression,
 )
 from railadhesion.numerics import jit
 
@@ -97,9 +98,12 @@ __all__ = [
     "pack_wilac",
     "polach_curve_scalar",
     "polach_checked",
+    "polach_longitudinal",
     "polach_scalar",
     "wilac_checked",
+    "wilac_condition_parameters",
     "wilac_scalar",
+    "wilac_weights_scalar",
 ]
 
 #: Number of header values of a packed WILAC set (:func:`pack_wilac`).
@@ -123,20 +127,36 @@ fletcher_scalar = jit(fletcher_curve)
 polach_curve_scalar = jit(polach_curve)
 
 
-# The two functions below serve the braking kernels (railadhesion.braking._kernels) until they
-# call the WILAC laws directly; they hold no equation of their own.
+# Compositions of the laws for the braking integrator (railadhesion.braking.curves), which
+# evaluates WILAC's four conditions once per axle and load; they hold no equation of their own.
+
+#: ``polach_longitudinal(creep, speed, stiffness, k_A, k_S, mu0, A, B) -> (mu, dmu/ds,
+#: dmu/dV)``: :func:`railadhesion.models.polach.polach_longitudinal`.
+polach_longitudinal = jit(_polach.polach_longitudinal)
 
 
 @jit
-def _factors(q, v, packed, fac):
-    """Fill ``fac`` (7) with the regression factors of Q and v and the factor 1."""
-    qn, vn = wilac_normalise(q, v, packed)
-    fac[0], fac[1], fac[2], fac[3], fac[4], fac[5] = wilac_factors(qn, vn)
-    fac[6] = 1.0
+def wilac_weights_scalar(water_flow, packed):
+    """WILAC's four blending weights (dry, damp 2, damp 1, wet) at one water flow [ul/s]:
+    :func:`~railadhesion.models.wilac_parameters.wilac_blend_weights` with the transitions of
+    the packed set."""
+    return wilac_blend_weights(water_flow, packed[6], packed[7], packed[8], packed[9],
+                               packed[10], packed[11])  # fmt: skip
 
 
 @jit
-def _weights(w, packed):
-    """The four weights of the water flow w (:func:`wilac_blend_weights`)."""
-    return wilac_blend_weights(w, packed[6], packed[7], packed[8], packed[9], packed[10],
-                               packed[11])  # fmt: skip
+def wilac_condition_parameters(normal_force, speed, packed, factors, out):
+    """WILAC's Polach parameters (k_A, k_S, mu0, A, B) of the four conditions at a wheel load
+    [N] and speed [m/s] into ``out`` (20 values, condition by condition): Q' and v'
+    (:func:`~railadhesion.models.wilac_parameters.wilac_normalise`), the factors into
+    ``factors`` (7 values, the last the factor 1) and the regressions
+    (:func:`~railadhesion.models.wilac_parameters.wilac_regression`), as
+    :func:`~railadhesion.models.wilac.wilac_law` computes them."""
+    qn, vn = wilac_normalise(normal_force, speed, packed)
+    f0, f1, f2, f3, f4, f5 = wilac_factors(qn, vn)
+    factors[0], factors[1], factors[2] = f0, f1, f2
+    factors[3], factors[4], factors[5] = f3, f4, f5
+    factors[6] = 1.0
+    for i in range(4):
+        for j in range(5):
+            out[5 * i + j] = wilac_regression(packed, i, j, f0, f1, f2, f3, f4, f5)

@@ -34,7 +34,7 @@ from railadhesion._validate import (
     check_positive,
     check_range,
 )
-from railadhesion.contact.friction import falling_friction_factor
+from railadhesion.contact.friction import falling_friction_factor, falling_friction_slope
 from railadhesion.contact.kalker import (
     AOB_MAX,
     AOB_MIN,
@@ -75,6 +75,7 @@ __all__ = [
     "polach_force",
     "polach_forces",
     "polach_law",
+    "polach_longitudinal",
 ]
 
 _TWO_OVER_PI = 2.0 / math.pi
@@ -173,11 +174,39 @@ def polach_curve(creep, slope, inverse_mu, ratio):
     z = math.pi * slope * creep / (2.0 * (1.0 + ratio))
     x = z * inverse_mu
     y = ratio * x
-    g = math.atan(y) / y if y > 1e-6 else 1.0 - y * y / 3.0
+    g = atan_nonneg(y) / y if y > 1e-6 else 1.0 - y * y / 3.0
     xx = x * x
     f = 2.0 / math.pi * z * (1.0 / (1.0 + xx) + ratio * g)
     fp = (1.0 - xx) / ((1.0 + xx) * (1.0 + xx)) + ratio / (1.0 + y * y)
     return f, slope * fp / (1.0 + ratio), creep * fp / (1.0 + ratio)
+
+
+@jitable(inline="always")
+def polach_longitudinal(creep, speed, stiffness, k_A, k_S, mu0, A, B):  # noqa: N803
+    """Polach's adhesion coefficient for pure longitudinal creepage, with its two slopes.
+
+    The model of :func:`polach_forces` with no lateral creepage and no spin, for a contact
+    whose geometry and load are fixed (a braking axle): with s = ``creep`` >= 0, V =
+    ``speed`` and ``stiffness`` K = (pi/4) G a b C11 / Q [-], the friction falls with the slip
+    velocity, mu_k = mu0 (:func:`~railadhesion.contact.friction.falling_friction_factor` at
+    w = s V), and the force is the curve of :func:`polach_curve` at mu_k (Polach 2005, Wear
+    258, eqs. for F with k_A, k_S; initial slope (2/pi)(k_A + k_S) K). Returns
+    ``(mu, dmu/ds, dmu/dV)``: the slopes by the chain rule through mu_k, with
+    d(F/Q)/d mu_k = (F/Q - s d(F/Q)/ds|mu_k) / mu_k (F/Q is mu_k times a function of K s /
+    mu_k). No friction left (A = 0 and exp(-B w) underflowed) gives (0, 0, 0), as
+    :func:`polach_law` gives no force. Call-free (vectorises when inlined in a loop).
+    """
+    w = creep * speed
+    mu_k = mu0 * falling_friction_factor(w, A, B)
+    dmu_k = mu0 * falling_friction_slope(w, A, B)  # d mu_k / d w
+    friction = mu_k > 0.0
+    mu_k = mu_k if friction else 1.0  # zeros below
+    slope = _TWO_OVER_PI * (k_A + k_S) * stiffness
+    f, df_ds, _ = polach_curve(creep, slope, 1.0 / mu_k, k_S / k_A)
+    df_dmu = (f - creep * df_ds) / mu_k
+    if not friction:
+        return 0.0, 0.0, 0.0
+    return f, df_ds + df_dmu * dmu_k * speed, df_dmu * dmu_k * creep
 
 
 # --- compiled entry points (numba, built on first use) ---------------------------------------
