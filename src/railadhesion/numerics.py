@@ -519,7 +519,7 @@ def _pool():
 
 
 def run_chunks(func, args, nchunk: int, parallel: bool) -> list:
-    """Run ``func(*args, first, last)`` over the chunks ``0 .. nchunk - 1``; return the
+    """Run ``func(*args, first, last)`` over the chunks ``0`` to ``nchunk - 1``; return the
     results of the calls.
 
     ``parallel`` False, or one thread (``numba.get_num_threads()``): one call. Else the chunks

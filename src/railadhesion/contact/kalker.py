@@ -258,8 +258,9 @@ def kalker_rows(buf, ratio_row, nu_row, out_row, chunk, m):
     return ok
 
 
-#: Compiled :func:`kalker_law`, (c11, c22, c23, c33) of one contact (built on first call;
-#: its numba dispatcher, for numba code: :func:`railadhesion.models.kernels.kalker_scalar`).
+#: Compiled :func:`~railadhesion.contact.kalker.kalker_law`, (c11, c22, c23, c33) of one
+#: contact (built on first call; its numba dispatcher, for numba code:
+#: :func:`railadhesion.models.kernels.kalker_scalar`).
 kalker_scalar = kernel(kalker_law)
 
 

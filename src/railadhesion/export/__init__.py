@@ -12,7 +12,8 @@
   (:func:`write_table_netcdf`) and as a plain CSV (:func:`write_table_csv`), with the error
   of multilinear interpolation in the table measured at the cell midpoints.
 
-See the README section "Using the models from other tools" and ``docs/creep-force-tables.md``.
+See ``docs/fmu.md``, ``docs/creep-force-tables.md`` and the guide
+``docs/guides/multibody.md``.
 """
 
 from railadhesion.export.braking_fmu import braking_fmu_variables, build_braking_fmu

@@ -2,8 +2,9 @@
 
 The FMU binary shipped by pythonfmu runs the slave class (a Python file stored in the FMU's
 ``resources/``) in the host's Python interpreter: the machine that runs the FMU needs a Python
-with ``railadhesion`` (and its dependencies) installed. See the README section "Using the
-models from other tools" for a worked FMPy example and the limits.
+with ``railadhesion`` (and its dependencies) installed. See ``docs/fmu.md`` for what the FMU
+holds and what its host needs, and the gallery example "A creep-force FMU, run from FMPy"
+(``examples/gallery/plot_fmu_fmpy.py``) for a worked FMPy run.
 
 The module is split in two layers so that further FMUs (e.g. a braking vehicle) can be added:
 

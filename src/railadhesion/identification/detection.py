@@ -25,7 +25,8 @@ little more than the measurement noise, CG1 to 0.2 % creep with noise 0.002 give
 k_a not determined, fewer than 3 points below the creep of full slip, e.g. data that run to
 20-60 % creep, far beyond it), the level is ``unknown``, never ``normal`` or ``low``, and
 :attr:`DetectionResult.warnings` says why.
-:func:`fletcher_detection_study` runs this on Fletcher's ten conditions (README table).
+:func:`fletcher_detection_study` runs this on Fletcher's ten conditions (the table of
+``docs/validation.md``, "Low-adhesion detection").
 """
 
 from __future__ import annotations

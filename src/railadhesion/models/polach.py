@@ -211,8 +211,9 @@ def polach_longitudinal(creep, speed, stiffness, k_A, k_S, mu0, A, B):  # noqa: 
 
 # --- compiled entry points (numba, built on first use) ---------------------------------------
 
-#: Compiled :func:`polach_law`: (fx, fy) of one contact, no validation (its numba dispatcher,
-#: for numba code: :func:`railadhesion.models.kernels.polach_scalar`).
+#: Compiled :func:`~railadhesion.models.polach.polach_law`: (fx, fy) of one contact, no
+#: validation (its numba dispatcher, for numba code:
+#: :func:`railadhesion.models.kernels.polach_scalar`).
 polach_scalar = kernel(polach_law)
 
 
@@ -256,8 +257,9 @@ def polach_bad_input(sx, sy, psi, q, v, a, b, g, nu, k_a, k_s, mu0, big_a, big_b
 @kernel
 def polach_checked(creep_x, creep_y, spin, normal_force, speed, a, b, G, nu, c11, c22, c23,
                    k_A, k_S, mu0, A, B):  # fmt: skip
-    """:func:`polach_law` with validation: (fx, fy, bad), ``bad`` = -1 if every argument is in
-    range, else :func:`polach_bad_input` (the forces are then NaN)."""
+    """:func:`~railadhesion.models.polach.polach_law` with validation: (fx, fy, bad), ``bad``
+    = -1 if every argument is in range, else
+    :func:`~railadhesion.models.polach.polach_bad_input` (the forces are then NaN)."""
     bad = polach_bad_input(creep_x, creep_y, spin, normal_force, speed, a, b, G, nu, k_A, k_S,
                            mu0, A, B)  # fmt: skip
     if bad >= 0:

@@ -148,7 +148,7 @@ def wilac_law(creep_x, creep_y, spin, normal_force, speed, a, b, water_flow, G, 
 
 # --- compiled entry points (numba, built on first use) ---------------------------------------
 
-#: Compiled :func:`wilac_law` (its numba dispatcher, for numba code:
+#: Compiled :func:`~railadhesion.models.wilac.wilac_law` (its numba dispatcher, for numba code:
 #: :func:`railadhesion.models.kernels.wilac_scalar`).
 wilac_scalar = kernel(wilac_law)
 
@@ -156,8 +156,8 @@ wilac_scalar = kernel(wilac_law)
 @kernel
 def wilac_checked(creep_x, creep_y, spin, normal_force, speed, a, b, water_flow, G, nu, c11,
                   c22, c23, packed):  # fmt: skip
-    """:func:`wilac_law` with validation: (fx, fy, ok); ``ok`` False if an argument is out of
-    range (forces NaN)."""
+    """:func:`~railadhesion.models.wilac.wilac_law` with validation: (fx, fy, ok); ``ok`` False
+    if an argument is out of range (forces NaN)."""
     bad = polach_bad_input(creep_x, creep_y, spin, normal_force, speed, a, b, G, nu, 1.0, 1.0,
                            1.0, 0.0, 0.0)  # fmt: skip
     if bad >= 0 or not 0.0 <= water_flow < math.inf:

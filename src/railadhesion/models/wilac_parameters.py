@@ -610,8 +610,8 @@ _TERMS = _COUNTS + 20
 
 
 def pack_wilac(params: WilacParameters) -> np.ndarray:
-    """Pack a :class:`WilacParameters` into one read-only float64 array (for the compiled
-    laws), computed once per set.
+    """Pack a :class:`~railadhesion.models.WilacParameters` into one read-only float64 array
+    (for the compiled laws), computed once per set.
 
     Returns
     -------
