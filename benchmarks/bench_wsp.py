@@ -2,7 +2,7 @@
 
     PYTHONPATH=src python3 benchmarks/bench_wsp.py [--quick]
 
-1. The whole default programme (30 stops, 40-200 km/h, 2.5 h of simulated braking at a 1 ms
+1. The whole default programme (31 stops, 40-200 km/h, 2.5 h of simulated braking at a 1 ms
    step) on the default WSP, as ``railadhesion wsp-test default --out DIR`` runs it: JSON/CSV
    after every case and one figure per case; beside the same programme without figures
    (ratio), after a warm-up run of one case (numba compiles or loads its cache once per

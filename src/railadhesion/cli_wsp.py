@@ -24,7 +24,7 @@ def register(app: typer.Typer) -> None:
     @app.command("wsp-test")
     def wsp_test(
         programme: str = typer.Argument(
-            ..., help="Programme TOML file, or 'default' for the shipped 30-case programme."),
+            ..., help="Programme TOML file, or 'default' for the shipped 31-case programme."),
         controller: str = typer.Option(
             "default", "--controller",
             help="'default' (the package's WSP), a .fmu file (FMI 2.0 co-simulation WSP unit), "
@@ -65,19 +65,20 @@ def register(app: typer.Typer) -> None:
         result = run_wsp_programme(prog, ctrl, out=out, figures=figures, histories=histories,
                                    progress=progress)
         table = Table(title=escape(f"{prog.name or programme} — {result.controller}"))
-        # stop / its adhesion-limited distance; extension over the dry stop; longest lock;
-        # time in deep slide; mean braking creepage; vented free air
-        for col in ("case", "status", "stop [m]", "/ideal", "dry+%", "lock [s]", "deep [s]",
-                    "creep", "air [l]", "ok"):
+        # stop / its adhesion-limited distance; / the stop without WSP; extension over the
+        # dry stop; longest lock; time in deep slide; mean braking creepage; vented free air
+        for col in ("case", "status", "stop [m]", "/ideal", "/no WSP", "dry+%", "lock [s]",
+                    "deep [s]", "creep", "air [l]", "ok"):
             table.add_column(escape(col), justify="left" if col in ("case", "status") else
                              "right", no_wrap=col == "case")
         for c in result.cases:
             if c.get("status") == "error":
                 table.add_row(escape(c["name"]), "[red]error[/red]", "", "", "", "", "", "",
-                              "", "no")
+                              "", "", "no")
                 continue
             table.add_row(escape(c["name"]), escape(c["status"]),
                           _fmt(c["stopping_distance_m"], ".1f"), _fmt(c["distance_ratio"], ".3f"),
+                          _fmt(c["distance_vs_no_wsp"], ".3f"),
                           _fmt(c["extension_vs_dry_percent"], ".0f"),
                           _fmt(c["longest_lock_s"], ".2f"), _fmt(c["deep_slide_s"], ".2f"),
                           _fmt(c["mean_creep"], ".3f"), _fmt(c["vented_air_l"], ".0f"),
@@ -90,7 +91,8 @@ def register(app: typer.Typer) -> None:
         console.print(
             f"{o['passed']}/{o['cases']} cases passed; worst longest lock "
             f"{_fmt(o['worst_longest_lock_s'], '.2f')} s, worst distance ratio "
-            f"{_fmt(o['worst_distance_ratio'], '.3f')}, mean adhesion utilisation "
+            f"{_fmt(o['worst_distance_ratio'], '.3f')} (against no WSP "
+            f"{_fmt(o['worst_distance_vs_no_wsp'], '.3f')}), mean adhesion utilisation "
             f"{_fmt(o['mean_adhesion_utilisation'], '.3f')}, vented air "
             f"{_fmt(o['total_vented_air_l'], '.0f')} l", highlight=False)
         console.print(f"outputs written to {escape(str(out))}")

@@ -86,6 +86,8 @@ def test_default_programme_covers_what_issue_20_asks():
         ('format = "railadhesion-wsp-programme"', 'format = "x"', "format"),
         ("[criteria]", "[wsp]\nhold_slip_ratio_x = 1\n[criteria]", "wsp.hold_slip_ratio_x"),
         ("[criteria]", "[wsp]\nperiod_s = 5.0\n[criteria]", "wsp.period_s"),
+        ("max_longest_lock_s = 1.0", "max_longest_lock_s = 1.0\nmax_ratio_no_wsp = 0.0",
+         "criteria.max_ratio_no_wsp"),
     ],
 )
 def test_bad_programme_names_the_field(tmp_path, old, new, field):
@@ -94,6 +96,22 @@ def test_bad_programme_names_the_field(tmp_path, old, new, field):
     with pytest.raises(BrakingFileError) as err:
         load_wsp_programme(path)
     assert field in str(err.value) and "prog.toml" in str(err.value)
+
+
+def test_default_programme_holds_the_stop_without_wsp_where_adhesion_does_not_fall():
+    """Constant adhesion and WILAC cases carry the check against the stop without WSP
+    (3 %, 5 % with noisy sensors); a flooded WILAC rail (adhesion rising with slip to its
+    peak near 15-20 %) is among them."""
+    cases = load_wsp_programme("default").cases
+    flat = [c for c in cases if c.adhesion.section is None and (
+        c.adhesion.model == "wilac" or c.adhesion.parameters.A == 1)]
+    assert len(flat) >= 20
+    for c in flat:
+        limit = c.criteria["max_ratio_no_wsp"]
+        assert limit == (1.05 if c.sensors == "noisy" else 1.03), c.name
+    assert any(c.adhesion.model == "wilac" and c.adhesion.water_flow >= 350 for c in flat)
+    falling = [c for c in cases if c.adhesion.model == "polach" and c.adhesion.parameters.A < 1]
+    assert all(math.isinf(c.criteria["max_ratio_no_wsp"]) for c in falling)
 
 
 def test_adhesion_limited_stop_is_brake_limited_on_a_dry_rail():
@@ -144,8 +162,12 @@ def test_small_programme_writes_every_output(tmp_path):
     for key in ("stopping_distance_m", "adhesion_limited_distance_m", "distance_ratio",
                 "dry_stopping_distance_m", "extension_vs_dry_percent",
                 "mean_adhesion_utilisation", "longest_lock_s", "deep_slide_s",
-                "vented_air_l", "vent_actions", "checks", "axles"):
+                "vented_air_l", "vent_actions", "checks", "axles", "no_wsp_distance_m",
+                "distance_vs_no_wsp"):
         assert key in case
+    assert case["distance_vs_no_wsp"] == case["stopping_distance_m"] / case["no_wsp_distance_m"]
+    assert "distance_vs_no_wsp" in case["checks"]
+    assert doc["overall"]["worst_distance_vs_no_wsp"] >= case["distance_vs_no_wsp"]
     assert case["distance_ratio"] >= 0.999  # nothing beats the adhesion-limited stop
     assert case["stopping_distance_m"] > case["dry_stopping_distance_m"]
     assert (out / "cases.csv").read_text().count("\n") == 3

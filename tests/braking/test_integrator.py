@@ -43,11 +43,16 @@ def test_newton_and_safeguarded_solve_reach_the_same_backward_euler_solution():
     assert np.sum(newton.vent_actions) > 3  # WSP at work: slides and recoveries
     a, b = newton.histories(), safe.histories()
     assert a.shape == b.shape
-    assert newton.stop_distance == pytest.approx(safe.stop_distance, rel=1e-9)
     # the solvers' tolerances differ (accepted Newton update 5e-6 v, nested solve 1e-10 m/s);
-    # a sliding wheel on the falling branch of its curve amplifies such differences a little
+    # a sliding wheel on the falling branch of its curve amplifies such differences: here axle
+    # 4 slides to 60 % creep at 2.3 m/s (7.3-7.6 s; the wheel's time constant J v / (R² N
+    # |dμ/dξ|) is about 0.05 s there), the valve sequences stay identical and the difference
+    # grows from 1e-8 to 1.1e-4 m/s and decays again (stop: 1.8e-9 relative)
+    assert newton.stop_distance == pytest.approx(safe.stop_distance, rel=5e-9)
     speeds = [f"wheel_speed_{i}" for i in range(1, 5)] + ["train_speed"]
-    np.testing.assert_allclose(a[speeds].to_numpy(), b[speeds].to_numpy(), rtol=0, atol=1e-5)
+    np.testing.assert_allclose(a[speeds].to_numpy(), b[speeds].to_numpy(), rtol=0, atol=2e-4)
+    valves = [f"valve_{i}" for i in range(1, 5)]
+    assert (a[valves].to_numpy() == b[valves].to_numpy()).all()
 
 
 def test_one_newton_iteration_per_step_on_a_smooth_stop():

@@ -44,6 +44,12 @@ water_flow_ul_s = 25.0
 [wsp]
 period_s = 0.005
 watchdog_time_s = 2.0
+# the step-halving replay below replays this run's valve states open loop: the default
+# WSP's look-ahead steps hold a wheel in slip beyond the adhesion peak of this falling
+# curve, where the wheel is unstable without the controller and any O(dt) difference grows
+# until it locks (replayed at dt/2: 268 m against 186 m, whatever the integrator); without
+# the look-ahead the valve sequence is one the wheels follow open loop
+reapply_lookahead_s = 0.0
 """
 
 

@@ -7,6 +7,8 @@ import warnings
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as hst
 from numba import njit
 
 from railadhesion.braking import APPLY, HOLD, VENT, BrakeCylinders, load_vehicle
@@ -252,3 +254,192 @@ def test_docs_list_every_setting():
     text = (Path(__file__).resolve().parents[2] / "docs" / "wsp.md").read_text(encoding="utf-8")
     for name in WSPSettings.sources():
         assert f"| `{name}` |" in text, name
+
+
+# -- using the adhesion that is there (issue 20 follow-up) ----------------------------------
+class _BandRecorder:
+    """The default WSP in ``simulate``'s loop, recording its reference speed and slip bands."""
+
+    def __init__(self, **settings):
+        self.wsp = WheelSlideProtection(**settings)
+        self.period = self.wsp.period
+        self.trace = []
+
+    def reset(self, n_axles, wheel_radius):
+        self.wsp.configure(COACH, BrakeCylinders(max_pressure=6e5))
+        self.wsp.reset(n_axles, wheel_radius)
+
+    def __call__(self, time, wheel_speeds, pressure_command, brake_pressures=None,
+                 external_speed=math.nan):
+        out = self.wsp(time, wheel_speeds, pressure_command, brake_pressures, external_speed)
+        d = self.wsp.diagnostics()
+        self.trace.append((d["reference_speed_m_s"], *d["band_scales"]))
+        return out
+
+
+def _polach(mu, A=1.0, B=0.0):
+    return PolachParameters(k_A=1.0, k_S=0.4, mu0=mu, A=A, B=B, name="test")
+
+
+@pytest.mark.parametrize(
+    ("rail", "rises"),
+    [("flooded", True), ("constant", True), ("falling", False)])
+def test_the_slip_band_rises_where_adhesion_does_not_fall_with_slip_and_falls_where_it_does(
+        rail, rises):
+    """Above 20 m/s: on WILAC at 350 µl/s (adhesion rising with slip to 15-20 %) and on a
+    constant adhesion the bands sit raised (median 3x: hold 15 %); on a falling law
+    (μ0 0.05, A 0.4, B 0.6: peak near 0.5-1 %) they sit at or below the settings' band
+    more than 90 % of the time."""
+    from railadhesion.braking import PolachAdhesion, WilacAdhesion, simulate
+
+    adhesion = {"flooded": WilacAdhesion(350.0),
+                "constant": PolachAdhesion(_polach(0.05)),
+                "falling": PolachAdhesion(_polach(0.05, A=0.4, B=0.6))}[rail]
+    rec = _BandRecorder()
+    simulate(COACH, adhesion, 200 / 3.6, 5.5e5, cylinders=BrakeCylinders(max_pressure=6e5),
+             wsp=rec)
+    trace = np.array(rec.trace)
+    bands = trace[trace[:, 0] > 20.0, 1:]
+    assert len(bands) > 500
+    if rises:
+        assert (np.median(bands, axis=0) >= 2.0).all()
+    else:
+        assert np.mean(bands <= 1.0) > 0.9
+        assert (bands >= WSPSettings().band_scale_min).all()
+
+
+def _wilac(flow, noisy=False, valves="axle", speed=200 / 3.6):
+    return BenchCase(f"wilac{flow}", AdhesionCase("wilac", None, float(flow)), COACH, speed,
+                     5.5e5, 6e5, valves, "noisy" if noisy else "ideal", 0.01, False, 0)
+
+
+@pytest.fixture(scope="module")
+def wet_runs():
+    ctrl = load_controller()
+    return {"350": run_wsp_case(_wilac(350), ctrl),
+            "350 noisy": run_wsp_case(_wilac(350, noisy=True), ctrl),
+            "60 bogie 160": run_wsp_case(_wilac(60, valves="bogie", speed=160 / 3.6), ctrl)}
+
+
+@pytest.mark.parametrize(
+    "key", [(0.03, False), (0.05, False), (0.03, True), (0.05, True), "350", "350 noisy",
+            "60 bogie 160"])
+def test_the_stop_is_not_longer_than_without_wsp_where_adhesion_does_not_fall_with_slip(
+        hard_runs, wet_runs, key):
+    """Where a locked wheel keeps the curve's adhesion (constant μ; WILAC at 60-350 µl/s,
+    within 8 % of its peak at full slide), a WSP must not stop the train later than no WSP:
+    at most 3 % longer with exact wheel speeds, 5 % with the noisy sensors' ±1 % wheel
+    diameters (not calibrated). The WSP of issue 20 took 943.5 m against 864.2 m without WSP
+    on WILAC at 350 µl/s from 200 km/h (+9.2 %)."""
+    from railadhesion.braking import simulate
+
+    summary, h, _ = hard_runs[key] if isinstance(key, tuple) else wet_runs[key]
+    noisy = summary["sensors"] == "noisy"
+    assert summary["status"] == "ok" and summary["longest_lock_s"] <= 1.0
+    assert summary["mean_creep"] <= 0.3
+    assert summary["distance_vs_no_wsp"] <= (1.05 if noisy else 1.03)
+    if key == "350":  # the bench's reference stop is the simulator's stop without WSP
+        bare = simulate(COACH, AdhesionCase("wilac", None, 350.0).build(), 200 / 3.6, 5.5e5,
+                        cylinders=BrakeCylinders(max_pressure=6e5))
+        assert summary["no_wsp_distance_m"] == pytest.approx(bare.stopping_distance, rel=1e-12)
+        assert bare.stopping_distance == pytest.approx(864.2, abs=0.1)  # docs/validation.md
+
+
+def test_the_damp_example_stops_where_the_earlier_wsp_did():
+    """examples/brake_damp.toml (WILAC 25 µl/s on 50-900 m, 160 km/h): 643.5 m with the WSP
+    of issue 20, 606.7 m with the WSP before it (docs/validation.md); now within 1 % of the
+    latter."""
+    from pathlib import Path
+
+    from railadhesion.braking.scenario import load_scenario
+
+    examples = Path(__file__).resolve().parents[2] / "examples"
+    res = load_scenario(examples / "brake_damp.toml").simulate()
+    assert res.success and res.summary["longest_lock_s"] <= 1.0
+    assert res.stopping_distance <= 1.01 * 606.7
+
+
+def test_a_probe_vents_deeper_until_the_released_wheel_recovers():
+    """A steeply falling law (μ0 0.05, A 0.25: a full slide needs a quarter of the peak's
+    torque): a probed wheel vented to a fraction of its pressure can stay held in a deep
+    slide; its speed is not a fix until it has re-accelerated (else the reference follows
+    it down and every wheel locks)."""
+    summary, h, trace = run_wsp_case(_case(0.05, False, A=0.25, B=0.6), load_controller())
+    assert summary["status"] == "ok" and summary["longest_lock_s"] <= 1.0
+    assert slide_metrics(h, R, speed_floor=0.05)["longest_lock_s"] <= 1.0
+    v = np.interp(trace["time"], h["time"], h["train_speed"])
+    moving = v > 2.0
+    assert np.max(np.abs(trace["reference_speed"][moving] / v[moving] - 1)) < 0.06
+    assert summary["controller_diagnostics"]["probes"] > 5
+
+
+@pytest.mark.parametrize("brake_factor", [0.8, 1.2])
+@pytest.mark.parametrize("noisy", [False, True])
+def test_a_brake_20_percent_off_the_nominal_rate(brake_factor, noisy):
+    """The WSP's brake rate (seed 002 eq. 8) is the vehicle's nominal one; real pad friction
+    differs. With the brake 20 % weaker or stronger than the WSP assumes, μ = 0.03 at
+    200 km/h still meets issue 20's targets (the learnt drift takes the rest)."""
+    from dataclasses import replace
+
+    nominal = WheelSlideProtection().configure(COACH, BrakeCylinders()).settings
+    vehicle = replace(COACH, brake_coefficient=COACH.brake_coefficient * brake_factor)
+    case = BenchCase("pads", AdhesionCase("polach", _polach(0.03)), vehicle, 200 / 3.6, 5.5e5,
+                     6e5, "axle", "noisy" if noisy else "ideal", 0.01, False, 0)
+    ctrl = load_controller(WheelSlideProtection(
+        deceleration_per_pressure=nominal.deceleration_per_pressure,
+        wheel_inertia_pressure=nominal.wheel_inertia_pressure))
+    summary, _, _ = run_wsp_case(case, ctrl)
+    assert summary["status"] == "ok" and summary["longest_lock_s"] <= 1.0
+    assert summary["distance_ratio"] <= 1.15 and summary["mean_creep"] <= 0.3
+    assert summary["distance_vs_no_wsp"] <= 1.05
+
+
+def test_dry_rail_no_wsp_action_with_a_brake_25_percent_stronger_than_nominal():
+    from dataclasses import replace
+
+    from railadhesion.braking import PolachAdhesion, simulate
+
+    nominal = WheelSlideProtection().configure(COACH, BrakeCylinders()).settings
+    strong = replace(COACH, brake_coefficient=COACH.brake_coefficient * 1.25)
+    wsp = WheelSlideProtection(deceleration_per_pressure=nominal.deceleration_per_pressure,
+                               wheel_inertia_pressure=nominal.wheel_inertia_pressure)
+    res = simulate(strong, PolachAdhesion("polach2005_dry"), 200 / 3.6, 5.5e5,
+                   cylinders=BrakeCylinders(max_pressure=6e5), wsp=wsp)
+    assert res.summary["vent_actions"] == 0
+
+
+@given(seed=hst.integers(0, 2**32 - 1), speed=hst.floats(0.5, 80.0),
+       slip=hst.floats(0.0, 1.0), pressure=hst.floats(0.0, 6e5),
+       noise=hst.floats(0.0, 0.05), pressures_known=hst.booleans(),
+       bogie=hst.booleans())
+@settings(max_examples=40, deadline=None)
+def test_wsp_update_keeps_its_invariants_on_any_readings(seed, speed, slip, pressure, noise,
+                                                          pressures_known, bogie):
+    """Random wheel-speed and pressure readings (sliding, recovering, noisy, pressures
+    unknown): valve codes stay 0-2 (the same for the axles of a bogie), the reference finite
+    and >= 0, the band scales within their bounds, the learnt drift within [0,
+    reference_deceleration] and the probe interval within its bounds."""
+    rng = np.random.default_rng(seed)
+    w = WheelSlideProtection(valves="bogie" if bogie else "axle").configure(COACH)
+    s = w.settings
+    rec, state = w.settings_record(), w.state_record(4)
+    out = np.zeros(4, np.int64)
+    v = speed
+    cmd = np.full(4, 5.5e5)
+    for k in range(400):
+        t = k * s.period
+        v = max(v - 0.5 * s.period, 0.0)
+        depth = slip * (0.5 + 0.5 * np.sin(0.02 * k + rng.uniform(0, 6.3, 4)))
+        omega = v * (1 - depth) * (1 + noise * rng.standard_normal(4)) / R
+        p = (pressure * rng.uniform(0.0, 1.0, 4) if pressures_known else np.full(4, np.nan))
+        wsp_update(rec, state, t, np.maximum(omega, 0.0), p, cmd, math.nan, out)
+        r = state[0]
+        assert set(out.tolist()) <= {APPLY, HOLD, VENT}
+        if bogie:
+            assert out[0] == out[1] and out[2] == out[3]
+        assert math.isfinite(r["v_ref"]) and r["v_ref"] >= 0.0
+        ng = int(r["n_groups"])
+        assert (r["scale"][:ng] >= s.band_scale_min - 1e-12).all()
+        assert (r["scale"][:ng] <= s.band_scale_max + 1e-12).all()
+        assert 0.0 <= r["excess"] <= s.reference_deceleration
+        assert s.probe_interval <= r["probe_gap"] <= s.probe_interval_max

@@ -1,7 +1,7 @@
 """WSP test bench: a programme of low-adhesion stops run on any WSP controller.
 
 A *programme* (TOML, ``format = "railadhesion-wsp-programme"``; ``docs/wsp.md`` documents every
-field; the shipped ``default`` programme has 30 cases) lists braking cases: vehicle, speed,
+field; the shipped ``default`` programme has 31 cases) lists braking cases: vehicle, speed,
 brake, valve arrangement, sensors and the rail's adhesion. :func:`run_wsp_programme` runs each
 case in the braking simulator with the controller in the loop, through the stepping API: every
 control period the sensors (:mod:`railadhesion.braking.sensors`) measure the wheel speeds,
@@ -14,7 +14,8 @@ WheelSlideProtection`; a user's Python controller (the interface of
 imported with FMPy (:class:`FmuController`).
 
 Per case it reports the stopping distance against the adhesion-limited stop
-(:func:`adhesion_limited_stop`) and the dry-rail stop, the adhesion utilisation, the lock and
+(:func:`adhesion_limited_stop`), the same stop without WSP and the dry-rail stop, the
+adhesion utilisation, the lock and
 slide figures of :func:`railadhesion.braking.metrics.slide_metrics`, the air consumption, and
 pass/fail against the programme's criteria. A case that fails (a bad controller output, a
 simulation error) is recorded with its message and the others still run; with ``out`` the
@@ -94,7 +95,7 @@ __all__ = [
 PROGRAMME_FORMAT = "railadhesion-wsp-programme"
 #: The criteria of a case and their defaults (the issue-20 targets).
 DEFAULT_CRITERIA = {"max_longest_lock_s": 1.0, "max_mean_creep": 0.3,
-                    "max_distance_ratio": math.inf}
+                    "max_distance_ratio": math.inf, "max_ratio_no_wsp": math.inf}
 _DATA = Path(__file__).resolve().parent.parent / "data"
 
 
@@ -214,7 +215,8 @@ _CASE_KEYS = {
     "max_time_s": 600.0,
     "gradient": 0.0,
 }
-_CRITERIA_KEYS = ("max_longest_lock_s", "max_mean_creep", "max_distance_ratio")
+_CRITERIA_KEYS = ("max_longest_lock_s", "max_mean_creep", "max_distance_ratio",
+                  "max_ratio_no_wsp")
 
 
 def _criteria(tab, where, base):
@@ -225,9 +227,10 @@ def _criteria(tab, where, base):
                                        f"{where}.max_longest_lock_s", 0.0, 1e4)
     out["max_mean_creep"] = number(tab.get("max_mean_creep", out["max_mean_creep"]),
                                    f"{where}.max_mean_creep", 0.0, 1.0)
-    ratio = tab.get("max_distance_ratio", out["max_distance_ratio"])
-    out["max_distance_ratio"] = (math.inf if ratio == math.inf else
-                                 number(ratio, f"{where}.max_distance_ratio", 1.0, 100.0))
+    for key, low in (("max_distance_ratio", 1.0), ("max_ratio_no_wsp", 0.01)):
+        ratio = tab.get(key, out[key])
+        out[key] = math.inf if ratio == math.inf else number(ratio, f"{where}.{key}", low,
+                                                             100.0)
     return out
 
 
@@ -374,7 +377,7 @@ def programme_from_document(doc, base=".") -> WSPProgramme:
 
 
 def load_wsp_programme(path="default") -> WSPProgramme:
-    """Read and check a programme file (``"default"``: the shipped 30-case programme).
+    """Read and check a programme file (``"default"``: the shipped 31-case programme).
     Errors are :class:`~railadhesion.braking.BrakingFileError` naming the file and field."""
     if os.fspath(path) == "default":
         path = _DATA / "wsp_programme_default.toml"
@@ -750,6 +753,22 @@ def adhesion_limited_stop(vehicle: Vehicle, adhesion: AxleAdhesion, initial_spee
     return {"distance_m": x, "time_s": t}
 
 
+def _no_wsp_stop(case: BenchCase, cache: dict) -> dict:
+    """The same stop on the same rail without WSP (valves always apply; cached per vehicle,
+    speed, brake and rail): what a WSP is measured against where locking costs little."""
+    from railadhesion.braking.run import simulate
+
+    key = ("no wsp", id(case.vehicle), case.initial_speed, case.pressure, case.max_pressure,
+           case.valves, case.dt, case.max_time, case.gradient, case.adhesion.describe())
+    if key not in cache:
+        res = simulate(case.vehicle, case.adhesion.build(), case.initial_speed, case.pressure,
+                       cylinders=case.cylinders, dt=case.dt, max_time=case.max_time,
+                       gradient=case.gradient)
+        cache[key] = {"distance_m": res.stopping_distance if res.success else math.nan,
+                      "time_s": res.stopping_time if res.success else math.nan}
+    return cache[key]
+
+
 def _dry_stop(case: BenchCase, cache: dict) -> dict:
     """The same stop on a dry rail without WSP (cached per vehicle, speed and brake)."""
     from railadhesion.braking.run import simulate
@@ -839,7 +858,9 @@ def run_wsp_case(case: BenchCase, controller=None, *, dry_cache: dict | None = N
     slides = slide_metrics(h, vehicle.wheel_radius, cylinder_volume=cyl.cylinder_volume)
     ideal = adhesion_limited_stop(vehicle, case.adhesion.build(), case.initial_speed,
                                   case.pressure, cyl, case.gradient)
-    dry = _dry_stop(case, {} if dry_cache is None else dry_cache)
+    cache = {} if dry_cache is None else dry_cache
+    dry = _dry_stop(case, cache)
+    bare = _no_wsp_stop(case, cache)
     stopped = bool(live.stopped)
     distance = float(sim.stop_distance) if stopped else math.nan
     ratio_ideal = distance / ideal["distance_m"] if stopped else math.nan
@@ -853,6 +874,8 @@ def run_wsp_case(case: BenchCase, controller=None, *, dry_cache: dict | None = N
         "stopping_time_s": float(sim.stop_time) if stopped else math.nan,
         "adhesion_limited_distance_m": ideal["distance_m"],
         "distance_ratio": ratio_ideal,
+        "no_wsp_distance_m": bare["distance_m"],
+        "distance_vs_no_wsp": distance / bare["distance_m"] if stopped else math.nan,
         "dry_stopping_distance_m": dry["distance_m"],
         "extension_vs_dry_m": distance - dry["distance_m"],
         "extension_vs_dry_percent": 100.0 * (distance - dry["distance_m"]) / dry["distance_m"],
@@ -869,6 +892,10 @@ def run_wsp_case(case: BenchCase, controller=None, *, dry_cache: dict | None = N
                        "passed": bool(slides["mean_creep"] <= c["max_mean_creep"])},
         "distance_ratio": {"value": ratio_ideal, "limit": c["max_distance_ratio"],
                            "passed": bool(ratio_ideal <= c["max_distance_ratio"])},
+        "distance_vs_no_wsp": {"value": summary["distance_vs_no_wsp"],
+                               "limit": c["max_ratio_no_wsp"],
+                               "passed": bool(summary["distance_vs_no_wsp"]
+                                              <= c["max_ratio_no_wsp"])},
     }
     summary["passed"] = stopped and all(v["passed"] for v in summary["checks"].values())
     summary["wall_time_s"] = _time.perf_counter() - started
@@ -931,6 +958,7 @@ def _overall(cases: list) -> dict:
         "worst_longest_lock_s": agg(max, "longest_lock_s"),
         "worst_distance_ratio": agg(max, "distance_ratio"),
         "mean_distance_ratio": agg(lambda v: float(np.mean(v)), "distance_ratio"),
+        "worst_distance_vs_no_wsp": agg(max, "distance_vs_no_wsp"),
         "worst_mean_creep": agg(max, "mean_creep"),
         "mean_adhesion_utilisation": agg(lambda v: float(np.mean(v)),
                                          "mean_adhesion_utilisation"),

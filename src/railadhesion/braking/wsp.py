@@ -28,28 +28,34 @@ setting with its default and its source or the word *assumption*, and what follo
 UIC 541-05 as far as public sources describe them, are in ``docs/wsp.md``. In short:
 
 * **Reference speed** from the (filtered) wheel speeds: it follows the fastest wheel upwards
-  and falls at most at a deceleration limit. The limit adapts to the brake: the train cannot
-  decelerate faster than its brakes make it, so the limit is the vehicle's nominal
-  deceleration for the measured mean cylinder pressure (``deceleration_per_pressure``, from
-  the vehicle, seed 002 eq. 8) with a tolerance (``brake_rate_tolerance``) and an allowance
-  for gradient and resistance (``reference_deceleration_offset``), capped at
-  ``reference_deceleration``. Speed *fixes* correct it: a released wheel that has stopped
-  re-accelerating rolls at the train speed, and the reference takes its speed (downwards too
-  if its brake pressure is below ``free_pressure``, where a wheel cannot stay in slip). When
-  every valve group is in slide control and no fix came for ``probe_interval``, one group
-  (in turn) is released on purpose until its wheels roll freely (**probe**). An external
-  speed (radar, GNSS) keeps the reference within ``external_tolerance`` of it.
+  and falls at most at a deceleration limit. The limit is the train's deceleration that the
+  measured cylinder pressures and wheel accelerations give (seed 002 eq. 3 with the vehicle's
+  nominal brake rate ``deceleration_per_pressure``, eq. 8, and ``wheel_inertia_pressure``)
+  with a tolerance (``brake_rate_tolerance``) and an allowance for gradient and resistance
+  (``reference_deceleration_offset``), less what the speed fixes found it in excess of the
+  train's (learnt, ``drift_gain``), capped at ``reference_deceleration``. Speed *fixes*
+  correct it: a released wheel that has stopped re-accelerating rolls at the train speed; the
+  reference takes its speed (downwards only if its brake pressure is below
+  ``free_pressure``). When every valve group is in slide control and no fix came for a
+  while (``probe_interval``, doubled up to ``probe_interval_max`` while the probes find the
+  reference within ``probe_accuracy`` of the re-apply slip), one group (in turn) is released
+  on purpose (**probe**), deeper until its wheels re-accelerate. An external speed (radar,
+  GNSS) keeps the reference within ``external_tolerance`` of it.
 * **Per valve group** (an axle, or a bogie with ``valves="bogie"``): slip ``v_ref − ωR``
   and wheel deceleration *relative to the reference's* decide APPLY → HOLD → VENT; VENT →
-  HOLD when the wheel re-accelerates (or nothing is left to vent); after the re-acceleration
-  has ended for ``settle_time`` the wheel has rejoined the train: speed fix, then
+  HOLD when the wheel re-accelerates (or nothing is left to vent); then speed fix and
   **re-application**: fast up to ``reapply_fast_fraction`` of the pressure at which the slide
-  began, then in steps (an APPLY pulse of ``reapply_pulse`` every ``reapply_step``), until the
-  command is reached or a new slide starts.
+  began, then pressure steps that regulate the slip (looking ``reapply_lookahead`` ahead) in
+  the group's **band**. The band is the settings' slip thresholds times a scale that adapts
+  (perturb and observe): the group's adhesion, measured in quasi-steady regulation as the
+  pressure the wheel holds corrected for its acceleration (seed 002 eqs. 2, 5), is compared
+  before and after each move of the band; the band rises (up to ``band_scale_max``) while
+  the adhesion does not fall, and falls (down to ``band_scale_min``) while that raises it.
 * **Watchdog** (EN 15595 §5.1.4 "safety timer"): a group may not stay released (HOLD or VENT)
   for more than ``watchdog_time`` *without its wheels re-accelerating*; it is then forced to
   APPLY for ``watchdog_refill_time``. A wheel that is recovering (re-accelerating) is never
-  re-applied by the watchdog: that is what re-locked unrecovered wheels before. After
+  re-applied by the watchdog: that is what re-locked unrecovered wheels before. Regulation
+  steps at or above ``reapply_fast_fraction`` of the slide pressure are not a release. After
   ``watchdog_cutout_trips`` trips with no recovery in between the group's WSP is cut out
   (brake applied) until the brake command returns to 0: a fault reaction.
 """
@@ -87,6 +93,9 @@ _SPEC = {
                                "shipped coach at 5.5 bar)"),
     "deceleration_per_pressure": (None, 0.0, 1e-3, "m/s² per Pa", "the vehicle's nominal "
                                   "brake rate n c / (R M_eff), seed 002 eq. 8; 0: not used"),
+    "wheel_inertia_pressure": (None, 0.0, 1e7, "Pa per m/s²", "the vehicle's J / (c R): the "
+                               "brake pressure whose torque decelerates a wheelset at 1 m/s², "
+                               "seed 002 eq. 2 (J dω/dt = R T − c p); 0: not used"),
     "brake_rate_tolerance": (0.25, 0.0, 5.0, "-", "assumption: spread of pad friction and "
                              "load"),
     "reference_deceleration_offset": (0.15, 0.0, 5.0, "m/s²", "assumption: 1 % up-gradient "
@@ -120,13 +129,51 @@ _SPEC = {
                       "pressure is not measured"),
     "release_pulse": (0.01, 0.0, 1.0, "s", "assumption: the VENT pulse of a release step when "
                       "the pressure is not measured"),
+    "reapply_lookahead": (0.5, 0.0, 10.0, "s", "assumption: a re-application step looks at the "
+                          "slip this far ahead (slip + lookahead x its rate of growth)"),
     "reapply_step": (0.1, 1e-4, 10.0, "s", "assumption"),
     "reapply_max_time": (3.0, 0.01, 600.0, "s", "assumption"),
     "probe_interval": (2.0, 0.05, 600.0, "s", "assumption"),
     "probe_max_time": (2.0, 0.05, 600.0, "s", "assumption"),
-    "probe_pressure_fraction": (0.5, 0.0, 1.0, "-", "assumption: a probe vents to this "
-                                "fraction of the pressure (less while the wheel still slides)"),
-    "probe_min_speed": (2.0, 0.0, 100.0, "m/s", "assumption"),
+    "probe_pressure_fraction": (0.7, 0.0, 1.0, "-", "assumption: a probe vents to this "
+                                "fraction of the pressure, and by this factor again until "
+                                "the wheel re-accelerates or its brake is off"),
+    "probe_min_speed": (1.0, 0.0, 100.0, "m/s", "assumption: probes go on down to here; "
+                        "below it the remaining metres are too few to matter"),
+    "probe_refill_fraction": (0.9, 0.0, 1.0, "-", "assumption: after a probe the pressure "
+                              "returns fast (APPLY) to this fraction of the pressure before "
+                              "it, which the wheel held in its band"),
+    "probe_interval_max": (8.0, 0.05, 600.0, "s", "assumption: the probe interval doubles, up "
+                           "to this, while the probes find the reference accurate"),
+    "probe_accuracy": (1.0, 0.0, 10.0, "-", "assumption: a probe that finds the reference "
+                       "within this fraction of the settings' re-apply slip (3 % of the "
+                       "speed, an error a wheel in the band tolerates) doubles the probe "
+                       "interval, else halves it"),
+    "drift_gain": (0.5, 0.0, 1.0, "-", "assumption: the part of the reference's drift that "
+                   "a speed fix finds which is taken off its deceleration limit"),
+    "drift_margin": (0.05, 0.0, 5.0, "-", "assumption: the learnt limit stays this fraction "
+                     "above the deceleration the pressures and wheel accelerations give"),
+    "band_scale_max": (3.0, 1.0, 10.0, "-", "assumption: the slip band may rise to 3x (hold "
+                       "15 %, vent 30 %); WSP units released the brake above about 20 % "
+                       "creep on the HAROLD rig (trade press); the SNCF curve's second "
+                       "maximum lies between 5 % and 25 % slip (seed 002); 1: no adaptation"),
+    "band_scale_min": (0.5, 0.01, 1.0, "-", "assumption: the band may fall to 1/2 (re-apply "
+                       "1.5 %, hold 2.5 %) where adhesion falls with slip from a peak near "
+                       "0.5-1 % (Polach's falling sets), no lower: the re-apply slip stays "
+                       "above the ±1 % wheel-diameter differences a WSP must cope with "
+                       "(EN 15595 §5.1.6), else a wheel read 1 % slow is released to 0"),
+    "band_min_speed": (5.0, 0.0, 100.0, "m/s", "assumption: below this speed the band returns "
+                       "linearly to the settings' band (near standstill a locked wheel is "
+                       "close and no probe checks the reference below probe_min_speed)"),
+    "band_scale_step": (1.5, 1.01, 4.0, "-", "assumption: the band moves by this factor per "
+                        "adaptation step"),
+    "adapt_time": (1.0, 0.05, 60.0, "s", "assumption: the wheel settles at a new slip within "
+                   "about 0.5 s; the adhesion estimate is averaged over this much regulation"),
+    "adapt_tolerance": (0.02, 0.0, 0.5, "-", "assumption: a relative change of the adhesion "
+                        "estimate smaller than this is no change (adhesion rises by < 1 % per "
+                        "second as the train slows; the re-application steps are 5 %)"),
+    "adapt_block_time": (4.0, 0.0, 600.0, "s", "assumption: after a raise that cost adhesion "
+                         "(or a slide at a raised band), no raise for this long"),
     "watchdog_time": (3.0, 0.01, 600.0, "s", "assumption; EN 15595 §5.1.4 names the safety "
                       "timer, its value is not public; Open Rails locks out after 7 s"),
     "watchdog_refill_time": (0.5, 0.0, 60.0, "s", "assumption"),
@@ -169,6 +216,8 @@ STATE_DTYPE = np.dtype([
     ("valve", "i8", (MAX_AXLES,)),
     ("t_phase", "f8", (MAX_AXLES,)),
     ("p_slide", "f8", (MAX_AXLES,)),
+    ("p_fast", "f8", (MAX_AXLES,)),   # re-application is fast (APPLY) below this [Pa]
+    ("dec0", "f8", (MAX_AXLES,)),     # relative deceleration when the onset hold began
     ("t_step", "f8", (MAX_AXLES,)),
     ("settle", "f8", (MAX_AXLES,)),
     ("turned", "i8", (MAX_AXLES,)),   # re-application step: 0 up, 1 down, 2 none
@@ -177,17 +226,117 @@ STATE_DTYPE = np.dtype([
     ("wd_until", "f8", (MAX_AXLES,)),
     ("wd_trips", "i8", (MAX_AXLES,)),
     ("cutout", "i8", (MAX_AXLES,)),
+    ("probe_gap", "f8"),           # current probe interval [s]
+    ("rel_v0", "f8", (MAX_AXLES,)),   # reference when the group's release began [m/s]
+    ("rel_d0", "f8", (MAX_AXLES,)),   # its deceleration then [m/s²]
+    ("rel_t0", "f8", (MAX_AXLES,)),   # time the release began [s]
+    ("recovered", "i8", (MAX_AXLES,)),  # the probed wheel re-accelerated
+    ("excess", "f8"),              # learnt excess of the deceleration limit [m/s²]
+    ("scale", "f8", (MAX_AXLES,)),    # slip band scale (1: the settings' band)
+    ("a_dir", "i8", (MAX_AXLES,)),    # direction of the last band move: +1 up, -1 down
+    ("a_prev", "f8", (MAX_AXLES,)),   # adhesion (pressure units) of the last dwell [Pa]
+    ("a_sum", "f8", (MAX_AXLES,)),    # its integral over the current dwell [Pa s]
+    ("a_time", "f8", (MAX_AXLES,)),   # regulation time of the current dwell [s]
+    ("a_block", "f8", (MAX_AXLES,)),  # time left without raises [s]
 ], align=True)
 
 
 @njit(cache=True)
-def _enter(st, g, phase, p_slide):
+def _enter(s, st, g, phase, p_slide):
     st.phase[g] = phase
     st.turned[g] = 2
     st.t_phase[g] = 0.0
     st.t_step[g] = 1e9  # the first step is decided at once
     if not math.isnan(p_slide):
         st.p_slide[g] = p_slide
+        st.p_fast[g] = s.reapply_fast_fraction * p_slide
+
+
+@njit(cache=True)
+def _released(st, g, t):
+    """A release (a slide's vent or a probe) of group g begins: remember the reference."""
+    st.rel_v0[g] = st.v_ref
+    st.rel_d0[g] = st.d_ref
+    st.rel_t0[g] = t
+
+
+@njit(cache=True)
+def _reference_error(st, g, u, t):
+    """The reference's error [m/s] found by group g's wheel speed ``u`` after its release:
+    against where the reference would be had it gone on as before the release (meanwhile
+    it followed the recovering wheel up)."""
+    return u - (st.rel_v0[g] - st.rel_d0[g] * (t - st.rel_t0[g]))
+
+
+@njit(cache=True)
+def _learn(s, st, jump, t):
+    """A speed fix found the reference ``jump`` [m/s] below the train (negative: above it):
+    it fell faster than the train by jump / (time since the last fix) on average. That part
+    (drift_gain) is taken off the deceleration limit from now on (``excess``)."""
+    if s.deceleration_per_pressure > 0.0:
+        st.excess = min(max(st.excess + s.drift_gain * jump
+                            / max(t - st.t_fix, s.probe_interval), 0.0),
+                        s.reference_deceleration)
+
+
+@njit(cache=True)
+def _forget(st, g):
+    """The band adaptation of group g starts a new comparison (its regulation was
+    interrupted: a slide, a probe, a speed fix, the end of the regulation)."""
+    st.a_prev[g] = math.nan
+    st.a_sum[g] = 0.0
+    st.a_time[g] = 0.0
+
+
+@njit(cache=True)
+def _slide_at_raised_band(s, st, g):
+    """A new slide: a raised band steps back down and stays there for adapt_block_time."""
+    if st.scale[g] > 1.0:
+        st.scale[g] = max(1.0, st.scale[g] / s.band_scale_step)
+        st.a_block[g] = s.adapt_block_time
+    _forget(st, g)
+
+
+@njit(cache=True)
+def _adapt_band(s, st, g, held):
+    """End of a dwell: move the band of group g (perturb and observe).
+
+    ``held`` is the mean adhesion torque of the group's wheels over the dwell in pressure
+    units, R T / c = p + (J / (c R)) du/dt (seed 002 eqs. 2 and 5: the brake torque less
+    what decelerates the wheel): it measures the adhesion at the band's slip. The band keeps
+    moving in its direction while that pays (upwards: while the adhesion does not fall by
+    more than adapt_tolerance; downwards: while it rises by more than twice that) and turns
+    back when it does not.
+    """
+    eps = s.adapt_tolerance
+    move = 0
+    prev = st.a_prev[g]
+    if prev == prev and prev > 0.0:
+        gain = held / prev - 1.0
+        if st.a_dir[g] > 0:
+            if gain < -eps:  # the raise cost adhesion: back, and no raise for a while
+                st.a_dir[g] = -1
+                st.a_block[g] = s.adapt_block_time
+                move = -1
+            else:
+                move = 1
+        elif gain > 2.0 * eps:  # lowering clearly helped: go on
+            move = -1
+        else:
+            st.a_dir[g] = 1
+            move = 1
+    # (the first dwell after an interruption only measures: no move without a comparison)
+    if move > 0 and st.a_block[g] > 0.0:
+        move = 0
+    if move > 0:
+        st.scale[g] = min(st.scale[g] * s.band_scale_step, s.band_scale_max)
+    elif move < 0:
+        if st.scale[g] <= s.band_scale_min:
+            st.a_dir[g] = 1  # at the lowest band: the next move is a raise
+        st.scale[g] = max(st.scale[g] / s.band_scale_step, s.band_scale_min)
+    st.a_prev[g] = held
+    st.a_sum[g] = 0.0
+    st.a_time[g] = 0.0
 
 
 @njit(cache=True)
@@ -215,6 +364,7 @@ def wsp_update(settings, state, t, omega_meas, pressure_meas, command, external_
     a_a = T / (s.deceleration_filter + T)
     umax = -math.inf
     psum = 0.0
+    asum = 0.0
     for i in range(n):
         u = omega_meas[i] * radius
         if first:
@@ -226,22 +376,39 @@ def wsp_update(settings, state, t, omega_meas, pressure_meas, command, external_
             st.u[i] = u_new
         umax = max(umax, st.u[i])
         psum += pressure_meas[i]
+        asum += st.acc[i]
     if first:
         st.started = 1
         st.v_ref = umax
         st.d_ref = 0.0
         st.t_fix = t
         st.probe = -1
+        st.probe_gap = s.probe_interval
         for g in range(ng):
-            _enter(st, g, NORMAL, 0.0)
+            _enter(s, st, g, NORMAL, 0.0)
             st.valve[g] = APPLY
             st.wd_until[g] = -math.inf
+            st.scale[g] = 1.0
+            st.a_dir[g] = 1
+            st.a_block[g] = 0.0
+            _forget(st, g)
     # 2. reference speed
     limit = s.reference_deceleration
     if s.deceleration_per_pressure > 0.0 and psum == psum:
-        brake = ((1.0 + s.brake_rate_tolerance) * s.deceleration_per_pressure * psum / n
-                 + s.reference_deceleration_offset)
-        limit = min(limit, brake)
+        # the train's deceleration that the measured pressures and wheel accelerations
+        # give (seed 002 eq. 3: M d = Σ (c p_i + J dω_i/dt) / R); with the wheels
+        # following the train it is the nominal brake rate k p̄ (eq. 8), with wheels
+        # sliding deeper their inertia takes part of the brake torque:
+        # d = (k p̄ + j ā) / (1 − j), j = n J / (R² M_eff) = k · J / (c R), ā the mean
+        # wheel acceleration
+        k = s.deceleration_per_pressure
+        j = min(k * s.wheel_inertia_pressure, 0.5)
+        d_hat = (k * psum / n + j * asum / n) / (1.0 - j)
+        brake = (1.0 + s.brake_rate_tolerance) * d_hat + s.reference_deceleration_offset
+        # less what the speed fixes found it exceeds the train's deceleration by, never
+        # below that deceleration (with a margin)
+        brake = max(brake - st.excess, (1.0 + s.drift_margin) * d_hat)
+        limit = min(limit, max(brake, 0.0))
     v_new = max(umax, st.v_ref - limit * T)
     if external_speed == external_speed:
         v_ext = external_speed - st.d_ref * s.external_latency
@@ -251,12 +418,12 @@ def wsp_update(settings, state, t, omega_meas, pressure_meas, command, external_
     st.d_ref += a_d * (min(max(slope, 0.0), s.reference_deceleration) - st.d_ref)
     st.v_ref = max(v_new, 0.0)
     v_ref = st.v_ref
-    hold = max(s.hold_slip_ratio * v_ref, s.hold_slip_min)
-    vent = max(s.vent_slip_ratio * v_ref, s.vent_slip_min)
+    # the settings' re-apply slip: a wheel this close to the reference rolls with it (fixes)
     reapply = max(s.reapply_slip_ratio * v_ref, s.reapply_slip_min)
     # 3. valve groups
     normal_groups = 0
     fixing = 0
+    v_before = v_ref
     for g in range(ng):
         slip = -math.inf
         dec = -math.inf
@@ -274,8 +441,19 @@ def wsp_update(settings, state, t, omega_meas, pressure_meas, command, external_
                 p = math.nan
             u_g = max(u_g, st.u[i])
             cmd = max(cmd, command[i])
-        want_vent = slip > vent or dec > s.vent_deceleration
-        want_hold = slip > hold or dec > s.hold_deceleration
+        # the group's band: the settings' thresholds times its adapted scale
+        # (the minimum slips are not scaled: near standstill a raised minimum would let
+        # a locked wheel stay below the vent threshold)
+        f = st.scale[g]
+        if v_ref < s.band_min_speed:  # back to the settings' band towards standstill
+            f = 1.0 + (f - 1.0) * v_ref / s.band_min_speed
+        hold_g = max(f * s.hold_slip_ratio * v_ref, s.hold_slip_min)
+        reapply_g = max(f * s.reapply_slip_ratio * v_ref, s.reapply_slip_min)
+        vent_g = max(f * s.vent_slip_ratio * v_ref, s.vent_slip_min)
+        want_vent = slip > vent_g or dec > s.vent_deceleration
+        want_hold = slip > hold_g or dec > s.hold_deceleration
+        if st.a_block[g] > 0.0:
+            st.a_block[g] -= T
         accelerating = reacc > s.recovery_end_acceleration
         if not accelerating and dec < s.recovery_end_acceleration:
             st.settle[g] += T
@@ -287,61 +465,120 @@ def wsp_update(settings, state, t, omega_meas, pressure_meas, command, external_
         if cmd <= 0.0:
             # not braking: nothing to protect; a cut-out ends with the brake application
             if phase != NORMAL:
-                _enter(st, g, NORMAL, 0.0)
+                _enter(s, st, g, NORMAL, 0.0)
+            _forget(st, g)
             st.cutout[g] = 0
             st.wd_trips[g] = 0
         elif st.cutout[g] != 0:
             phase = CUTOUT
         elif phase == NORMAL:
             if want_vent:
-                _enter(st, g, VENTING, p)
+                _slide_at_raised_band(s, st, g)
+                _released(st, g, t)
+                _enter(s, st, g, VENTING, p)
             elif want_hold:
-                _enter(st, g, ONSET, p)
+                _enter(s, st, g, ONSET, p)
+                st.dec0[g] = dec
         elif phase == ONSET:
-            if want_vent or st.t_phase[g] > s.onset_hold_time:
-                _enter(st, g, VENTING, math.nan)
-            elif slip < reapply and dec < 0.5 * s.hold_deceleration:
-                _enter(st, g, REAPPLY, math.nan)
+            # held: a wheel on a falling curve keeps falling behind faster (a runaway),
+            # one on a rising curve converges to a new slip
+            if want_vent or (st.t_phase[g] > s.onset_hold_time and (
+                    dec > s.hold_deceleration
+                    or slip + s.reapply_lookahead * dec > vent_g
+                    or (dec > s.reapply_deceleration and dec >= st.dec0[g]))):
+                _slide_at_raised_band(s, st, g)
+                _released(st, g, t)
+                _enter(s, st, g, VENTING, math.nan)
+            elif st.t_phase[g] > s.onset_hold_time:
+                # held, the wheel converges below the vent threshold: release steps
+                _enter(s, st, g, REAPPLY, math.nan)
+            elif slip < reapply_g and dec < 0.5 * s.hold_deceleration:
+                _enter(s, st, g, REAPPLY, math.nan)
         elif phase == VENTING:
             if reacc > s.recovery_acceleration or p < 0.5 * s.free_pressure:
-                _enter(st, g, RECOVER, math.nan)
+                _enter(s, st, g, RECOVER, math.nan)
         elif phase == RECOVER:
             if st.settle[g] >= s.settle_time:
                 if slip < reapply or free:
                     fixing = 1
+                    jump = _reference_error(st, g, u_g, t)
+                    if free or jump > 0.0:  # (a wheel with its brake on may still slip)
+                        _learn(s, st, jump, t)
                     st.v_ref = u_g if free else max(st.v_ref, u_g)
                     st.t_fix = t
                     st.fixes += 1
                     st.wd_trips[g] = 0
-                    _enter(st, g, REAPPLY, math.nan)
+                    _enter(s, st, g, REAPPLY, math.nan)
                 elif want_hold:
-                    _enter(st, g, VENTING, math.nan)
+                    _enter(s, st, g, VENTING, math.nan)
                 else:
-                    _enter(st, g, REAPPLY, math.nan)
-            elif slip < reapply and st.t_phase[g] >= s.settle_time:
-                _enter(st, g, REAPPLY, math.nan)  # nearly back: re-apply at once (no fix)
+                    _enter(s, st, g, REAPPLY, math.nan)
+            elif slip < reapply_g and st.t_phase[g] >= s.settle_time:
+                # nearly back: re-apply at once; if the wheel is back near the reference,
+                # it found the reference's error on its way (it pulled the reference up)
+                if slip < reapply:
+                    jump = _reference_error(st, g, u_g, t)
+                    if jump > 0.0:
+                        _learn(s, st, jump, t)
+                        st.t_fix = t
+                _enter(s, st, g, REAPPLY, math.nan)
             elif want_vent and reacc < s.recovery_acceleration and st.t_phase[g] > s.settle_time:
-                _enter(st, g, VENTING, math.nan)
+                _enter(s, st, g, VENTING, math.nan)
         elif phase == REAPPLY:
             if want_vent:
-                _enter(st, g, VENTING, p)
-            elif want_hold:
-                _enter(st, g, ONSET, p)
+                _slide_at_raised_band(s, st, g)
+                _released(st, g, t)
+                _enter(s, st, g, VENTING, p)
+            elif slip > reapply_g and (dec > s.hold_deceleration or (
+                    slip > hold_g and dec > s.reapply_deceleration)):
+                # a slide: a wheel above its band that still falls behind, or one
+                # decelerating fast (below its band a decelerating wheel is returning to
+                # it; above it a steady wheel is brought back by release steps)
+                _enter(s, st, g, ONSET, p)
+                st.dec0[g] = dec
             elif p >= cmd - 5e3 or st.t_phase[g] > s.reapply_max_time:
-                _enter(st, g, NORMAL, math.nan)
+                _forget(st, g)
+                _enter(s, st, g, NORMAL, math.nan)
         elif phase == PROBE:
-            if st.settle[g] >= s.settle_time and (free or p <= st.p_target[g]
-                                                  or (p != p and slip < reapply)):
-                st.v_ref = u_g
+            if reacc > s.recovery_acceleration:
+                st.recovered[g] = 1
+            settled = st.settle[g] >= s.settle_time and (free or p <= st.p_target[g] or p != p)
+            if settled and not (free or st.recovered[g] or (p != p and slip < reapply)):
+                # settled without a recovery: the wheel rolled already, or the released
+                # brake still holds it in a deep slide (on a falling curve a slide can
+                # need much less torque than the band): vent deeper, until it recovers
+                # or its brake is off
+                st.p_target[g] = s.probe_pressure_fraction * min(st.p_target[g], p)
+                st.settle[g] = 0.0
+            elif settled:
+                # the released wheel rolls near the train speed, a little below it (its
+                # creep at the probe pressure): it may raise the reference, lower it only
+                # when its brake is off (the same rule as a recovery's fix)
+                fixing = 1
+                # the reference's error: the wheel's speed against where the reference
+                # would be had it gone on as before the probe (meanwhile it followed the
+                # recovering wheel up)
+                jump = _reference_error(st, g, u_g, t)
+                st.v_ref = u_g if free else max(st.v_ref, u_g)
+                # the probe interval adapts to the error the probe found: doubled while
+                # it is within probe_accuracy of the settings' re-apply slip
+                if abs(jump) <= s.probe_accuracy * reapply:
+                    st.probe_gap = min(2.0 * st.probe_gap, s.probe_interval_max)
+                else:
+                    st.probe_gap = max(0.5 * st.probe_gap, s.probe_interval)
+                _learn(s, st, jump, t)
                 st.t_fix = t
                 st.fixes += 1
                 st.probe = -1
-                _enter(st, g, REAPPLY, math.nan)
+                _enter(s, st, g, REAPPLY, math.nan)
+                # the wheel held the pressure before the probe at its band: back fast
+                st.p_fast[g] = s.probe_refill_fraction * st.p_slide[g]
             elif st.t_phase[g] > s.probe_max_time:
                 st.probe = -1
-                _enter(st, g, REAPPLY, math.nan)
+                _enter(s, st, g, REAPPLY, math.nan)
         phase = st.phase[g] if st.cutout[g] == 0 or cmd <= 0.0 else CUTOUT
         # valve of the phase
+        regulating = False
         if phase == NORMAL or phase == CUTOUT:
             valve = APPLY
         elif phase == ONSET or phase == RECOVER:
@@ -350,34 +587,62 @@ def wsp_update(settings, state, t, omega_meas, pressure_meas, command, external_
             valve = VENT
         elif phase == REAPPLY:
             valve = HOLD
-            if p < s.reapply_fast_fraction * st.p_slide[g]:
+            # stepping at or above the fast part: the brake is regulated, not released
+            regulating = p >= s.reapply_fast_fraction * st.p_slide[g]
+            if p < st.p_fast[g]:
                 valve = APPLY  # fast part; the first step pulse follows at once
                 st.t_step[g] = 0.0
             else:
+                st.p_fast[g] = 0.0  # the fast part is over (no return to it on noise)
                 # steps of the memorised slide pressure: up while the wheel follows the
                 # reference, down when it falls behind (an incipient slide), else hold;
                 # timed pulses when the pressure is not measured
                 if st.t_step[g] >= s.reapply_step - 1e-12:
                     st.t_step[g] = 0.0
                     step = s.reapply_step_fraction * st.p_slide[g]
-                    middle = 0.5 * (reapply + hold)
-                    if dec > 2.0 * s.reapply_deceleration or (
-                            slip > middle and dec > 0.5 * s.reapply_deceleration):
+                    middle = 0.5 * (reapply_g + hold_g)
+                    # the slip a lookahead ahead: beyond the saturation of the curve the
+                    # slip integrates the excess brake torque, so its rate decides too
+                    ahead = slip + s.reapply_lookahead * dec
+                    quarter = 0.25 * (hold_g - reapply_g)
+                    if slip > reapply_g and (dec > 2.0 * s.reapply_deceleration or (
+                            ahead > middle + quarter) or (
+                            ahead > middle and dec > 0.5 * s.reapply_deceleration)):
                         st.turned[g] = 1  # a release step
                         st.p_target[g] = p - step
-                    elif slip < middle and dec < s.reapply_deceleration:
+                        st.t_phase[g] = 0.0  # regulating: reapply_max_time restarts
+                    elif ahead < middle - quarter and dec < 2.0 * s.reapply_deceleration:
                         st.turned[g] = 0  # an apply step
                         st.p_target[g] = p + step
                     else:
                         st.turned[g] = 2
+                        st.t_phase[g] = 0.0
+                # a step ends when its pressure is reached (latched: a noisy reading
+                # does not reopen it)
                 if st.turned[g] == 0:
                     if (p < st.p_target[g]) if p == p else (
                             st.t_step[g] < s.reapply_pulse - 1e-12):
                         valve = APPLY
+                    else:
+                        st.turned[g] = 2
                 elif st.turned[g] == 1:
                     if (p > st.p_target[g]) if p == p else (
                             st.t_step[g] < s.release_pulse - 1e-12):
                         valve = VENT
+                    else:
+                        st.turned[g] = 2
+                # band adaptation: the adhesion torque while the wheel runs in its band,
+                # in pressure units, R T / c = p + (J / (c R)) du/dt (seed 002 eqs. 2, 5)
+                if (s.band_scale_max > s.band_scale_min and p == p
+                        and reapply_g <= slip <= hold_g
+                        and abs(dec) < s.hold_deceleration):
+                    held = 0.0
+                    for i in range(g * per, g * per + per):
+                        held += pressure_meas[i] + s.wheel_inertia_pressure * st.acc[i]
+                    st.a_sum[g] += held / per * T
+                    st.a_time[g] += T
+                    if st.a_time[g] >= s.adapt_time - 1e-12:
+                        _adapt_band(s, st, g, st.a_sum[g] / st.a_time[g])
         else:  # PROBE: vent to a fraction of the pressure (deeper while the wheel slides)
             if dec > s.reapply_deceleration and st.t_phase[g] > s.settle_time:
                 st.p_target[g] = min(st.p_target[g], s.probe_pressure_fraction * p)
@@ -385,7 +650,7 @@ def wsp_update(settings, state, t, omega_meas, pressure_meas, command, external_
         # 4. watchdog (safety timer)
         if t < st.wd_until[g]:
             valve = APPLY
-        elif valve != APPLY and not accelerating:
+        elif valve != APPLY and not accelerating and not regulating:
             st.wd_timer[g] += T
             if st.wd_timer[g] >= s.watchdog_time - 1e-9:
                 valve = APPLY
@@ -395,7 +660,8 @@ def wsp_update(settings, state, t, omega_meas, pressure_meas, command, external_
                 st.watchdog_trips += 1
                 if st.probe == g:
                     st.probe = -1
-                _enter(st, g, REAPPLY, math.nan)
+                _slide_at_raised_band(s, st, g)
+                _enter(s, st, g, REAPPLY, math.nan)
                 if st.wd_trips[g] >= s.watchdog_cutout_trips:
                     st.cutout[g] = 1
         else:
@@ -408,9 +674,13 @@ def wsp_update(settings, state, t, omega_meas, pressure_meas, command, external_
             normal_groups += 1
         for i in range(g * per, g * per + per):
             valves_out[i] = valve
+    # a speed fix that moved the reference moved every group's slip: new comparisons
+    if fixing and abs(st.v_ref - v_before) > s.probe_accuracy * reapply:
+        for g in range(ng):
+            _forget(st, g)
     # 5. probe: every group in slide control and no speed fix for a while
     if (fixing == 0 and st.probe < 0 and normal_groups == 0 and ng > 1
-            and t - st.t_fix > s.probe_interval and st.v_ref > s.probe_min_speed):
+            and t - st.t_fix > st.probe_gap and st.v_ref > s.probe_min_speed):
         busy = False
         for g in range(ng):
             if st.phase[g] == VENTING or st.phase[g] == RECOVER:
@@ -422,16 +692,19 @@ def wsp_update(settings, state, t, omega_meas, pressure_meas, command, external_
                     st.probe = g
                     st.probe_next = (g + 1) % ng
                     st.probes += 1
-                    _enter(st, g, PROBE, math.nan)
+                    st.recovered[g] = 0
+                    _released(st, g, t)
+                    _forget(st, g)
                     p = -math.inf
                     for i in range(g * per, g * per + per):
                         p = max(p, pressure_meas[i])
+                    _enter(s, st, g, PROBE, p)
                     st.p_target[g] = s.probe_pressure_fraction * p
                     break
 
 
 _SUFFIX = {"s": "_s", "m/s²": "_m_s2", "m/s": "_m_s", "Pa": "_Pa", "m": "_m", "-": "",
-           "m/s² per Pa": "_m_s2_per_Pa"}
+           "m/s² per Pa": "_m_s2_per_Pa", "Pa per m/s²": "_Pa_s2_per_m"}
 
 
 def settings_file_keys() -> dict:
@@ -470,6 +743,7 @@ class WSPSettings:
     period: float = 5e-3
     reference_deceleration: float = 2.5
     deceleration_per_pressure: float | None = None
+    wheel_inertia_pressure: float | None = None
     brake_rate_tolerance: float = 0.25
     reference_deceleration_offset: float = 0.15
     hold_slip_ratio: float = 0.05
@@ -492,12 +766,25 @@ class WSPSettings:
     reapply_step_fraction: float = 0.05
     reapply_pulse: float = 5e-3
     release_pulse: float = 0.01
+    reapply_lookahead: float = 0.5
     reapply_step: float = 0.1
     reapply_max_time: float = 3.0
     probe_interval: float = 2.0
     probe_max_time: float = 2.0
-    probe_pressure_fraction: float = 0.5
-    probe_min_speed: float = 2.0
+    probe_pressure_fraction: float = 0.7
+    probe_min_speed: float = 1.0
+    probe_refill_fraction: float = 0.9
+    probe_interval_max: float = 8.0
+    probe_accuracy: float = 1.0
+    drift_gain: float = 0.5
+    drift_margin: float = 0.05
+    band_scale_max: float = 3.0
+    band_scale_min: float = 0.5
+    band_min_speed: float = 5.0
+    band_scale_step: float = 1.5
+    adapt_time: float = 1.0
+    adapt_tolerance: float = 0.02
+    adapt_block_time: float = 4.0
     watchdog_time: float = 3.0
     watchdog_refill_time: float = 0.5
     watchdog_cutout_trips: int = 3
@@ -540,6 +827,9 @@ class WSPSettings:
         if not self.hold_deceleration <= self.vent_deceleration:
             raise ValueError("hold_deceleration must not exceed vent_deceleration, got "
                              f"{self.hold_deceleration} > {self.vent_deceleration}")
+        if not self.probe_interval <= self.probe_interval_max:
+            raise ValueError("probe_interval must not exceed probe_interval_max, got "
+                             f"{self.probe_interval} > {self.probe_interval_max}")
 
     def replace(self, **changes) -> WSPSettings:
         return WSPSettings(**{**self.as_dict(), **changes})
@@ -583,6 +873,10 @@ class WheelSlideProtection:
         if vehicle is not None:
             if s.wheel_radius is None:
                 changes["wheel_radius"] = float(vehicle.wheel_radius)
+            if s.wheel_inertia_pressure is None:
+                changes["wheel_inertia_pressure"] = float(
+                    vehicle.wheelset_inertia
+                    / (vehicle.brake_coefficient * vehicle.wheel_radius))
             if s.deceleration_per_pressure is None:
                 changes["deceleration_per_pressure"] = float(
                     vehicle.n_axles * vehicle.brake_coefficient
@@ -672,7 +966,8 @@ class WheelSlideProtection:
 
     def diagnostics(self) -> dict:
         """Counters of the run so far: speed fixes, probes, watchdog trips, cut-out groups,
-        the phase of each valve group and the reference speed and deceleration."""
+        the phase and slip-band scale of each valve group, the reference speed and
+        deceleration, the probe interval and the reference drift learnt from the fixes."""
         if self._state is None:
             return {}
         return state_diagnostics(self._state)
@@ -688,7 +983,10 @@ def state_diagnostics(state) -> dict:
             "watchdog_trips": int(r["watchdog_trips"]),
             "vent_commands": int(r["vent_commands"]),
             "cut_out_groups": [g + 1 for g in range(ng) if r["cutout"][g]],
-            "phases": [PHASES[int(r["phase"][g])] for g in range(ng)]}
+            "phases": [PHASES[int(r["phase"][g])] for g in range(ng)],
+            "band_scales": [float(r["scale"][g]) for g in range(ng)],
+            "probe_interval_s": float(r["probe_gap"]),
+            "learnt_drift_m_s2": float(r["excess"])}
 
 
 def accepts_measurements(fn) -> bool:
