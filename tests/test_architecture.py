@@ -8,9 +8,9 @@
    unit has a floor.
 
 Violations that other branches are removing are listed in :data:`PENDING`, with who removes
-them: they are tolerated by the rule tests and expected to vanish by
-:func:`test_pending_violations_are_gone` (an xfail: when it passes, strictly, delete the
-entries it no longer finds and the mark).
+them: they are tolerated by the rule tests and expected to vanish. While :data:`PENDING` has
+entries, mark :func:`test_pending_violations_are_gone` as a strict xfail; when it passes,
+delete the entries it no longer finds and the mark (it is empty today: the test must pass).
 """
 
 from __future__ import annotations
@@ -44,15 +44,8 @@ FLOORS: tuple[tuple[str, ...], ...] = (
 )
 
 #: Violations being removed on other branches: (rule, importer, imported, name) -> owner.
-PENDING: dict[tuple[str, str, str, str], str] = {
-    # models.wilac reads its default parameter file through io (the file reader would have to
-    # move below models, or the default set above it: both change public import paths)
-    ("layer", "railadhesion.models.wilac", "railadhesion.io.paramfiles", ""): "lead",
-    # a braking scenario reads an identified adhesion law: the law's file format must move
-    # below braking (it is in identification/curves.py, which another branch edits)
-    ("layer", "railadhesion.braking.scenario", "railadhesion.identification.curves", ""):
-        "lead, after the merge",
-}
+#: Empty: keep it so while nothing is in flight (see test_pending_violations_are_gone).
+PENDING: dict[tuple[str, str, str, str], str] = {}
 
 
 # --- reading the imports ------------------------------------------------------------------
@@ -205,8 +198,6 @@ def test_no_violation_beyond_the_pending_ones(found, rule):
     assert not new, f"{rule} violations (docs/architecture.md):\n{_show(new.items())}"
 
 
-@pytest.mark.xfail(strict=True, reason="braking.scenario -> identification.curves and "
-                   "models.wilac -> io are left to the lead")
 def test_pending_violations_are_gone(found):
     left = {k: found[k] for k in PENDING if k in found}
     assert not left, "still there:\n" + _show(left.items())
