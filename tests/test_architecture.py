@@ -266,3 +266,56 @@ def test_the_package_is_read_whole():
     # a function-level import is seen (cli imports the identification pipeline in a command)
     assert any(i == "railadhesion.cli_identification" and t.startswith(
         "railadhesion.identification") for i, t, _, _ in imports)
+
+
+# --- numba's private internals: in _jit.py only ---------------------------------------------
+
+#: numba modules that are not its public API (numba.extending, numba.types, numba.typed and
+#: the top-level names are).
+NUMBA_PRIVATE_MODULES = ("numba.core", "numba.np", "numba.cpython", "numba.misc",
+                         "numba.parfors", "numba.typeconv", "numba.cuda.cudadrv")
+#: Dispatcher attributes that are numba internals (its public ones: py_func, signatures,
+#: compile, recompile, inspect_*, stats).
+NUMBA_PRIVATE_ATTRIBUTES = {"overloads", "entry_point", "_cache_path", "disable_compile",
+                            "targetctx", "typingctx", "_compile_for_args", "_can_compile",
+                            "_cache"}
+
+
+def numba_internals(src: Path = SRC, package: str = PACKAGE, allowed=("railadhesion._jit",)):
+    """Uses of numba's private modules and dispatcher internals outside ``allowed``:
+    (module, what, line). ``self._cache`` of the package's own classes is not numba's."""
+    found = []
+    for module, path in find_modules(src, package).items():
+        if module in allowed:
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
+            names = []
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom) and not node.level:
+                names = [node.module or ""]
+            for name in names:
+                if name.startswith(NUMBA_PRIVATE_MODULES):
+                    found.append((module, name, node.lineno))
+            if (isinstance(node, ast.Attribute) and node.attr in NUMBA_PRIVATE_ATTRIBUTES
+                    and not (isinstance(node.value, ast.Name) and node.value.id == "self")):
+                found.append((module, node.attr, node.lineno))
+    return found
+
+
+def test_numba_internals_are_used_in_jit_only():
+    assert not numba_internals(), numba_internals()
+
+
+def test_the_numba_check_finds_internals(tmp_path):
+    src = _tree(tmp_path, {
+        "pkg/__init__.py": "",
+        "pkg/a.py": "from numba.core import types\nimport numba.np.numpy_support\n",
+        "pkg/b.py": "def f(d):\n    return d.overloads[0].entry_point, d._cache._cache_path\n",
+        "pkg/c.py": "class C:\n    def f(self):\n        return self._cache\n",
+        "pkg/_jit.py": "def g(d):\n    return d.overloads\n",
+    })
+    found = {(m, what) for m, what, _ in numba_internals(src, "pkg", ("pkg._jit",))}
+    assert found == {("pkg.a", "numba.core"), ("pkg.a", "numba.np.numpy_support"),
+                     ("pkg.b", "overloads"), ("pkg.b", "entry_point"), ("pkg.b", "_cache"),
+                     ("pkg.b", "_cache_path")}
