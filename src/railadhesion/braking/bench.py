@@ -90,6 +90,10 @@ __all__ = [
     "run_wsp_programme",
     "write_programme_outputs",
     "json_safe",
+    "read_programme_file",
+    "release_fmu",
+    "select_cases",
+    "write_json",
 ]
 
 PROGRAMME_FORMAT = "railadhesion-wsp-programme"
@@ -191,13 +195,20 @@ class WSPProgramme:
 
     def select(self, names) -> WSPProgramme:
         """The programme with the named cases only (in the programme's order)."""
-        wanted = list(names)
-        known = {c.name for c in self.cases}
-        missing = [n for n in wanted if n not in known]
-        if missing:
-            raise ValueError(f"unknown case(s) {missing}; the programme has "
-                             f"{', '.join(c.name for c in self.cases)}")
-        return replace(self, cases=[c for c in self.cases if c.name in wanted])
+        return select_cases(self, names)
+
+
+def select_cases(programme, names):
+    """A copy of ``programme`` (a dataclass with a list ``cases`` of named cases) with the
+    cases named in ``names`` only, in the programme's order; ``ValueError`` for an unknown
+    name."""
+    wanted = list(names)
+    known = {c.name for c in programme.cases}
+    missing = [n for n in wanted if n not in known]
+    if missing:
+        raise ValueError(f"unknown case(s) {missing}; the programme has "
+                         f"{', '.join(c.name for c in programme.cases)}")
+    return replace(programme, cases=[c for c in programme.cases if c.name in wanted])
 
 
 _CASE_KEYS = {
@@ -379,14 +390,20 @@ def programme_from_document(doc, base=".") -> WSPProgramme:
 def load_wsp_programme(path="default") -> WSPProgramme:
     """Read and check a programme file (``"default"``: the shipped 31-case programme).
     Errors are :class:`~railadhesion.braking.BrakingFileError` naming the file and field."""
+    return read_programme_file(path, "wsp_programme_default.toml", _programme_from_document)
+
+
+def read_programme_file(path, default: str, build):
+    """Read a programme file: ``path``, or the package's data file ``default`` for
+    ``"default"``; ``build(document, folder of the file)`` makes the programme, whose
+    ``source`` is set to the file's label. Its errors (a field's, or ``ValueError``) become a
+    :class:`~railadhesion.braking.BrakingFileError` naming the file."""
     if os.fspath(path) == "default":
-        path = _DATA / "wsp_programme_default.toml"
+        path = _DATA / default
     doc, label = read_toml(path)
     try:
-        prog = _programme_from_document(doc, Path(os.fspath(path)).resolve().parent)
-    except FieldError as exc:
-        raise BrakingFileError(f"{label}: {exc}") from None
-    except ValueError as exc:
+        prog = build(doc, Path(os.fspath(path)).resolve().parent)
+    except (FieldError, ValueError) as exc:
         raise BrakingFileError(f"{label}: {exc}") from None
     prog.source = label
     return prog
@@ -463,6 +480,15 @@ class _PythonController:
     def diagnostics(self):
         d = getattr(self.obj, "diagnostics", None)
         return d() if callable(d) else {}
+
+
+def release_fmu(fmu) -> None:
+    """Terminate and free an FMPy FMU instance; an FMU already broken is let go silently."""
+    try:
+        fmu.terminate()
+        fmu.freeInstance()
+    except Exception:  # pragma: no cover - the FMU is already broken
+        pass
 
 
 def read_cosim_fmu(path, period: float | None = None, what: str = "FMU"):
@@ -602,11 +628,7 @@ class FmuController:
 
     def close(self):
         if self.fmu is not None:
-            try:
-                self.fmu.terminate()
-                self.fmu.freeInstance()
-            except Exception:  # pragma: no cover - the FMU is already broken
-                pass
+            release_fmu(self.fmu)
             self.fmu = None
             import shutil
 
@@ -1049,6 +1071,18 @@ def json_safe(obj):
     return obj
 
 
+def write_json(path, obj, *, atomic: bool = False) -> Path:
+    """Write ``obj`` (:func:`json_safe`) as indented UTF-8 JSON to ``path``; ``atomic``: through
+    a temporary file renamed into place. Returns the path."""
+    path = Path(path)
+    tmp = path.with_suffix(path.suffix + ".tmp") if atomic else path
+    tmp.write_text(json.dumps(json_safe(obj), indent=2, ensure_ascii=False) + "\n",
+                   encoding="utf-8")
+    if atomic:
+        tmp.replace(path)
+    return path
+
+
 def write_programme_outputs(result: WSPProgrammeResult, out, *, case=None,
                             figures: bool = True, histories: bool = False,
                             summary_figure: bool = False) -> list:
@@ -1061,12 +1095,7 @@ def write_programme_outputs(result: WSPProgrammeResult, out, *, case=None,
     written = []
     doc = {"format": "railadhesion-wsp-results", "programme": result.programme,
            "controller": result.controller, "overall": result.overall, "cases": result.cases}
-    path = out / "summary.json"
-    tmp = path.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(json_safe(doc), indent=2, ensure_ascii=False) + "\n",
-                   encoding="utf-8")
-    tmp.replace(path)
-    written.append(path)
+    written.append(write_json(out / "summary.json", doc, atomic=True))
     result.frame().to_csv(out / "cases.csv", index=False, float_format="%.6g")
     written.append(out / "cases.csv")
     axles = result.axle_frame()
@@ -1075,10 +1104,7 @@ def write_programme_outputs(result: WSPProgrammeResult, out, *, case=None,
     if case is not None:
         bench_case, summary, h, trace = case
         (out / "cases").mkdir(exist_ok=True)
-        path = out / "cases" / f"{bench_case.name}.json"
-        path.write_text(json.dumps(json_safe(summary), indent=2, ensure_ascii=False) + "\n",
-                        encoding="utf-8")
-        written.append(path)
+        written.append(write_json(out / "cases" / f"{bench_case.name}.json", summary))
         if h is not None and figures:
             from railadhesion.braking.figures import wsp_case_figure
 
