@@ -98,10 +98,15 @@ class SweepModel:
         raise NotImplementedError  # pragma: no cover
 
 
-def _labelled(cache: dict, key, make):
-    if key not in cache:
-        cache[key] = make()
-    return cache[key]
+def _from_file(cache: dict, label: str, loader):
+    """The parameter set of the file ``label`` read by ``loader`` (once: kept in ``cache``);
+    a file that cannot be read is a ``ValueError`` naming the label."""
+    if label not in cache:
+        try:
+            cache[label] = loader(label)
+        except OSError as exc:
+            raise ValueError(f"parameter_set: cannot read {label}: {exc}") from exc
+    return cache[label]
 
 
 @dataclass(frozen=True)
@@ -153,16 +158,9 @@ class WilacSweep(SweepModel):
             return self.parameters
         if label == "default":
             return default_wilac_parameters()
+        from railadhesion.io.paramfiles import load_wilac_parameters
 
-        def load():
-            from railadhesion.io.paramfiles import load_wilac_parameters
-
-            try:
-                return load_wilac_parameters(label)
-            except OSError as exc:
-                raise ValueError(f"parameter_set: cannot read {label}: {exc}") from exc
-
-        return _labelled(self._cache, label, load)
+        return _from_file(self._cache, label, load_wilac_parameters)
 
     def evaluate(self, values, labels):
         from railadhesion.models.wilac import wilac_forces
@@ -242,16 +240,9 @@ class PolachSweep(SweepModel):
             return polach_parameters(label)
         if not (label.endswith(".toml") or Path(label).exists()):
             polach_parameters(label)  # raises, listing the named sets
+        from railadhesion.io.paramfiles import load_polach_parameters
 
-        def load():
-            from railadhesion.io.paramfiles import load_polach_parameters
-
-            try:
-                return load_polach_parameters(label)
-            except OSError as exc:
-                raise ValueError(f"parameter_set: cannot read {label}: {exc}") from exc
-
-        return _labelled(self._cache, label, load)
+        return _from_file(self._cache, label, load_polach_parameters)
 
     def evaluate(self, values, labels):
         from railadhesion.models.polach import polach_forces
