@@ -91,14 +91,7 @@ def export_fmu(
     if native:
         console.print("native FMU: binaries/linux64 needs no Python on the host; sources in "
                       "sources/ (docs/fmu.md)")  # fmt: skip
-    try:
-        from fmpy.validation import validate_fmu
-    except ImportError:  # pragma: no cover - fmpy is optional at run time
-        return
-    problems = validate_fmu(str(path))
-    if problems:
-        _fail("the FMU does not pass FMPy's validation: " + "; ".join(problems))
-    console.print("modelDescription.xml passes FMPy's validation")
+    _check_fmu(path, required=False)
 
 
 @export_app.command("braking-fmu")
@@ -117,8 +110,18 @@ def export_braking_fmu(
     except OSError as exc:
         _fail(f"cannot write {out}: {exc.strerror or exc}")
     console.print(f"FMU written to {escape(str(path))}")
-    from fmpy.validation import validate_fmu
+    _check_fmu(path, required=True)
 
+
+def _check_fmu(path, *, required: bool) -> None:
+    """Validate the FMU at ``path`` with FMPy (fail on a problem); without FMPy, an error if
+    ``required``, else nothing."""
+    try:
+        from fmpy.validation import validate_fmu
+    except ImportError:  # pragma: no cover - fmpy is optional at run time
+        if required:
+            raise
+        return
     problems = validate_fmu(str(path))
     if problems:
         _fail("the FMU does not pass FMPy's validation: " + "; ".join(problems))
