@@ -319,3 +319,35 @@ def test_the_numba_check_finds_internals(tmp_path):
     assert found == {("pkg.a", "numba.core"), ("pkg.a", "numba.np.numpy_support"),
                      ("pkg.b", "overloads"), ("pkg.b", "entry_point"), ("pkg.b", "_cache"),
                      ("pkg.b", "_cache_path")}
+
+
+# --- the table of the laws ------------------------------------------------------------------
+
+
+def law_table(text: str) -> list[tuple[str, list[str], list[str]]]:
+    """Rows of the tables of "Where each law lives": (law, files, function names)."""
+    part = text[text.index("## Where each law lives"):text.index("## How a kernel is added")]
+    rows = []
+    for line in part.splitlines():
+        cells = [c.strip() for c in re.split(r"(?<!\\)\|", line.strip())[1:-1]]
+        if len(cells) != 3 or cells[0] in ("Law (source)", "---"):
+            continue
+        files = re.findall(r"`([\w/]+\.py)`", cells[1])
+        names = re.findall(r"`([\w.]+)`", cells[2])  # Class.method: the method
+        rows.append((cells[0], files, [n.split(".")[-1] for n in names]))
+    return rows
+
+
+def test_every_law_of_the_table_is_where_it_says():
+    rows = law_table((ROOT / "docs" / "architecture.md").read_text(encoding="utf-8"))
+    assert len(rows) >= 20
+    missing = []
+    for law, files, names in rows:
+        assert files, law
+        text = "\n".join((SRC / PACKAGE / f).read_text(encoding="utf-8") for f in files)
+        defined = {n.name for n in ast.walk(ast.parse(text))
+                   if isinstance(n, ast.FunctionDef | ast.ClassDef)}
+        defined |= {t.id for n in ast.walk(ast.parse(text)) if isinstance(n, ast.Assign)
+                    for t in n.targets if isinstance(t, ast.Name)}
+        missing += [(law, name) for name in names if name not in defined]
+    assert not missing, missing
