@@ -420,9 +420,10 @@ adhesion = { model = "polach", mu0 = 0.03 }
 """
 
 
-@pytest.mark.xfail(strict=True, reason="known, not fixed: after a long spin at mu = 0.03 the "
-                   "accelerometer fit's upper bound falls below the true position for about "
-                   "20 s of the following stop (by up to 1.7 m; stop error -6 %)")
+@pytest.mark.xfail(strict=True, reason="known, not fixed (docs/odometry.md): spinning "
+                   "wheels push the train forward for 12 s after the brake command, which "
+                   "the odometry's brake regime rules out; its upper bound falls below the "
+                   "true position")
 def test_long_spin_then_brake_keeps_the_true_position_inside(tmp_path):
     """Found in review: 30 s of traction at twice the adhesion torque, then an emergency brake
     with every axle sliding. The guaranteed interval must hold here too."""
