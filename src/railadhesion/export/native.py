@@ -339,7 +339,7 @@ def _c_scalar(dtype: np.dtype, where: str) -> str:
     key = f"{dtype.kind}{dtype.itemsize}"
     if key not in _C_TYPES:
         raise ValueError(f"{where}: dtype {dtype} is not supported "
-                         "(float64, int64, int32, uint8, bool; uint64 in records only)")  # fmt: skip
+                         "(float64, int64, int32, uint8, bool; uint64 in records only)")
     return _C_TYPES[key][0]
 
 

@@ -153,13 +153,51 @@ def build_native_braking_fmu(out, scenario) -> Path:
     the variable); a failed step returns ``fmi2Error`` with the reason logged.
     ``fmi2GetFMUstate``/``fmi2SetFMUstate`` save and restore the whole vehicle.
     """
+    path = Path(scenario)
+    if not path.is_file():
+        raise ValueError(f"scenario must be an existing TOML file, got {str(path)!r}")
+    if not _generic_cpu():
+        return _build_in_generic_process(out, path)
+    return _build(out, path)
+
+
+def _generic_cpu() -> bool:
+    from numba.core import config
+
+    return config.CPU_NAME == "generic"
+
+
+def _build_in_generic_process(out, path: Path) -> Path:
+    """Build in a Python process whose numba compiles for a generic x86-64: the braking
+    step's IR then holds no vector intrinsics of this machine's processor (AVX masked loads),
+    which the portable binary may not contain."""
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, NUMBA_CPU_NAME="generic", NUMBA_CPU_FEATURES="")
+    code = ("import sys; from railadhesion.export.native_braking import _build; "
+            "_build(sys.argv[1], sys.argv[2])")  # fmt: skip
+    done = subprocess.run([sys.executable, "-c", code, str(out), str(path)], env=env,
+                          capture_output=True, text=True)  # fmt: skip
+    if done.returncode != 0:
+        last = (done.stderr.strip().splitlines() or ["(no message)"])[-1]
+        from railadhesion.export.native import NativeBuildError
+
+        if "NativeBuildError" in last:
+            raise NativeBuildError(last.split(": ", 1)[-1])
+        if "ValueError" in last:
+            raise ValueError(last.split(": ", 1)[-1])
+        raise RuntimeError(f"building the native braking FMU failed: {last}")
+    return Path(out)
+
+
+def _build(out, path) -> Path:
     import railadhesion
     from railadhesion.braking import BrakingSimulator
     from railadhesion.braking.scenario import load_scenario
 
-    path = Path(scenario)
-    if not path.is_file():
-        raise ValueError(f"scenario must be an existing TOML file, got {str(path)!r}")
+    path = Path(path)
     text = path.read_text(encoding="utf-8")
     with tempfile.TemporaryDirectory() as tmp:  # the copy must load on its own
         copy = Path(tmp) / _SCENARIO_FILE
