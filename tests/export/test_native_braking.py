@@ -111,3 +111,20 @@ def test_bad_input_is_an_error_naming_the_variable(fmu, name, value, message):
 
 def test_fmpy_validates(fmu):
     assert validate_fmu(str(fmu.fmu)) == []
+
+
+def test_cli_writes_a_native_braking_fmu(tmp_path):
+    from typer.testing import CliRunner
+
+    from railadhesion.cli import app
+
+    out = tmp_path / "b.fmu"
+    result = CliRunner().invoke(app, ["export", "braking-fmu", str(SCENARIO), "--out", str(out),
+                                      "--native"])  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert "passes FMPy's validation" in result.output
+    import zipfile
+
+    names = zipfile.ZipFile(out).namelist()
+    assert "binaries/linux64/railadhesion_braking.so" in names
+    assert "sources/buildDescription.xml" in names
