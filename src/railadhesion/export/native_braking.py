@@ -86,7 +86,7 @@ def braking_step_model(simulator, identifier: str = "railadhesion_braking") -> S
     """The braking vehicle of ``simulator`` (a :class:`~railadhesion.braking.BrakingSimulator`
     in its current state, not recording) as a :class:`StepModel` with the braking FMU's
     variables."""
-    from railadhesion.braking.records import INPUTS
+    from railadhesion.braking.records import INPUTS, POLACH, WILAC
     from railadhesion.braking.step import MACHINE, split_buffer
 
     if simulator._rows is not None:  # noqa: SLF001
@@ -94,6 +94,13 @@ def braking_step_model(simulator, identifier: str = "railadhesion_braking") -> S
     buffer = simulator._buffer  # noqa: SLF001
     machine, tables = split_buffer(buffer)
     n = int(machine[0]["settings"]["n_axles"])
+    if int(machine[0]["settings"]["model"]) not in (POLACH, WILAC):
+        raise ValueError("simulator: the native braking FMU compiles the built-in adhesion "
+                         "models (Polach sets, WILAC) only; this simulator's model is a "
+                         "Python function or a user's law: use the Python braking FMU")
+    if int(machine[0]["settings"]["wsp_on"]) != 0:
+        raise ValueError("simulator: build it without the built-in WSP (the FMU's master "
+                         "commands the valves)")
     state_t = np.dtype([("machine", MACHINE), ("stopped", "f8")], align=True)
     settings_t = np.dtype([("tables", "f8", (max(tables.size, 1),))], align=True)
     state = np.zeros(1, state_t)
@@ -131,7 +138,7 @@ def build_native_braking_fmu(out, scenario) -> Path:
     """Write a native FMI 2.0 co-simulation FMU of a braking vehicle: no Python at run time.
 
     Same scenario file, variables and outputs as :func:`railadhesion.export.build_braking_fmu`;
-    the braking step (:mod:`railadhesion.braking.step`) is compiled in with the vehicle, the
+    the braking step (``railadhesion.braking.step``) is compiled in with the vehicle, the
     cylinders, the adhesion model and the track of the scenario (binary for linux64, sources
     in ``sources/``; ``docs/fmu.md``). Building needs a C compiler and FMPy.
 
