@@ -128,3 +128,19 @@ def test_cli_writes_a_native_braking_fmu(tmp_path):
     names = zipfile.ZipFile(out).namelist()
     assert "binaries/linux64/railadhesion_braking.so" in names
     assert "sources/buildDescription.xml" in names
+
+
+def test_two_instances_side_by_side_and_no_allocation_in_steps(fmu):
+    v = fmu.vr
+    speed, valve = v["train_speed"], v["valve_2"]
+    sets = "".join(f"set {i} {v[f'pressure_command_{k}']} 550000\n" for i in (0, 1)
+                   for k in range(1, N + 1))  # fmt: skip
+    steps = "".join(f"step 0 {j * 1e-3!r} 0.001\nstep 1 {j * 1e-3!r} 0.001\n"
+                    for j in range(200))  # fmt: skip
+    lines, _ = fmu.run(f"new 0\nnew 1\ninit 0\ninit 1\n{sets}set 1 {valve} 2\nallocs\n{steps}"
+                       f"allocs\nget 0 {speed}\nget 1 {speed}\n")  # fmt: skip
+    allocs = [line for line in lines if line.startswith("allocs")]
+    assert allocs[0] == allocs[1]  # nothing allocated while stepping
+    gets = [float(line.split()[3]) for line in lines if line.startswith("get")]
+    assert gets[0] < gets[1]  # instance 1 vents axle 2: it brakes less than instance 0
+    assert all(line.split()[2] == "0" for line in lines if line.startswith("step"))
