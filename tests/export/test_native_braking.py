@@ -144,3 +144,10 @@ def test_two_instances_side_by_side_and_no_allocation_in_steps(fmu):
     gets = [float(line.split()[3]) for line in lines if line.startswith("get")]
     assert gets[0] < gets[1]  # instance 1 vents axle 2: it brakes less than instance 0
     assert all(line.split()[2] == "0" for line in lines if line.startswith("step"))
+
+
+@pytest.mark.parametrize("h", ["0", "-0.001", "nan"])
+def test_step_size_must_be_positive(fmu, h):
+    lines, err = fmu.run(f"new 0\ninit 0\nstep 0 0 {h}\n")
+    assert lines[-1] == "step 0 3"
+    assert "fmi2DoStep: communicationStepSize must be > 0 and finite" in err
