@@ -8,9 +8,9 @@ host of the tests (``tests/export/data/fmi2_host.c``, no Python in its process):
 the pressure commands and the valve states of all axles set every step (apply, hold, vent
 changing), doStep, the train and wheel speeds read back; then doStep alone. The train is
 moving throughout (2 x REPEAT x ROWS ms = 10 s; the script checks that it has not stopped).
-The Python braking FMU (pythonfmu) of the same scenario is timed under FMPy (``bench_export.bench_braking``), and the
-native WILAC creep-force FMU's doStep in the same C host. Medians of the host's runs; the
-machine is shared: compare the ratio.
+The Python braking FMU (pythonfmu) of the same scenario is timed under FMPy
+(``bench_export.bench_braking``), and the native WILAC creep-force FMU's doStep in the same
+C host. Medians of the host's runs; the machine is shared: compare the ratio.
 """
 
 from __future__ import annotations
