@@ -122,3 +122,16 @@ def test_cache_path_is_where_numba_writes_the_cache_files(tmp_path):
     files = sorted(p.name for p in (tmp_path / "cache").rglob("probe.f-*"))
     assert files and any(n.endswith(".nbi") for n in files), files
     assert all(p.parent == type(p)(path) for p in (tmp_path / "cache").rglob("probe.f-*"))
+
+
+def test_guard_cache_finds_numbas_cache_directory():
+    """guard_cache reads numba's private ``dispatcher._cache._cache_path``: fail loudly if
+    numba moves it."""
+    from numba import njit
+
+    @njit(cache=True)
+    def cached():
+        return 1
+
+    assert cached() == 1
+    assert isinstance(cached._cache._cache_path, str), "see _jit.guard_cache"

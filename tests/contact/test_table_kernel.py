@@ -7,6 +7,7 @@ import pytest
 
 from railadhesion.contact import kalker_coefficients
 from railadhesion.contact import table as tm
+from railadhesion.simd import contract_rows
 
 #: The compiled kernels against their references over the whole input domain, implausible
 #: inputs included: the policy's warnings (docs/checks.md) are what tests/test_plausibility.py
@@ -113,8 +114,8 @@ def test_parallel_lookup_equals_serial(monkeypatch, shared_aob):
 @numba.njit
 def _contract_plain(tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd2, wd3, wu0, wu1, wu2,
                     wu3):  # fmt: skip
-    """The table's hand-written LLVM contraction (``tm._contract``) in plain numba code, the sums
-    in the same order."""
+    """The table's hand-written LLVM contraction (``railadhesion.simd.contract_rows``) in
+    plain numba code, the sums in the same order."""
     wt = (wt0, wt1, wt2, wt3)
     wd = (wd0, wd1, wd2, wd3)
     wu = (wu0, wu1, wu2, wu3)
@@ -148,7 +149,7 @@ def _contract_plain(tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd2, wd3, w
 
 @numba.njit
 def _contract_ir(tab, base, st, sd, w):
-    return tm._contract(tab, base, st, sd, w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7], w[8],
+    return contract_rows(tab, base, st, sd, w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7], w[8],
                         w[9], w[10], w[11])  # fmt: skip
 
 

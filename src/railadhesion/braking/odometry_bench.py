@@ -51,6 +51,7 @@ from railadhesion.braking.bench import (
     read_cosim_fmu,
     read_programme_file,
     release_fmu,
+    save_figure,
     select_cases,
     write_json,
 )
@@ -1075,7 +1076,7 @@ def write_odometry_outputs(result: OdometryProgrammeResult, out, *, case=None,
     written = []
     doc = {"format": "railadhesion-odometry-results", "programme": result.programme,
            "odometry": result.odometry, "overall": result.overall, "cases": result.cases}
-    written.append(write_json(out / "summary.json", doc, atomic=True))
+    written.append(write_json(out / "summary.json", doc))
     result.frame().to_csv(out / "fits.csv", index=False, float_format="%.6g")
     result.violation_frame().to_csv(out / "violations.csv", index=False, float_format="%.6g")
     written += [out / "fits.csv", out / "violations.csv"]
@@ -1086,12 +1087,9 @@ def write_odometry_outputs(result: OdometryProgrammeResult, out, *, case=None,
         if tr is not None and figures:
             from railadhesion.braking.figures import odometry_case_figure
 
-            (out / "figures").mkdir(exist_ok=True)
             fig = odometry_case_figure(tr, summary, title=f"{ocase.name}: "
                                        f"{ocase.run.adhesion.describe()}")
-            path = out / "figures" / f"{ocase.name}.png"
-            fig.savefig(path, dpi=80)
-            written.append(path)
+            written.append(save_figure(fig, out, ocase.name, 80))
         if tr is not None and histories:
             import pandas as pd
 
@@ -1109,9 +1107,5 @@ def write_odometry_outputs(result: OdometryProgrammeResult, out, *, case=None,
     if summary_figure:
         from railadhesion.braking.figures import odometry_summary_figure
 
-        (out / "figures").mkdir(exist_ok=True)
-        fig = odometry_summary_figure(result.cases)
-        path = out / "figures" / "summary.png"
-        fig.savefig(path, dpi=80)
-        written.append(path)
+        written.append(save_figure(odometry_summary_figure(result.cases), out, "summary", 80))
     return written

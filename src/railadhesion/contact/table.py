@@ -37,9 +37,6 @@ from functools import lru_cache
 from importlib import resources
 
 import numpy as np
-from llvmlite import ir
-from numba import types
-from numba.extending import intrinsic
 
 from railadhesion._validate import (
     as_float_array,
@@ -52,6 +49,7 @@ from railadhesion.contact.friction import falling_friction_factor
 from railadhesion.contact.kalker import kalker_coefficients, kalker_scalar
 from railadhesion.numerics import atan_nonneg, chunk_of, fill, jit, run_chunks
 from railadhesion.plausibility import input_checker
+from railadhesion.simd import NOUT, contract_rows
 
 __all__ = ["exact_table_forces", "table_axes"]
 
@@ -185,7 +183,7 @@ def _slice_at(laob: float) -> np.ndarray:
 
 #: Values per table node in memory: Fx, Fy, Mz (rows padded to 4 were measured slower: the
 #: table is larger, and the lookup is bound by its memory accesses as much as by arithmetic).
-_NOUT = 3
+_NOUT = NOUT  # values per node (Fx, Fy, Mz), as contract_rows reads them
 #: Contacts per chunk of the kernel (its scratch rows stay in the level-2 cache).
 _CHUNK = 512
 #: Contacts from which the lookup runs in parallel (as the package's Polach kernels).
@@ -200,72 +198,6 @@ _R_X, _R_Y, _R_S, _R_SGN, _R_SY, _R_FAC, _R_INV, _R_BASE = range(8)
 _R_WT, _R_WD, _R_WU, _R_WA = 8, 12, 16, 20
 _R_F0, _R_F1, _R_F2, _R_ARG, _R_TMP = range(24, 29)
 _ROWS = 29
-
-
-@intrinsic
-def _contract(typingctx, tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd2, wd3, wu0, wu1,
-              wu2, wu3):  # fmt: skip
-    """The cubic interpolation of one contact in a table of rows of _NOUT values:
-    sum over qt, qd, qu = 0..3 of wt[qt] wd[qd] wu[qu] tab[base + qt st + qd sd + _NOUT qu + j],
-    j = 0, 1, 2 (Fx, Fy, Mz). Written in LLVM vector operations: the 4 spin nodes of a
-    (t, theta) pair are 4 _NOUT contiguous doubles, loaded and accumulated as one vector
-    (numba does not vectorise such short fixed loops itself: they are unrolled before its
-    loop vectoriser runs, and its SLP vectoriser is off). The products are summed along
-    theta, then t, then u.
-
-    Why hand-written IR: the same sums in plain numba code (``tests/contact/
-    test_table_kernel.py``, which holds this function to it) made the whole lookup about three
-    times slower (measured side by side, one thread; docs/kernels.md).
-    The only LLVM IR of the package; it uses numba's public extension API (``intrinsic``)."""
-    f64 = types.float64
-    if not (isinstance(tab, types.Array) and tab.dtype == f64 and tab.ndim == 1
-            and tab.layout == "C" and all(isinstance(v, types.Integer) for v in (base, st, sd))
-            and all(w == f64 for w in (wt0, wt1, wt2, wt3, wd0, wd1, wd2, wd3, wu0, wu1, wu2,
-                                       wu3))):  # fmt: skip
-        return None
-    sig = types.UniTuple(f64, 3)(tab, base, st, sd, *([f64] * 12))
-
-    def codegen(context, builder, signature, args):
-        data = context.make_array(signature.args[0])(context, builder, args[0]).data
-        i64 = ir.IntType(64)
-        i32 = ir.IntType(32)
-        base_, st_, sd_ = (
-            context.cast(builder, v, t, types.int64)
-            for v, t in zip(args[1:4], signature.args[1:4], strict=True)
-        )
-        wt, wd, wu = args[4:8], args[8:12], args[12:16]
-        n = 4 * _NOUT
-        vrun = ir.VectorType(ir.DoubleType(), n)  # the 4 spin nodes of a (t, theta) pair
-        vnode = ir.VectorType(ir.DoubleType(), _NOUT)
-        flags = ("contract",)
-
-        def splat(x, vty, width):
-            v = builder.insert_element(ir.Constant(vty, ir.Undefined), x, ir.Constant(i32, 0))
-            mask = ir.Constant(ir.VectorType(i32, width), [0] * width)
-            return builder.shuffle_vector(v, ir.Constant(vty, ir.Undefined), mask)
-
-        acc = None
-        for qt in range(4):
-            row_t = builder.add(base_, builder.mul(st_, ir.Constant(i64, qt)))
-            part = None
-            for qd in range(4):
-                row = builder.add(row_t, builder.mul(sd_, ir.Constant(i64, qd)))
-                ptr = builder.bitcast(builder.gep(data, [row], inbounds=True), vrun.as_pointer())
-                term = builder.fmul(builder.load(ptr, align=8), splat(wd[qd], vrun, n),
-                                    flags=flags)  # fmt: skip
-                part = term if part is None else builder.fadd(part, term, flags=flags)
-            term = builder.fmul(part, splat(wt[qt], vrun, n), flags=flags)
-            acc = term if acc is None else builder.fadd(acc, term, flags=flags)
-        res = None
-        for qu in range(4):
-            mask = ir.Constant(ir.VectorType(i32, _NOUT), [_NOUT * qu + j for j in range(_NOUT)])
-            node = builder.shuffle_vector(acc, ir.Constant(vrun, ir.Undefined), mask)
-            term = builder.fmul(node, splat(wu[qu], vnode, _NOUT), flags=flags)
-            res = term if res is None else builder.fadd(res, term, flags=flags)
-        vals = [builder.extract_element(res, ir.Constant(i32, j)) for j in range(3)]
-        return context.make_tuple(builder, signature.return_type, vals)
-
-    return sig, codegen
 
 
 # Each stage below is one short loop over a chunk, with few arrays (few run-time aliasing
@@ -348,7 +280,7 @@ def _gather(tab, rows, m, st, sd, sa):
     for k in range(m):
         b = int(base[k])
         if sa == 0:
-            a0, a1, a2 = _contract(tab, b, st, sd, wt[0, k], wt[1, k], wt[2, k], wt[3, k],
+            a0, a1, a2 = contract_rows(tab, b, st, sd, wt[0, k], wt[1, k], wt[2, k], wt[3, k],
                                    wd[0, k], wd[1, k], wd[2, k], wd[3, k], wu[0, k], wu[1, k],
                                    wu[2, k], wu[3, k])  # fmt: skip
         else:
@@ -356,7 +288,7 @@ def _gather(tab, rows, m, st, sd, sa):
             a1 = 0.0
             a2 = 0.0
             for qa in range(4):
-                s0, s1, s2 = _contract(tab, b + qa * sa, st, sd, wt[0, k], wt[1, k], wt[2, k],
+                s0, s1, s2 = contract_rows(tab, b + qa * sa, st, sd, wt[0, k], wt[1, k], wt[2, k],
                                        wt[3, k], wd[0, k], wd[1, k], wd[2, k], wd[3, k],
                                        wu[0, k], wu[1, k], wu[2, k], wu[3, k])  # fmt: skip
                 w = wa[qa, k]
