@@ -8,9 +8,9 @@
    unit has a floor.
 
 Violations that other branches are removing are listed in :data:`PENDING`, with who removes
-them: they are tolerated by the rule tests and expected to vanish by
-:func:`test_pending_violations_are_gone` (an xfail: when it passes, strictly, delete the
-entries it no longer finds and the mark).
+them: they are tolerated by the rule tests and expected to vanish. While :data:`PENDING` has
+entries, mark :func:`test_pending_violations_are_gone` as a strict xfail; when it passes,
+delete the entries it no longer finds and the mark (it is empty today: the test must pass).
 """
 
 from __future__ import annotations
@@ -44,15 +44,8 @@ FLOORS: tuple[tuple[str, ...], ...] = (
 )
 
 #: Violations being removed on other branches: (rule, importer, imported, name) -> owner.
-PENDING: dict[tuple[str, str, str, str], str] = {
-    # models.wilac reads its default parameter file through io (the file reader would have to
-    # move below models, or the default set above it: both change public import paths)
-    ("layer", "railadhesion.models.wilac", "railadhesion.io.paramfiles", ""): "lead",
-    # a braking scenario reads an identified adhesion law: the law's file format must move
-    # below braking (it is in identification/curves.py, which another branch edits)
-    ("layer", "railadhesion.braking.scenario", "railadhesion.identification.curves", ""):
-        "lead, after the merge",
-}
+#: Empty: keep it so while nothing is in flight (see test_pending_violations_are_gone).
+PENDING: dict[tuple[str, str, str, str], str] = {}
 
 
 # --- reading the imports ------------------------------------------------------------------
@@ -205,8 +198,6 @@ def test_no_violation_beyond_the_pending_ones(found, rule):
     assert not new, f"{rule} violations (docs/architecture.md):\n{_show(new.items())}"
 
 
-@pytest.mark.xfail(strict=True, reason="braking.scenario -> identification.curves and "
-                   "models.wilac -> io are left to the lead")
 def test_pending_violations_are_gone(found):
     left = {k: found[k] for k in PENDING if k in found}
     assert not left, "still there:\n" + _show(left.items())
@@ -275,3 +266,88 @@ def test_the_package_is_read_whole():
     # a function-level import is seen (cli imports the identification pipeline in a command)
     assert any(i == "railadhesion.cli_identification" and t.startswith(
         "railadhesion.identification") for i, t, _, _ in imports)
+
+
+# --- numba's private internals: in _jit.py only ---------------------------------------------
+
+#: numba modules that are not its public API (numba.extending, numba.types, numba.typed and
+#: the top-level names are).
+NUMBA_PRIVATE_MODULES = ("numba.core", "numba.np", "numba.cpython", "numba.misc",
+                         "numba.parfors", "numba.typeconv", "numba.cuda.cudadrv")
+#: Dispatcher attributes that are numba internals (its public ones: py_func, signatures,
+#: compile, recompile, inspect_*, stats).
+NUMBA_PRIVATE_ATTRIBUTES = {"overloads", "entry_point", "_cache_path", "disable_compile",
+                            "targetctx", "typingctx", "_compile_for_args", "_can_compile",
+                            "_cache"}
+
+
+def numba_internals(src: Path = SRC, package: str = PACKAGE, allowed=("railadhesion._jit",)):
+    """Uses of numba's private modules and dispatcher internals outside ``allowed``:
+    (module, what, line). ``self._cache`` of the package's own classes is not numba's."""
+    found = []
+    for module, path in find_modules(src, package).items():
+        if module in allowed:
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
+            names = []
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom) and not node.level:
+                names = [node.module or ""]
+            for name in names:
+                if name.startswith(NUMBA_PRIVATE_MODULES):
+                    found.append((module, name, node.lineno))
+            if (isinstance(node, ast.Attribute) and node.attr in NUMBA_PRIVATE_ATTRIBUTES
+                    and not (isinstance(node.value, ast.Name) and node.value.id == "self")):
+                found.append((module, node.attr, node.lineno))
+    return found
+
+
+def test_numba_internals_are_used_in_jit_only():
+    assert not numba_internals(), numba_internals()
+
+
+def test_the_numba_check_finds_internals(tmp_path):
+    src = _tree(tmp_path, {
+        "pkg/__init__.py": "",
+        "pkg/a.py": "from numba.core import types\nimport numba.np.numpy_support\n",
+        "pkg/b.py": "def f(d):\n    return d.overloads[0].entry_point, d._cache._cache_path\n",
+        "pkg/c.py": "class C:\n    def f(self):\n        return self._cache\n",
+        "pkg/_jit.py": "def g(d):\n    return d.overloads\n",
+    })
+    found = {(m, what) for m, what, _ in numba_internals(src, "pkg", ("pkg._jit",))}
+    assert found == {("pkg.a", "numba.core"), ("pkg.a", "numba.np.numpy_support"),
+                     ("pkg.b", "overloads"), ("pkg.b", "entry_point"), ("pkg.b", "_cache"),
+                     ("pkg.b", "_cache_path")}
+
+
+# --- the table of the laws ------------------------------------------------------------------
+
+
+def law_table(text: str) -> list[tuple[str, list[str], list[str]]]:
+    """Rows of the tables of "Where each law lives": (law, files, function names)."""
+    part = text[text.index("## Where each law lives"):text.index("## How a kernel is added")]
+    rows = []
+    for line in part.splitlines():
+        cells = [c.strip() for c in re.split(r"(?<!\\)\|", line.strip())[1:-1]]
+        if len(cells) != 3 or cells[0] in ("Law (source)", "---"):
+            continue
+        files = re.findall(r"`([\w/]+\.py)`", cells[1])
+        names = re.findall(r"`([\w.]+)`", cells[2])  # Class.method: the method
+        rows.append((cells[0], files, [n.split(".")[-1] for n in names]))
+    return rows
+
+
+def test_every_law_of_the_table_is_where_it_says():
+    rows = law_table((ROOT / "docs" / "architecture.md").read_text(encoding="utf-8"))
+    assert len(rows) >= 20
+    missing = []
+    for law, files, names in rows:
+        assert files, law
+        text = "\n".join((SRC / PACKAGE / f).read_text(encoding="utf-8") for f in files)
+        defined = {n.name for n in ast.walk(ast.parse(text))
+                   if isinstance(n, ast.FunctionDef | ast.ClassDef)}
+        defined |= {t.id for n in ast.walk(ast.parse(text)) if isinstance(n, ast.Assign)
+                    for t in n.targets if isinstance(t, ast.Name)}
+        missing += [(law, name) for name in names if name not in defined]
+    assert not missing, missing

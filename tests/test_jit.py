@@ -1,6 +1,8 @@
-"""The numba cache guard of railadhesion._jit (used by the braking kernels only, until they
-are built with railadhesion.numerics.jit): kernels that inline njit helpers of another module
-must not keep cached machine code built against an older version of that module."""
+"""railadhesion._jit, the only module that uses numba's private internals (for the monitor's
+kernels): the cache guard (kernels that inline njit helpers of another module must not keep
+cached machine code built against an older version of that module) and the compiled entry
+point. The internals are read from the installed numba directly: these tests fail, loudly,
+when numba changes them (the package itself would fall back, or fail at import)."""
 
 from __future__ import annotations
 
@@ -79,20 +81,47 @@ def test_source_checksum_changes_with_the_source(tmp_path):
     assert _jit.source_checksum(module) != before
 
 
-def test_kernel_entry_calls_the_compiled_code():
+def test_kernel_entry_calls_the_compiled_code_not_the_dispatcher(recwarn):
     from numba import njit
-
-    from railadhesion._jit import kernel_entry
 
     @njit
     def add(a, b):
         return a + b
 
-    entry = kernel_entry(add, (1.0, 2.0))
+    entry = _jit.kernel_entry(add, (1.0, 2.0))
+    # no fallback: numba still gives the entry point (Dispatcher.overloads[...].entry_point)
+    assert entry is not add and entry is _jit.compiled_entry(add, (1.0, 2.0))
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
     assert entry(3.0, 4.0) == 7.0
-    # fails loudly when numba's internals change: kernel_entry's fallback would keep the
-    # package working (through the dispatcher, a few hundred ns slower a call), unnoticed
-    assert entry is not add, "numba's overloads[...].entry_point is gone: see _jit.kernel_entry"
+
+
+def test_compiled_entry_of_an_uncompiled_type_is_an_error():
+    from numba import njit
+
+    @njit
+    def add(a, b):
+        return a + b
+
+    add(1.0, 2.0)
+    try:
+        _jit.compiled_entry(add, (1, 2))
+    except RuntimeError as exc:
+        assert "entry point" in str(exc) and "numba" in str(exc)
+    else:  # pragma: no cover
+        raise AssertionError("an entry point for a type never compiled")
+
+
+def test_cache_path_is_where_numba_writes_the_cache_files(tmp_path):
+    # Dispatcher._cache._cache_path: the directory that holds the .nbi/.nbc files
+    code = ("import numba, sys\nfrom railadhesion import _jit\n"
+            "@numba.njit(cache=True)\ndef f(x):\n    return x + 1.0\n"
+            "f(1.0)\nprint(_jit.cache_path(f))\n")
+    mod = tmp_path / "probe.py"
+    mod.write_text(code)
+    path = _run(tmp_path, "import probe")
+    files = sorted(p.name for p in (tmp_path / "cache").rglob("probe.f-*"))
+    assert files and any(n.endswith(".nbi") for n in files), files
+    assert all(p.parent == type(p)(path) for p in (tmp_path / "cache").rglob("probe.f-*"))
 
 
 def test_guard_cache_finds_numbas_cache_directory():

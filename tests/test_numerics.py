@@ -262,8 +262,9 @@ def _version(text: str) -> tuple[int, ...]:
 
 @pytest.mark.parametrize("name", ["numba", "llvmlite"])
 def test_installed_numba_and_llvmlite_are_within_the_declared_bounds(name):
-    """The kernels use numba's public API only, tested with the versions in the declared
-    range; a newer numba or llvmlite must be tested before the bound is raised."""
+    """The kernels use numba's public API (its internals in _jit.py only, tests/test_jit.py),
+    tested with the versions in the declared range; a newer numba or llvmlite must be tested
+    before the bound is raised."""
     low, high = _declared_bound(name)
     installed = _version(metadata.version(name))
     assert _version(low) <= installed < _version(high), (name, installed, low, high)

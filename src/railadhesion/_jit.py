@@ -1,13 +1,26 @@
-"""The package's only uses of numba internals, isolated here: the cache guard of the kernels
-that still use numba's in-tree cache (``braking._kernels``, ``monitor.kernel``; every other
-kernel is built with :func:`railadhesion.numerics.jit`, whose cache directory is keyed by the
-kernel sources and needs no guard) and :func:`kernel_entry` (with a fallback).
-``tests/test_jit.py`` checks both against the installed numba.
+"""The package's only uses of numba's private internals, isolated here on purpose.
+
+Two remain, both for ``monitor.kernel`` and ``monitor.estimator`` (every other kernel is built
+with :func:`railadhesion.numerics.jit`, whose cache directory is keyed by the kernel sources and
+needs no guard, and called through numba's public dispatcher):
+
+* :func:`guard_cache` reads ``Dispatcher._cache._cache_path``: numba has no public way to say
+  where it keeps a function's cache files (``__pycache__`` beside the source, or a user-wide
+  directory when that is not writable), and the guard must delete them there. Moving the
+  monitor's kernels to :func:`railadhesion.numerics.jit` makes the guard unnecessary.
+* :func:`kernel_entry` reads ``Dispatcher.overloads[types].entry_point``: calling the compiled
+  entry point skips the dispatcher's type resolution of every argument on every call (numba
+  has no public equivalent short of a ``cfunc`` with a C signature for the monitor's records).
+
+``tests/test_jit.py`` reads both internals from the installed numba directly and fails when
+numba changes them (the declared upper bounds on numba and llvmlite, checked by
+``tests/test_numerics.py``, keep an untested numba out).
 """
 
 from __future__ import annotations
 
-__all__ = ["guard_cache", "kernel_entry", "purge_module_cache", "source_checksum"]
+__all__ = ["cache_path", "compiled_entry", "guard_cache", "kernel_entry", "purge_module_cache",
+           "source_checksum"]
 
 # numba keys a cached kernel on its own source file only. A kernel that calls (and inlines)
 # njit helpers of another module keeps its cached machine code when that module changes; the
@@ -42,28 +55,65 @@ def purge_module_cache(cache_dir, module_stem: str, compiled: int, current: int)
     return gone
 
 
+def cache_path(dispatcher) -> str:
+    """The directory of the cache files of an ``@njit(cache=True)`` ``dispatcher``
+    (``Dispatcher._cache._cache_path``, numba internals). Raises ``RuntimeError`` naming
+    numba's version if numba no longer gives it."""
+    import numba
+
+    try:
+        path = dispatcher._cache._cache_path
+    except AttributeError as exc:
+        raise RuntimeError(f"numba {numba.__version__} no longer gives a function's cache "
+                           f"directory (Dispatcher._cache._cache_path): {exc!r}") from exc
+    if not isinstance(path, str):
+        raise RuntimeError(f"numba {numba.__version__}: Dispatcher._cache._cache_path is "
+                           f"{type(path).__name__}, not a directory name")
+    return path
+
+
 def guard_cache(fingerprint_dispatcher, module_file: str, current: int) -> list:
     """Run the guard: ``fingerprint_dispatcher`` is an ``@njit(cache=True)`` function of the
     guarded module (``module_file``) returning the checksum global it was compiled with."""
     from pathlib import Path
 
-    cache_dir = fingerprint_dispatcher._cache._cache_path
+    cache_dir = cache_path(fingerprint_dispatcher)
     gone = purge_module_cache(cache_dir, Path(module_file).stem, fingerprint_dispatcher(), current)
     if gone:
         fingerprint_dispatcher.recompile()
     return gone
 
 
+def compiled_entry(dispatcher, args):
+    """``dispatcher.overloads[types of args].entry_point`` (numba internals): the compiled
+    entry point for the types of ``args``, which must already be compiled. Raises
+    ``RuntimeError`` naming numba's version if numba no longer gives it."""
+    import numba
+
+    try:
+        entry = dispatcher.overloads[tuple(numba.typeof(a) for a in args)].entry_point
+    except (AttributeError, KeyError, TypeError) as exc:
+        raise RuntimeError(f"numba {numba.__version__} no longer gives a kernel's entry point "
+                           f"(Dispatcher.overloads[...].entry_point): {exc!r}") from exc
+    if not callable(entry):
+        raise RuntimeError(f"numba {numba.__version__}: Dispatcher.overloads[...].entry_point "
+                           f"is not callable ({type(entry).__name__})")
+    return entry
+
+
 def kernel_entry(dispatcher, args):
-    """The compiled entry point of the numba ``dispatcher`` for the types of ``args``: calling
-    it skips the dispatcher's type resolution (a few hundred ns a call). ``args`` must make a
-    call without harm (it compiles the kernel, or loads it from the cache); falls back to the
-    dispatcher if numba's internals do not give the entry point."""
+    """The compiled entry point of the numba ``dispatcher`` for the types of ``args``
+    (:func:`compiled_entry`): calling it skips the dispatcher's type resolution. ``args`` must
+    make a call without harm (it compiles the kernel, or loads it from the cache). If numba's
+    internals do not give the entry point, warns (``RuntimeWarning``) and returns the
+    dispatcher: the results are the same, each call is slower. ``tests/test_jit.py`` fails in
+    that case."""
     dispatcher(*args)
     try:
-        from numba import typeof
+        return compiled_entry(dispatcher, args)
+    except RuntimeError as exc:  # pragma: no cover - numba changed: tests/test_jit.py fails
+        import warnings
 
-        entry = dispatcher.overloads[tuple(typeof(a) for a in args)].entry_point
-    except Exception:  # pragma: no cover - numba internals changed: use the dispatcher
-        entry = None
-    return entry if callable(entry) else dispatcher
+        warnings.warn(f"{exc}; calling the kernel through its dispatcher (slower)",
+                      RuntimeWarning, stacklevel=2)  # fmt: skip
+        return dispatcher

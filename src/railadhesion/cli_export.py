@@ -67,7 +67,6 @@ def export_fmu(
     """Write an FMI 2.0 co-simulation FMU of a creep-force law (the Python FMU needs Python
     on the host; --native does not)."""
     from railadhesion.export import (
-        NativeBuildError,
         build_creep_force_fmu,
         build_native_creep_force_fmu,
         resolve_parameters,
@@ -76,29 +75,15 @@ def export_fmu(
     build = build_native_creep_force_fmu if native else build_creep_force_fmu
     try:
         resolved = resolve_parameters(model, params, parameter_set)
-        path = build(
-            out, model, params, parameter_set=parameter_set,
-            shear_modulus=shear_modulus, poisson=poisson,
-        )  # fmt: skip
-    except NativeBuildError as exc:
-        _fail(f"no native FMU: {exc}")
     except ValueError as exc:
         _fail(exc)
-    except OSError as exc:
-        _fail(f"cannot write {out}: {exc.strerror or exc}")
-    console.print(f"FMU written to {escape(str(path))}")
+    path = _write_fmu(build, out, model, params, parameter_set=parameter_set,
+                      shear_modulus=shear_modulus, poisson=poisson)  # fmt: skip
     console.print(escape(f"{model}: {resolved.summary()}"))
     if native:
         console.print("native FMU: binaries/linux64 needs no Python on the host; sources in "
                       "sources/ (docs/fmu.md)")  # fmt: skip
-    try:
-        from fmpy.validation import validate_fmu
-    except ImportError:  # pragma: no cover - fmpy is optional at run time
-        return
-    problems = validate_fmu(str(path))
-    if problems:
-        _fail("the FMU does not pass FMPy's validation: " + "; ".join(problems))
-    console.print("modelDescription.xml passes FMPy's validation")
+    _check_fmu(path, required=False)
 
 
 @export_app.command("braking-fmu")
@@ -113,11 +98,19 @@ def export_braking_fmu(
 ) -> None:
     """Write the braking vehicle of SCENARIO as an FMI 2.0 co-simulation FMU (inputs: commanded
     pressure and WSP valve per axle; the Python FMU needs Python on the host, --native not)."""
-    from railadhesion.export import NativeBuildError, build_braking_fmu, build_native_braking_fmu
+    from railadhesion.export import build_braking_fmu, build_native_braking_fmu
 
-    build = build_native_braking_fmu if native else build_braking_fmu
+    path = _write_fmu(build_native_braking_fmu if native else build_braking_fmu, out, scenario)
+    _check_fmu(path, required=True)
+
+
+def _write_fmu(build, out, *args, **kwargs):
+    """``build(out, *args, **kwargs)`` (an FMU builder); its errors become a red message and
+    exit code 1; says where the FMU was written and returns its path."""
+    from railadhesion.export import NativeBuildError
+
     try:
-        path = build(out, scenario)
+        path = build(out, *args, **kwargs)
     except NativeBuildError as exc:
         _fail(f"no native FMU: {exc}")
     except ValueError as exc:
@@ -125,8 +118,18 @@ def export_braking_fmu(
     except OSError as exc:
         _fail(f"cannot write {out}: {exc.strerror or exc}")
     console.print(f"FMU written to {escape(str(path))}")
-    from fmpy.validation import validate_fmu
+    return path
 
+
+def _check_fmu(path, *, required: bool) -> None:
+    """Validate the FMU at ``path`` with FMPy (fail on a problem); without FMPy, an error if
+    ``required``, else nothing."""
+    try:
+        from fmpy.validation import validate_fmu
+    except ImportError:  # pragma: no cover - fmpy is optional at run time
+        if required:
+            raise
+        return
     problems = validate_fmu(str(path))
     if problems:
         _fail("the FMU does not pass FMPy's validation: " + "; ".join(problems))

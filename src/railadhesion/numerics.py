@@ -127,7 +127,9 @@ def load_numba():
 def jit(func=None, **options):
     """``numba.njit`` with the package's settings: ``cache=True`` in :func:`cache_directory`,
     ``error_model="numpy"`` unless ``options`` say otherwise; ``options`` are passed on (e.g.
-    ``nogil=True``).
+    ``nogil=True``). ``signature`` (a numba signature string) compiles that version only, when
+    the dispatcher is built: other argument types are converted to it by numba's dispatcher,
+    never compiled anew (numba's eager compilation, ``numba.njit(signature)``).
 
     The cache directory is given to numba through its public setting ``numba.config.CACHE_DIR``
     while the dispatcher is created (numba picks a function's cache location then), and the
@@ -135,6 +137,7 @@ def jit(func=None, **options):
     """
 
     flags = {"error_model": "numpy", **options, "cache": True}
+    signature = flags.pop("signature", None)
 
     def build(f):
         numba = load_numba()
@@ -142,6 +145,8 @@ def jit(func=None, **options):
             saved = numba.config.CACHE_DIR
             numba.config.CACHE_DIR = str(cache_directory())
             try:
+                if signature is not None:
+                    return numba.njit(signature, **flags)(f)
                 return numba.njit(**flags)(f)
             finally:
                 numba.config.CACHE_DIR = saved

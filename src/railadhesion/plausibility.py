@@ -389,7 +389,8 @@ def input_checker(names: Sequence[str]) -> Callable[[Sequence], tuple[str, ...]]
 
     if not spec:
         return lambda values: ()
-    # The fast test as one generated expression (no loop: well under 0.1 us per argument):
+    # The fast test as one generated expression, with no loop (its cost in the model
+    # functions: benchmarks/bench_plausibility.py):
     # ``type(v) in (float, numpy.float64, int) and lo <= v <= hi`` for each checked argument.
     unpack = ", ".join(f"v{i}" for i in range(len(names)))
     test = " and ".join(

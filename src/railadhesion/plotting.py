@@ -114,6 +114,17 @@ def _finish_zoom(ax_zoom, zoom: float, ax=None) -> None:
     ax_zoom.grid(True, alpha=0.3)
 
 
+def _creep_panels(ax, creep_max: float, n_points: int, zoom):
+    """Creepages of a traction creep-curve figure (negative, dense at low creep and in the
+    zoomed range) and its panels: ``(creep, figure, main axes, zoom axes or None, the axes to
+    draw on)`` (:func:`_creep_axes`)."""
+    creep = -_traction_creep(creep_max, n_points)
+    if zoom is not None:
+        creep = np.unique(np.concatenate([creep, -np.linspace(0, float(zoom) / 100, 120)]))
+    fig, ax, ax_zoom = _creep_axes(ax, zoom)
+    return creep, fig, ax, ax_zoom, [x for x in (ax_zoom, ax) if x is not None]
+
+
 def _traction_creep(creep_max: float, n_points: int) -> np.ndarray:
     """Magnitudes 0 … creep_max, dense at low creep (where the curves bend)."""
     creep_max = float(check_positive(creep_max, "creep_max"))
@@ -247,12 +258,8 @@ def plot_wilac_curves(
     v = float(check_nonnegative(speed, "speed"))
     flows = check_nonnegative(np.atleast_1d(np.asarray(water_flows, dtype=float)), "water_flows")
     a, b = contact_semi_axes(geometry, q)
-    creep = -_traction_creep(creep_max, n_points)
-    if zoom is not None:  # dense in the zoomed range too
-        creep = np.unique(np.concatenate([creep, -np.linspace(0, float(zoom) / 100, 120)]))
-    fig, ax, ax_zoom = _creep_axes(ax, zoom)
+    creep, fig, ax, ax_zoom, axes = _creep_panels(ax, creep_max, n_points, zoom)
     fx, _ = wilac_forces(creep[None, :], 0.0, 0.0, q, v, a, b, flows[:, None], p)
-    axes = [x for x in (ax_zoom, ax) if x is not None]
     _draw_distinguishable(
         axes, 100 * creep, list(np.asarray(fx) / q), [f"w = {w:g} µl/s" for w in flows],
         [{"color": f"C{i}"} for i in range(flows.size)],
@@ -418,11 +425,7 @@ def plot_wilac_speeds(
     w = float(check_nonnegative(water_flow, "water_flow"))
     vs = check_nonnegative(np.atleast_1d(np.asarray(speeds, dtype=float)), "speeds")
     a, b = contact_semi_axes(geometry, q)
-    creep = -_traction_creep(creep_max, n_points)
-    if zoom is not None:
-        creep = np.unique(np.concatenate([creep, -np.linspace(0, float(zoom) / 100, 120)]))
-    fig, ax, ax_zoom = _creep_axes(ax, zoom)
-    axes = [x for x in (ax_zoom, ax) if x is not None]
+    creep, fig, ax, ax_zoom, axes = _creep_panels(ax, creep_max, n_points, zoom)
     fx, _ = wilac_forces(creep[None, :], 0.0, 0.0, q, vs[:, None], a, b, w, p)
     colors = [f"C{i}" for i in range(len(vs))]
     rows = list(np.asarray(fx) / q)

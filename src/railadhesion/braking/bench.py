@@ -92,6 +92,9 @@ __all__ = [
     "run_wsp_programme",
     "write_programme_outputs",
     "json_safe",
+    "read_programme_file",
+    "release_fmu",
+    "select_cases",
 ]
 
 PROGRAMME_FORMAT = "railadhesion-wsp-programme"
@@ -193,13 +196,20 @@ class WSPProgramme:
 
     def select(self, names) -> WSPProgramme:
         """The programme with the named cases only (in the programme's order)."""
-        wanted = list(names)
-        known = {c.name for c in self.cases}
-        missing = [n for n in wanted if n not in known]
-        if missing:
-            raise ValueError(f"unknown case(s) {missing}; the programme has "
-                             f"{', '.join(c.name for c in self.cases)}")
-        return replace(self, cases=[c for c in self.cases if c.name in wanted])
+        return select_cases(self, names)
+
+
+def select_cases(programme, names):
+    """A copy of ``programme`` (a dataclass with a list ``cases`` of named cases) with the
+    cases named in ``names`` only, in the programme's order; ``ValueError`` for an unknown
+    name."""
+    wanted = list(names)
+    known = {c.name for c in programme.cases}
+    missing = [n for n in wanted if n not in known]
+    if missing:
+        raise ValueError(f"unknown case(s) {missing}; the programme has "
+                         f"{', '.join(c.name for c in programme.cases)}")
+    return replace(programme, cases=[c for c in programme.cases if c.name in wanted])
 
 
 _CASE_KEYS = {
@@ -381,14 +391,20 @@ def programme_from_document(doc, base=".") -> WSPProgramme:
 def load_wsp_programme(path="default") -> WSPProgramme:
     """Read and check a programme file (``"default"``: the shipped 31-case programme).
     Errors are :class:`~railadhesion.braking.BrakingFileError` naming the file and field."""
+    return read_programme_file(path, "wsp_programme_default.toml", _programme_from_document)
+
+
+def read_programme_file(path, default: str, build):
+    """Read a programme file: ``path``, or the package's data file ``default`` for
+    ``"default"``; ``build(document, folder of the file)`` makes the programme, whose
+    ``source`` is set to the file's label. Its errors (a field's, or ``ValueError``) become a
+    :class:`~railadhesion.braking.BrakingFileError` naming the file."""
     if os.fspath(path) == "default":
-        path = _DATA / "wsp_programme_default.toml"
+        path = _DATA / default
     doc, label = read_toml(path)
     try:
-        prog = _programme_from_document(doc, Path(os.fspath(path)).resolve().parent)
-    except FieldError as exc:
-        raise BrakingFileError(f"{label}: {exc}") from None
-    except ValueError as exc:
+        prog = build(doc, Path(os.fspath(path)).resolve().parent)
+    except (FieldError, ValueError) as exc:
         raise BrakingFileError(f"{label}: {exc}") from None
     prog.source = label
     return prog
@@ -465,6 +481,15 @@ class _PythonController:
     def diagnostics(self):
         d = getattr(self.obj, "diagnostics", None)
         return d() if callable(d) else {}
+
+
+def release_fmu(fmu) -> None:
+    """Terminate and free an FMPy FMU instance; an FMU already broken is let go silently."""
+    try:
+        fmu.terminate()
+        fmu.freeInstance()
+    except Exception:  # pragma: no cover - the FMU is already broken
+        pass
 
 
 def read_cosim_fmu(path, period: float | None = None, what: str = "FMU"):
@@ -604,11 +629,7 @@ class FmuController:
 
     def close(self):
         if self.fmu is not None:
-            try:
-                self.fmu.terminate()
-                self.fmu.freeInstance()
-            except Exception:  # pragma: no cover - the FMU is already broken
-                pass
+            release_fmu(self.fmu)
             self.fmu = None
             import shutil
 

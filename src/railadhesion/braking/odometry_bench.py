@@ -28,7 +28,7 @@ import copy
 import math
 import os
 import time as _time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -40,7 +40,6 @@ from railadhesion.braking._fields import (
     integer,
     keys,
     number,
-    read_toml,
     string,
     table,
 )
@@ -50,7 +49,10 @@ from railadhesion.braking.bench import (
     load_controller,
     programme_from_document,
     read_cosim_fmu,
+    read_programme_file,
+    release_fmu,
     save_figure,
+    select_cases,
     write_json,
 )
 from railadhesion.braking.odometry import STATUS_BITS, ReferenceOdometry
@@ -90,7 +92,6 @@ STANDARD_FITS = {"wheels": (False, False), "radar": (True, False),
                  "accelerometer": (False, True), "radar+accelerometer": (True, True)}
 #: An odometry axle counts as sliding (spinning) while its creepage is above (below minus) this.
 SLIDE_CREEP = 0.02
-_DATA = Path(__file__).resolve().parent.parent / "data"
 
 
 class OdometryInterfaceError(ValueError):
@@ -195,13 +196,8 @@ class OdometryProgramme:
     source: str = ""
 
     def select(self, names) -> OdometryProgramme:
-        wanted = list(names)
-        known = {c.name for c in self.cases}
-        missing = [n for n in wanted if n not in known]
-        if missing:
-            raise ValueError(f"unknown case(s) {missing}; the programme has "
-                             f"{', '.join(c.name for c in self.cases)}")
-        return replace(self, cases=[c for c in self.cases if c.name in wanted])
+        """The programme with the named cases only (in the programme's order)."""
+        return select_cases(self, names)
 
 
 def _sensor_values(tab, where, base) -> dict:
@@ -412,17 +408,7 @@ def _programme_from_document(doc, base: Path) -> OdometryProgramme:
 def load_odometry_programme(path="default") -> OdometryProgramme:
     """Read and check an odometry programme (``"default"``: the shipped one). Errors are
     :class:`~railadhesion.braking.BrakingFileError` naming the file and the field."""
-    if os.fspath(path) == "default":
-        path = _DATA / "odometry_programme_default.toml"
-    doc, label = read_toml(path)
-    try:
-        prog = _programme_from_document(doc, Path(os.fspath(path)).resolve().parent)
-    except FieldError as exc:
-        raise BrakingFileError(f"{label}: {exc}") from None
-    except ValueError as exc:
-        raise BrakingFileError(f"{label}: {exc}") from None
-    prog.source = label
-    return prog
+    return read_programme_file(path, "odometry_programme_default.toml", _programme_from_document)
 
 
 # -- odometries ------------------------------------------------------------------------------
@@ -665,11 +651,7 @@ class _FmuSession:
         return check_output(values, t, self.label)
 
     def close(self):
-        try:
-            self.fmu.terminate()
-            self.fmu.freeInstance()
-        except Exception:  # pragma: no cover - the FMU is already broken
-            pass
+        release_fmu(self.fmu)
 
 
 def load_odometry(spec=None, *, period: float | None = None):

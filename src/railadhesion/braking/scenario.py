@@ -209,7 +209,7 @@ def _identified_law(tab: Mapping, base: Path, wheel_radius: float):
     (:func:`railadhesion.identification.load_adhesion_law`, the ``adhesion_law.toml`` that
     ``railadhesion identify`` writes), the same on every axle and all along the track; the dry
     reference is a named Polach set (``dry_parameters``, default ``polach2005_dry``)."""
-    from railadhesion.identification.curves import load_adhesion_law
+    from railadhesion.braking.adhesion_law import load_adhesion_law
 
     for k in ("parameters", "water_flow_ul_s", "sections", "table", "recovery_energy_J_per_m",
               "over"):

@@ -169,9 +169,9 @@ def build_native_braking_fmu(out, scenario) -> Path:
 
 
 def _generic_cpu() -> bool:
-    from numba.core import config
+    import numba
 
-    return config.CPU_NAME == "generic"
+    return numba.config.CPU_NAME == "generic"  # numba's public settings (NUMBA_CPU_NAME)
 
 
 def _build_in_generic_process(out, path: Path) -> Path:

@@ -433,36 +433,28 @@ def _log_from_columns(
     # -- stuck channels
     min_w = max(int(round(stuck_time / med)), 3)
     min_p = max(int(round(stuck_pressure_time / med)), 3)
+    def stuck(i, column, flagged, why):  # the flagged runs of axle i: invalid, one issue
+        if flagged:
+            r = np.concatenate(flagged)
+            valid[r, i] = False
+            issues.append(LogIssue("stuck-channel", column, src_rows[r],
+                                   f"{why}: samples invalid for axle {i + 1}"))
+
     for i in range(n_ax):
         if channels[f"wheel_speed_{i + 1}"] is not None:
-            flagged = []
-            for a, b in _constant_runs(wheel[:, i], min_w):
-                if wheel[a, i] > 0 and np.ptp(v[a:b]) > 1.0:
-                    flagged.append(np.arange(a, b))
-            if flagged:
-                r = np.concatenate(flagged)
-                valid[r, i] = False
-                issues.append(LogIssue(
-                    "stuck-channel", f"wheel_speed_{i + 1}", src_rows[r],
-                    f"constant for >= {stuck_time:g} s while the train speed changed by > 1 m/s: "
-                    f"samples invalid for axle {i + 1}",
-                ))
+            flagged = [np.arange(a, b) for a, b in _constant_runs(wheel[:, i], min_w)
+                       if wheel[a, i] > 0 and np.ptp(v[a:b]) > 1.0]
+            stuck(i, f"wheel_speed_{i + 1}", flagged, f"constant for >= {stuck_time:g} s "
+                  "while the train speed changed by > 1 m/s")
         if channels[f"brake_pressure_{i + 1}"] is not None and n_ax > 1:
             runs = _constant_runs(press[:, i], min_p)
             flagged = []
             if runs.size:  # the other axles' mean pressure, over the constant runs only
                 others = [j for j in range(n_ax) if j != i]
-                for a, b in runs:
-                    if np.ptp(press[a:b, others].mean(axis=1)) > 0.5 * BAR:
-                        flagged.append(np.arange(a, b))
-            if flagged:
-                r = np.concatenate(flagged)
-                valid[r, i] = False
-                issues.append(LogIssue(
-                    "stuck-channel", f"brake_pressure_{i + 1}", src_rows[r],
-                    f"constant for >= {stuck_pressure_time:g} s while the other pressures "
-                    f"changed by > 0.5 bar: samples invalid for axle {i + 1}",
-                ))
+                flagged = [np.arange(a, b) for a, b in runs
+                           if np.ptp(press[a:b, others].mean(axis=1)) > 0.5 * BAR]
+            stuck(i, f"brake_pressure_{i + 1}", flagged, f"constant for >= "
+                  f"{stuck_pressure_time:g} s while the other pressures changed by > 0.5 bar")
     # -- units (each finding a UnitWarning naming the column; values left as they are)
     found = (
         check_plausible(np.array([press.min(), press.max()]) / BAR, "brake_pressure",

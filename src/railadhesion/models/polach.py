@@ -269,25 +269,16 @@ def polach_checked(creep_x, creep_y, spin, normal_force, speed, a, b, G, nu, c11
     return fx, fy, -1
 
 
-@kernel
+# compiled for float64 arguments only: other numbers (ints, NumPy scalars) are converted by
+# numba's dispatcher instead of compiling new versions
+@kernel(signature="UniTuple(float64, 2)(float64, float64, float64, float64, float64, "
+        "float64[::1])")  # fmt: skip
 def _contact_forces(creep_x, creep_y, spin, normal_force, speed, data):
     """:func:`polach_law` with one contact's fixed data ``data`` = (a, b, G, nu, c11, c22, c23,
     k_A, k_S, mu0, A, B) (:class:`PolachContact`)."""
     return polach_law(creep_x, creep_y, spin, normal_force, speed, data[0], data[1], data[2],
                       data[3], data[4], data[5], data[6], data[7], data[8], data[9], data[10],
                       data[11])  # fmt: skip
-
-
-def _contact_kernel():
-    """The dispatcher of :func:`_contact_forces`, compiled for float64 arguments only: other
-    numbers (ints, NumPy scalars) are converted by numba's dispatcher instead of compiling
-    new versions."""
-    dispatcher = _contact_forces.dispatcher
-    if not dispatcher.signatures:
-        dispatcher.compile("UniTuple(float64, 2)(float64, float64, float64, float64, float64, "
-                           "float64[::1])")  # fmt: skip
-        dispatcher.disable_compile()
-    return dispatcher
 
 
 # Rows of the chunk buffer of the batch loops of Polach and WILAC (rows of CHUNK values): the
@@ -770,7 +761,7 @@ class PolachContact:
         self.mu0, self.k_A, self.k_S, self.A, self.B = mu0, k_a, k_s, big_a, big_b
         self.shear_modulus, self.poisson = g, nu
         self.c11, self.c22, self.c23 = kalker_scalar(a / b, nu)[:3]
-        object.__setattr__(self, "_kernel", _contact_kernel())
+        object.__setattr__(self, "_kernel", _contact_forces.dispatcher)
         self._refresh()
 
     def _refresh(self) -> None:

@@ -518,7 +518,7 @@ def default_wilac_parameters() -> WilacParameters:
     """
     from importlib import resources
 
-    from railadhesion.io.paramfiles import load_wilac_parameters
+    from railadhesion.models.paramfiles import load_wilac_parameters
 
     resource = resources.files("railadhesion").joinpath("data", DEFAULT_PARAMETER_FILE)
     if not resource.is_file():

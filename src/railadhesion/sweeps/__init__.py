@@ -17,6 +17,7 @@ from railadhesion.sweeps.derived import adhesion_at_creep, max_adhesion, min_adh
 from railadhesion.sweeps.models import (
     DIMENSIONS,
     SWEEP_MODELS,
+    ContactSweep,
     FunctionSweep,
     PolachSweep,
     SweepModel,
@@ -44,6 +45,7 @@ __all__ = [
     "BrakingStudy",
     "DIMENSIONS",
     "SWEEP_MODELS",
+    "ContactSweep",
     "FunctionSweep",
     "PolachSweep",
     "SweepModel",

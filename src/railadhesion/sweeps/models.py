@@ -26,6 +26,7 @@ __all__ = [
     "DIMENSIONS",
     "LABEL_DIMENSIONS",
     "SweepModel",
+    "ContactSweep",
     "WilacSweep",
     "PolachSweep",
     "TwoDSweep",
@@ -98,14 +99,58 @@ class SweepModel:
         raise NotImplementedError  # pragma: no cover
 
 
-def _labelled(cache: dict, key, make):
-    if key not in cache:
-        cache[key] = make()
-    return cache[key]
+def _from_file(cache: dict, label: str, loader):
+    """The parameter set of the file ``label`` read by ``loader`` (once: kept in ``cache``);
+    a file that cannot be read is a ``ValueError`` naming the label."""
+    if label not in cache:
+        try:
+            cache[label] = loader(label)
+        except OSError as exc:
+            raise ValueError(f"parameter_set: cannot read {label}: {exc}") from exc
+    return cache[label]
 
 
 @dataclass(frozen=True)
-class WilacSweep(SweepModel):
+class ContactSweep(SweepModel):
+    """Base of the 3D contact models with a parameter set (:class:`WilacSweep`,
+    :class:`PolachSweep`): a Hertz geometry, elastic constants, a ``parameter_set`` label.
+    Subclasses give :meth:`resolve` and :meth:`forces` (and their extra numeric inputs)."""
+
+    parameters: object = None
+    geometry: object = "tram"
+    shear_modulus: float = 8.2e10
+    poisson: float = 0.28
+    extra_inputs = {}
+
+    def __post_init__(self):
+        object.__setattr__(self, "geometry", check_geometry(self.geometry))
+        object.__setattr__(
+            self, "inputs",
+            {"creep_long": None, "creep_lat": 0.0, "spin": 0.0, "normal_force": None,
+             "speed": None, **self.extra_inputs},
+        )  # fmt: skip
+        label = self.parameters if isinstance(self.parameters, str) else "<given>"
+        object.__setattr__(self, "labels", {"parameter_set": label})
+        self.resolve("parameter_set", label)
+
+    @cached_property
+    def _cache(self) -> dict:
+        return {}
+
+    def forces(self, values: dict, a, b, params):  # pragma: no cover - overridden
+        """``(fx, fy)`` of the model at ``values`` with semi-axes ``a``, ``b`` and the set."""
+        raise NotImplementedError
+
+    def evaluate(self, values, labels):
+        params = self.resolve("parameter_set", labels["parameter_set"])
+        q = values["normal_force"]
+        a, b = contact_semi_axes(self.geometry, q)
+        fx, fy = self.forces(values, a, b, params)
+        return fx, fy, np.hypot(fx, fy) / q
+
+
+@dataclass(frozen=True)
+class WilacSweep(ContactSweep):
     """WILAC (:func:`railadhesion.models.wilac.wilac_forces`, Trummer et al. 2017 §5) on a grid.
 
     Parameters
@@ -125,24 +170,8 @@ class WilacSweep(SweepModel):
 
     parameters: object = "default"
     geometry: object = "tram"
-    shear_modulus: float = 8.2e10
-    poisson: float = 0.28
     name = "wilac"
-
-    def __post_init__(self):
-        object.__setattr__(self, "geometry", check_geometry(self.geometry))
-        object.__setattr__(
-            self, "inputs",
-            {"creep_long": None, "creep_lat": 0.0, "spin": 0.0, "normal_force": None,
-             "speed": None, "water_flow": None},
-        )  # fmt: skip
-        label = self.parameters if isinstance(self.parameters, str) else "<given>"
-        object.__setattr__(self, "labels", {"parameter_set": label})
-        self.resolve("parameter_set", label)
-
-    @cached_property
-    def _cache(self) -> dict:
-        return {}
+    extra_inputs = {"water_flow": None}
 
     def resolve(self, dim, label):
         from railadhesion.models.wilac import WilacParameters, default_wilac_parameters
@@ -153,29 +182,18 @@ class WilacSweep(SweepModel):
             return self.parameters
         if label == "default":
             return default_wilac_parameters()
+        from railadhesion.io.paramfiles import load_wilac_parameters
 
-        def load():
-            from railadhesion.io.paramfiles import load_wilac_parameters
+        return _from_file(self._cache, label, load_wilac_parameters)
 
-            try:
-                return load_wilac_parameters(label)
-            except OSError as exc:
-                raise ValueError(f"parameter_set: cannot read {label}: {exc}") from exc
-
-        return _labelled(self._cache, label, load)
-
-    def evaluate(self, values, labels):
+    def forces(self, values, a, b, params):
         from railadhesion.models.wilac import wilac_forces
 
-        params = self.resolve("parameter_set", labels["parameter_set"])
-        q = values["normal_force"]
-        a, b = contact_semi_axes(self.geometry, q)
-        fx, fy = wilac_forces(
-            values["creep_long"], values["creep_lat"], values["spin"], q, values["speed"],
-            a, b, values["water_flow"], params,
+        return wilac_forces(
+            values["creep_long"], values["creep_lat"], values["spin"], values["normal_force"],
+            values["speed"], a, b, values["water_flow"], params,
             shear_modulus=self.shear_modulus, poisson=self.poisson,
         )  # fmt: skip
-        return fx, fy, np.hypot(fx, fy) / q
 
     def describe(self):
         from railadhesion.io.paramfiles import wilac_parameters_to_toml
@@ -190,7 +208,7 @@ class WilacSweep(SweepModel):
 
 
 @dataclass(frozen=True)
-class PolachSweep(SweepModel):
+class PolachSweep(ContactSweep):
     """Polach (:func:`railadhesion.models.polach.polach_forces`, Polach 2005) on a grid.
 
     Parameters
@@ -208,24 +226,7 @@ class PolachSweep(SweepModel):
 
     parameters: object = "polach2005_dry"
     geometry: object = "locomotive"
-    shear_modulus: float = 8.2e10
-    poisson: float = 0.28
     name = "polach"
-
-    def __post_init__(self):
-        object.__setattr__(self, "geometry", check_geometry(self.geometry))
-        object.__setattr__(
-            self, "inputs",
-            {"creep_long": None, "creep_lat": 0.0, "spin": 0.0, "normal_force": None,
-             "speed": None},
-        )  # fmt: skip
-        label = self.parameters if isinstance(self.parameters, str) else "<given>"
-        object.__setattr__(self, "labels", {"parameter_set": label})
-        self.resolve("parameter_set", label)
-
-    @cached_property
-    def _cache(self) -> dict:
-        return {}
 
     def resolve(self, dim, label):
         from railadhesion.models.parameters import (
@@ -242,28 +243,18 @@ class PolachSweep(SweepModel):
             return polach_parameters(label)
         if not (label.endswith(".toml") or Path(label).exists()):
             polach_parameters(label)  # raises, listing the named sets
+        from railadhesion.io.paramfiles import load_polach_parameters
 
-        def load():
-            from railadhesion.io.paramfiles import load_polach_parameters
+        return _from_file(self._cache, label, load_polach_parameters)
 
-            try:
-                return load_polach_parameters(label)
-            except OSError as exc:
-                raise ValueError(f"parameter_set: cannot read {label}: {exc}") from exc
-
-        return _labelled(self._cache, label, load)
-
-    def evaluate(self, values, labels):
+    def forces(self, values, a, b, params):
         from railadhesion.models.polach import polach_forces
 
-        p = self.resolve("parameter_set", labels["parameter_set"])
-        q = values["normal_force"]
-        a, b = contact_semi_axes(self.geometry, q)
-        fx, fy = polach_forces(
-            values["creep_long"], values["creep_lat"], values["spin"], q, values["speed"],
-            a, b, **p.as_dict(), shear_modulus=self.shear_modulus, poisson=self.poisson,
+        return polach_forces(
+            values["creep_long"], values["creep_lat"], values["spin"], values["normal_force"],
+            values["speed"], a, b, **params.as_dict(), shear_modulus=self.shear_modulus,
+            poisson=self.poisson,
         )  # fmt: skip
-        return fx, fy, np.hypot(fx, fy) / q
 
     def describe(self):
         label = self.labels["parameter_set"]
