@@ -12,7 +12,13 @@ Cases:
 * creep: 0.1 %, 0.2 % and 1 % creep at 30, 40 and 55 m/s, 2 seeds;
 * steady: no modulation, 0.5 % creep, at 30, 40 and 55 m/s, 2 seeds;
 * dry: 100 km of dry rail (runs from 30-55 m/s, random light braking and modulation);
-* traction: only if the simulator has ``inputs.torque`` (it has not yet).
+* traction: the simulator's per-axle ``inputs.torque`` (see the traction-only list below).
+  to the monitor with 50 N m noise): every condition x 30-55 m/s x ``--seeds`` seeds at 0.5 %
+  creep; 0.2 % and 1 % creep at 30, 40 and 55 m/s, 2 seeds; 100 km of dry rail under
+  traction (runs from 30-40 m/s, random light traction and modulation).
+
+``--only traction`` runs the traction cases alone (results in ``traction.json``; the braking
+figures are left as they are).
 
 Writes ``results.json`` into ``--out`` (not under version control) and the figures
 ``docs/figures/monitor_track_low.png``, ``monitor_track_damp.png``, ``monitor_delays.png``;
@@ -173,7 +179,8 @@ def _track_figure(res, path, title):
     plt.close(fig)
 
 
-def _delay_figure(groups, path):
+def _delay_figure(groups, path,
+                  title="low after entry, 0.5 % creep, 30-55 m/s (per axle)"):
     import matplotlib
 
     matplotlib.use("Agg")
@@ -184,7 +191,7 @@ def _delay_figure(groups, path):
     series = {f"{c} (truth {g['truth_mean']:.3f})": np.array(
         [np.nan if d is None else d for d in g["delays"]]) for c, g in groups.items()
         if g["expected"] == "low"}
-    fig = plot_delays(series, title="low after entry, 0.5 % creep, 30-55 m/s (per axle)")
+    fig = plot_delays(series, title=title)
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
@@ -220,6 +227,7 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=ROOT / "out" / "monitor-eval")
     ap.add_argument("--quick", action="store_true", help="a few cases only (a check)")
     ap.add_argument("--dry-km", type=float, default=100.0)
+    ap.add_argument("--only", choices=("all", "traction"), default="all")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     FIGURES.mkdir(parents=True, exist_ok=True)
@@ -237,6 +245,9 @@ def main() -> None:
         if done[0] % 20 == 0:
             print(f"  {done[0]} cases, {time.time() - t0:.0f} s", flush=True)
 
+    if args.only == "traction":
+        _traction(args, conditions, speeds, seeds, few, progress, t0)
+        return
     print(f"load average {os.getloadavg()[0]:.2f}; main cases", flush=True)
     main_groups = _run_group(conditions, speeds, 0.005, 0.25, seeds, progress)
     creep_groups = {}
@@ -247,11 +258,7 @@ def main() -> None:
     steady = _run_group(conditions, few, 0.005, 0.0, range(2), progress)
     print(f"dry rail, {args.dry_km:g} km", flush=True)
     dry = run_dry_distance(args.dry_km * 1e3, seed=11)
-    traction_groups = {}
-    for creep in (0.002, 0.005, 0.01):
-        print(f"traction only, {creep:.1%} creep", flush=True)
-        traction_groups[creep] = _run_group(conditions, few, creep, 0.25, range(1), progress,
-                                            runner=run_traction_case)
+    traction = _traction_groups(args, conditions, speeds, seeds, few, progress)
     # figures
     low_res = next(r for r in main_groups["polach_wet_0.08"][1] if r.case.speed == 40.0)
     _track_figure(low_res, FIGURES / "monitor_track_low.png",
@@ -267,8 +274,7 @@ def main() -> None:
         "creep": {f"{k:.3f}": {c: g for c, (g, _) in v.items()} for k, v in creep_groups.items()},
         "steady_0.5pct": {c: g for c, (g, _) in steady.items()},
         "dry": dry,
-        "traction": {f"{k:.3f}": {c: g for c, (g, _) in v.items()}
-                     for k, v in traction_groups.items()},
+        "traction": traction,
         "wall_s": time.time() - t0,
         "load_average_end": os.getloadavg()[0],
     }
@@ -279,10 +285,44 @@ def main() -> None:
     print(_table({c: g for c, (g, _) in steady.items()}, "steady demand, 0.5 % creep"))
     dry = {k: v for k, v in dry.items() if k != "low_examples"}
     print("\ndry rail:", json.dumps(dry))
-    for k, v in traction_groups.items():
-        print(_table({c: g for c, (g, _) in v.items()},
-                     f"traction only, {k:.1%} creep, {'/'.join(f'{x:g}' for x in few)} m/s"))
+    _print_traction(traction)
     print(f"\n{time.time() - t0:.0f} s; results in {args.out / 'results.json'}")
+
+
+def _traction_groups(args, conditions, speeds, seeds, few, progress):
+    """The traction-only cases (issue 21): summaries by creep, and the dry distance."""
+    out = {}
+    for creep, spd, sds in ((0.005, speeds, seeds), (0.002, few, range(2)),
+                            (0.01, few, range(2))):
+        print(f"traction only, {creep:.1%} creep", flush=True)
+        groups = _run_group(conditions, spd, creep, 0.25, sds, progress,
+                            runner=run_traction_case)
+        out[f"{creep:.3f}"] = {c: g for c, (g, _) in groups.items()}
+    print(f"traction only, dry rail, {args.dry_km:g} km", flush=True)
+    out["dry"] = run_dry_distance(args.dry_km * 1e3, seed=13, traction=True)
+    return out
+
+
+def _print_traction(traction):
+    for k, v in traction.items():
+        if k == "dry":
+            dry = {key: val for key, val in v.items() if key != "low_examples"}
+            print("\ntraction only, dry rail:", json.dumps(dry))
+        else:
+            print(_table(v, f"traction only, {float(k):.1%} creep"))
+
+
+def _traction(args, conditions, speeds, seeds, few, progress, t0):
+    traction = _traction_groups(args, conditions, speeds, seeds, few, progress)
+    _delay_figure({c: g for c, g in traction["0.005"].items()},
+                  FIGURES / "monitor_delays_traction.png",
+                  "low after entry, traction only, 0.5 % creep, 30-55 m/s (per axle)")
+    traction["wall_s"] = time.time() - t0
+    traction["load_average_end"] = os.getloadavg()[0]
+    (args.out / "traction.json").write_text(json.dumps(traction, indent=1), encoding="utf-8")
+    _print_traction({k: v for k, v in traction.items() if k not in ("wall_s",
+                                                                     "load_average_end")})
+    print(f"\n{time.time() - t0:.0f} s; results in {args.out / 'traction.json'}")
 
 
 if __name__ == "__main__":

@@ -321,6 +321,9 @@ def summarise_case(res: CaseResult, settings: MonitorSettings) -> dict:
     n = res.entry_time.size
     delays = res.detect_time - res.entry_time
     speed_at = np.interp(res.entry_time, t, h["speed"]) if t.size else np.full(n, np.nan)
+    # distance run between each axle's entry and its first low
+    travelled = (np.interp(res.detect_time, t, h["distance"])
+                 - np.interp(res.entry_time, t, h["distance"])) if t.size else np.full(n, np.nan)
     errors = []
     section_creep = []
     for i in range(n):
@@ -349,6 +352,7 @@ def summarise_case(res: CaseResult, settings: MonitorSettings) -> dict:
         "delays_s": [float(x) if math.isfinite(x) else None for x in delays],
         "distance_first_axle_m": float(delays[0] * speed_at[0]) if math.isfinite(delays[0])
         else None,
+        "distances_m": [float(x) if math.isfinite(x) else None for x in travelled],
         "error_abs_max": float(np.max(np.abs(errors))) if errors.size else None,
         "error_abs_p95": float(np.percentile(np.abs(errors), 95)) if errors.size else None,
         "error_median": float(np.median(errors)) if errors.size else None,
