@@ -12,7 +12,7 @@ Cases:
 * creep: 0.1 %, 0.2 % and 1 % creep at 30, 40 and 55 m/s, 2 seeds;
 * steady: no modulation, 0.5 % creep, at 30, 40 and 55 m/s, 2 seeds;
 * dry: 100 km of dry rail (runs from 30-55 m/s, random light braking and modulation);
-* traction: the simulator's per-axle ``inputs.torque`` (see the traction-only list below).
+* traction only (no brake; the torque written into the simulator's ``inputs.torque`` and fed
   to the monitor with 50 N m noise): every condition x 30-55 m/s x ``--seeds`` seeds at 0.5 %
   creep; 0.2 % and 1 % creep at 30, 40 and 55 m/s, 2 seeds; 100 km of dry rail under
   traction (runs from 30-40 m/s, random light traction and modulation).
@@ -61,6 +61,7 @@ def _pct(x, q):
 def _summarise(results):
     """Aggregate the cases of one (condition, creep, modulation) group."""
     delays = []
+    distances = []
     firsts = []
     errors = []
     inside = []
@@ -79,6 +80,7 @@ def _summarise(results):
         creeps.append(s["section_creep_median"])
         d = np.array([np.nan if x is None else x for x in s["delays_s"]], float)
         delays += d.tolist()
+        distances += [np.nan if x is None else x for x in s["distances_m"]]
         firsts.append(np.nan if s["delay_first_axle_s"] is None else s["delay_first_axle_s"])
         found_all += int(np.all(np.isfinite(d) & (d <= 2.0)))
         false_before += int(s["false_low_before_section"])
@@ -126,6 +128,9 @@ def _summarise(results):
         "delay_median_s": _pct(delays, 50),
         "delay_p95_s": _pct(delays, 95),
         "delay_max_s": _pct(delays, 100),
+        "distance_median_m": _pct(distances, 50),
+        "distance_p95_m": _pct(distances, 95),
+        "distance_max_m": _pct(distances, 100),
         "first_axle_delay_median_s": _pct(firsts, 50),
         "error_abs_median": _pct(errors, 50),
         "error_abs_p95": _pct(errors, 95),
@@ -198,11 +203,11 @@ def _delay_figure(groups, path,
 
 def _table(groups, title):
     lines = [f"\n{title}", "| section | truth | creep | low within 2 s (axles) | all 4 axles "
-             "within 2 s (cases) | delay median / p95 [s] | abs. error on the section, median "
-             "/ p95 / max | "
+             "within 2 s (cases) | delay median / p95 / max [s] | distance median / p95 / "
+             "max [m] | abs. error on the section, median / p95 / max | "
              "band holds truth | level at the section's end | low where truth is not low | "
              "low lingers after the exit, median / max [s] |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for cond, g in groups.items():
         def f(x, fmt="{:.3f}"):
             return "–" if x is None else fmt.format(x)
@@ -212,7 +217,10 @@ def _table(groups, title):
             f"{f(g['section_creep_median'], '{:.2%}')} | "
             f"{f(g['axles_low_within_2s'], '{:.0%}')} | "
             f"{g['cases_all_axles_within_2s']:.0%} | "
-            f"{f(g['delay_median_s'], '{:.2f}')} / {f(g['delay_p95_s'], '{:.2f}')} | "
+            f"{f(g['delay_median_s'], '{:.2f}')} / {f(g['delay_p95_s'], '{:.2f}')} / "
+            f"{f(g['delay_max_s'], '{:.2f}')} | "
+            f"{f(g['distance_median_m'], '{:.0f}')} / {f(g['distance_p95_m'], '{:.0f}')} / "
+            f"{f(g['distance_max_m'], '{:.0f}')} | "
             f"{f(g['error_abs_median'])} / {f(g['error_abs_p95'])} / {f(g['error_abs_max'])} | "
             f"{f(g['band_holds_truth'], '{:.0%}')} | {end} | "
             f"{g['cases_low_where_truth_not_low']} of {g['cases']} | "
@@ -269,6 +277,8 @@ def main() -> None:
                       "WILAC, 25 ul/s (damp), 40 m/s, 0.5 % creep")
     summaries = {c: g for c, (g, _) in main_groups.items()}
     _delay_figure(summaries, FIGURES / "monitor_delays.png")
+    _delay_figure(traction["0.005"], FIGURES / "monitor_delays_traction.png",
+                  "low after entry, traction only, 0.5 % creep, 30-55 m/s (per axle)")
     results = {
         "main_0.5pct_modulated": summaries,
         "creep": {f"{k:.3f}": {c: g for c, (g, _) in v.items()} for k, v in creep_groups.items()},
