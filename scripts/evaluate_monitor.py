@@ -46,7 +46,7 @@ from railadhesion.monitor.evaluation import (
     run_dry_distance,
     run_traction_case,
 )
-from railadhesion.monitor.layout import LEVELS, LOW
+from railadhesion.monitor.layout import LEVELS, LOW, NORMAL
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURES = ROOT / "docs" / "figures"
@@ -70,6 +70,7 @@ def _summarise(results):
     false_section = 0
     false_after = 0
     lingers = []
+    normal_low = [0, 0]  # samples 'normal' on a section whose truth is low, samples there
     found_all = 0
     truth = []
     creeps = []
@@ -93,6 +94,9 @@ def _summarise(results):
             # whether the band holds the truth
             on = (h["time"] >= res.entry_time[i]) & (h["time"] <= res.exit_time[i])
             low = on & (h["level"][:, i] == LOW)
+            if res.expected == "low":
+                normal_low[0] += int(np.sum(on & (h["level"][:, i] == NORMAL)))
+                normal_low[1] += int(np.sum(on))
             if low.any():
                 e = (h["estimate"][:, i] - h["truth"][:, i])[low]
                 errors += np.abs(e[np.isfinite(e)]).tolist()
@@ -143,6 +147,7 @@ def _summarise(results):
         "low_lingers_after_exit_max_s": _pct(lingers, 100),
         "axles_low_more_than_1s_after_exit": false_after,
         "cases_low_where_truth_not_low": false_section,
+        "normal_share_on_low_section": normal_low[0] / normal_low[1] if normal_low[1] else None,
         "delays": [None if not math.isfinite(x) else float(x) for x in delays],
     }
 
@@ -206,8 +211,8 @@ def _table(groups, title):
              "within 2 s (cases) | delay median / p95 / max [s] | distance median / p95 / "
              "max [m] | abs. error on the section, median / p95 / max | "
              "band holds truth | level at the section's end | low where truth is not low | "
-             "low lingers after the exit, median / max [s] |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "low lingers after the exit, median / max [s] | normal on a low section |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for cond, g in groups.items():
         def f(x, fmt="{:.3f}"):
             return "–" if x is None else fmt.format(x)
@@ -225,7 +230,8 @@ def _table(groups, title):
             f"{f(g['band_holds_truth'], '{:.0%}')} | {end} | "
             f"{g['cases_low_where_truth_not_low']} of {g['cases']} | "
             f"{f(g['low_lingers_after_exit_median_s'], '{:.2f}')} / "
-            f"{f(g['low_lingers_after_exit_max_s'], '{:.2f}')} |")
+            f"{f(g['low_lingers_after_exit_max_s'], '{:.2f}')} | "
+            f"{f(g['normal_share_on_low_section'], '{:.2%}')} |")
     return "\n".join(lines)
 
 
