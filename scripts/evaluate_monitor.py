@@ -14,7 +14,7 @@ Cases:
 * dry: 100 km of dry rail (runs from 30-55 m/s, random light braking and modulation);
 * traction only (no brake; the torque written into the simulator's ``inputs.torque`` and fed
   to the monitor with 50 N m noise): every condition x 30-55 m/s x ``--seeds`` seeds at 0.5 %
-  creep; 0.2 % and 1 % creep at 30, 40 and 55 m/s, 2 seeds; 100 km of dry rail under
+  creep; 0.1 %, 0.2 % and 1 % creep at 30, 40 and 55 m/s, 2 seeds; 100 km of dry rail under
   traction (runs from 30-40 m/s, random light traction and modulation).
 
 ``--only traction`` runs the traction cases alone (results in ``traction.json``; the braking
@@ -308,8 +308,8 @@ def main() -> None:
 def _traction_groups(args, conditions, speeds, seeds, few, progress):
     """The traction-only cases (issue 21): summaries by creep, and the dry distance."""
     out = {}
-    for creep, spd, sds in ((0.005, speeds, seeds), (0.002, few, range(2)),
-                            (0.01, few, range(2))):
+    for creep, spd, sds in ((0.005, speeds, seeds), (0.001, few, range(2)),
+                            (0.002, few, range(2)), (0.01, few, range(2))):
         print(f"traction only, {creep:.1%} creep", flush=True)
         groups = _run_group(conditions, spd, creep, 0.25, sds, progress,
                             runner=run_traction_case)
