@@ -234,6 +234,31 @@ def test_bad_input_unknown_with_reason_then_recovery(low_run, low_levels, name):
     assert (low_levels["level"][k] == LOW).all()
 
 
+@pytest.fixture(scope="module")
+def traction_run():
+    sig = ms.make_signals(ms.braking_profile(level=0.045), duration=12.0, shape="polach",
+                          slope=40.0, mu=0.07, traction=True, seed=7)
+    return sig, ms.feed(AdhesionMonitor("coach_default", pressure=False, torque=True), sig)
+
+
+@pytest.mark.parametrize(("name", "value", "reason"),
+                         [("torque NaN", np.nan, 24), ("torque implausible", 5e6, 31),
+                          ("torque -inf", -np.inf, 31)])
+def test_bad_torque_unknown_with_reason_then_recovery(traction_run, name, value, reason):
+    """Traction only: a bad torque sample on axle 3 makes that axle unknown, with the reason,
+    for the recovery time; the clean run's low comes back."""
+    sig, clean = traction_run
+    k0 = _at(clean, 6.0)
+    assert (clean["level"][k0:] == LOW).all()
+    bad = _corrupt(sig, lambda s: s["torque"].__setitem__((slice(k0, k0 + 3), 2), value))
+    mon, res = _run(bad, pressure=False, torque=True)
+    assert np.isfinite(mon.bank).all()
+    assert res["level"][k0, 2] == UNKNOWN and res["reason"][k0, 2] == reason, name
+    assert (res["level"][k0 + 3:k0 + int(0.5 / 2.4e-3), 2] == UNKNOWN).all()
+    assert (res["level"][k0, [0, 1, 3]] == LOW).all()  # the other axles keep their level
+    assert (res["level"][_at(res, 9.0):] == LOW).all()
+
+
 def test_stuck_wheel_speed(low_run):
     sig = _corrupt(low_run, lambda s: s["wheel_speed"].__setitem__(
         (slice(K0, K0 + 400), 1), s["wheel_speed"][K0, 1]))
