@@ -71,6 +71,7 @@ def _summarise(results):
     false_after = 0
     lingers = []
     normal_low = [0, 0]  # samples 'normal' on a section whose truth is low, samples there
+    normal_last = []  # the last 'normal' on such a section, from the axle's entry [s]
     found_all = 0
     truth = []
     creeps = []
@@ -95,8 +96,11 @@ def _summarise(results):
             on = (h["time"] >= res.entry_time[i]) & (h["time"] <= res.exit_time[i])
             low = on & (h["level"][:, i] == LOW)
             if res.expected == "low":
-                normal_low[0] += int(np.sum(on & (h["level"][:, i] == NORMAL)))
+                normal = on & (h["level"][:, i] == NORMAL)
+                normal_low[0] += int(np.sum(normal))
                 normal_low[1] += int(np.sum(on))
+                if normal.any():
+                    normal_last.append(float(h["time"][normal][-1] - res.entry_time[i]))
             if low.any():
                 e = (h["estimate"][:, i] - h["truth"][:, i])[low]
                 errors += np.abs(e[np.isfinite(e)]).tolist()
@@ -148,6 +152,7 @@ def _summarise(results):
         "axles_low_more_than_1s_after_exit": false_after,
         "cases_low_where_truth_not_low": false_section,
         "normal_share_on_low_section": normal_low[0] / normal_low[1] if normal_low[1] else None,
+        "normal_on_low_section_until_s": _pct(normal_last, 100),
         "delays": [None if not math.isfinite(x) else float(x) for x in delays],
     }
 
@@ -211,7 +216,8 @@ def _table(groups, title):
              "within 2 s (cases) | delay median / p95 / max [s] | distance median / p95 / "
              "max [m] | abs. error on the section, median / p95 / max | "
              "band holds truth | level at the section's end | low where truth is not low | "
-             "low lingers after the exit, median / max [s] | normal on a low section |",
+             "low lingers after the exit, median / max [s] | normal on a low section "
+             "(share; last after entry [s]) |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for cond, g in groups.items():
         def f(x, fmt="{:.3f}"):
@@ -231,7 +237,8 @@ def _table(groups, title):
             f"{g['cases_low_where_truth_not_low']} of {g['cases']} | "
             f"{f(g['low_lingers_after_exit_median_s'], '{:.2f}')} / "
             f"{f(g['low_lingers_after_exit_max_s'], '{:.2f}')} | "
-            f"{f(g['normal_share_on_low_section'], '{:.2%}')} |")
+            f"{f(g['normal_share_on_low_section'], '{:.2%}')}; "
+            f"{f(g['normal_on_low_section_until_s'], '{:.2f}')} |")
     return "\n".join(lines)
 
 
