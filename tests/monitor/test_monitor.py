@@ -259,6 +259,30 @@ def test_bad_torque_unknown_with_reason_then_recovery(traction_run, name, value,
     assert (res["level"][_at(res, 9.0):] == LOW).all()
 
 
+def test_stuck_torque_under_traction():
+    """A torque frozen for 7 s while the other axles' torques vary: after stuck_pressure_time
+    (5 s) that axle is unknown, 'torque stuck'; the others keep low; it recovers after."""
+    sig = ms.make_signals(ms.braking_profile(level=0.045), duration=18.0, shape="polach",
+                          slope=40.0, mu=0.07, traction=True, seed=8)
+    k0, k1 = _at(sig, 5.0), _at(sig, 12.0)
+    bad = _corrupt(sig, lambda s: s["torque"].__setitem__((slice(k0, k1), 1),
+                                                          s["torque"][k0, 1]))
+    _, res = _run(bad, pressure=False, torque=True)
+    window = res["reason"][k0:k1, 1]
+    assert 34 in window  # "torque stuck"
+    first = res["time"][k0 + int(np.argmax(window == 34))]
+    assert 10.0 <= first < 11.5  # a constant value is a valid number for 5 s
+    assert (res["level"][:_at(res, 9.9), 1] == LOW).any()
+    assert (res["level"][_at(res, first):k1, 1] == UNKNOWN).all()
+    assert (res["level"][_at(res, 10.5), [0, 2, 3]] == LOW).all()
+    assert (res["level"][_at(res, 15.0):, 1] == LOW).all()
+    assert layout.reason_label(34) == "torque stuck"
+    # an unpowered axle (torque exactly 0 throughout) beside driven ones is not stuck
+    idle = _corrupt(sig, lambda s: s["torque"].__setitem__((slice(None), 1), 0.0))
+    _, res = _run(idle, pressure=False, torque=True)
+    assert not (res["reason"][:, 1] == 34).any()
+
+
 def test_stuck_wheel_speed(low_run):
     sig = _corrupt(low_run, lambda s: s["wheel_speed"].__setitem__(
         (slice(K0, K0 + 400), 1), s["wheel_speed"][K0, 1]))
