@@ -259,6 +259,24 @@ def test_bad_torque_unknown_with_reason_then_recovery(traction_run, name, value,
     assert (res["level"][_at(res, 9.0):] == LOW).all()
 
 
+def test_stuck_pressure():
+    """A brake pressure frozen for 8 s while the other axles' pressures vary: after
+    stuck_pressure_time (5 s) that axle is unknown, 'pressure stuck'; the others keep low."""
+    sig = ms.make_signals(ms.braking_profile(level=0.045), duration=20.0, shape="polach",
+                          slope=40.0, mu=0.07, seed=9)
+    k0, k1 = _at(sig, 5.0), _at(sig, 13.0)
+    bad = _corrupt(sig, lambda s: s["brake_pressure"].__setitem__((slice(k0, k1), 2),
+                                                                  s["brake_pressure"][k0, 2]))
+    _, res = _run(bad)
+    window = res["reason"][k0:k1, 2]
+    assert 27 in window  # "pressure stuck"
+    first = res["time"][k0 + int(np.argmax(window == 27))]
+    assert 10.0 <= first < 12.5  # a constant value is a valid number for 5 s
+    assert (res["level"][_at(res, first):k1, 2] == UNKNOWN).all()
+    assert (res["level"][_at(res, first), [0, 1, 3]] == LOW).all()
+    assert (res["level"][_at(res, 17.0):, 2] == LOW).all()
+
+
 def test_stuck_torque_under_traction():
     """A torque frozen for 7 s while the other axles' torques vary: after stuck_pressure_time
     (5 s) that axle is unknown, 'torque stuck'; the others keep low; it recovers after."""
