@@ -82,6 +82,21 @@ def _per_sample(repeat):
         for k in range(n):
             mon.update(t[k], v[k], w[k], p[k])
 
+    # traction only: the same wheel torque from a torque channel, no pressure channel
+    tq = p * coach.brake_coefficient
+    wt = 2.0 * v[:, None] / coach.wheel_radius - w
+    mon_t = AdhesionMonitor(coach, pressure=False, torque=True)
+    mon_t.update(0.0, 40.0, np.full(4, 40.0 / coach.wheel_radius), None, np.zeros(4))
+    inputs_t = mon_t.inputs
+
+    def traction():
+        mon_t.reset()
+        for k in range(n):
+            inputs_t.train_speed = v[k]
+            inputs_t.wheel_speeds[:] = wt[k]
+            inputs_t.torques[:] = tq[k]
+            mon_t.step(t[k])
+
     sim = BrakingSimulator(coach, WilacAdhesion(25.0), 44.0, record=False)
     sim.inputs.pressure_command[:] = 1.2e5
     sim.advance(PERIOD)
@@ -91,7 +106,8 @@ def _per_sample(repeat):
             sim.advance(PERIOD)
 
     return {name: _times(fn, repeat)[1] / n for name, fn in
-            (("step", stepping), ("update", updating), ("simulator", simulating))}
+            (("step", stepping), ("update", updating), ("traction", traction),
+             ("simulator", simulating))}
 
 
 def _compiled_per_sample(log, repeat):
@@ -168,6 +184,7 @@ def main() -> None:
     print(f"  monitor.step(t), inputs in place  {per['step'] * 1e6:7.2f} us  "
           f"(issue 21: <= 20 us)")
     print(f"  monitor.update(t, v, w, p)        {per['update'] * 1e6:7.2f} us")
+    print(f"  monitor.step(t), traction torques {per['traction'] * 1e6:7.2f} us")
     print(f"  simulator advance(2.4 ms), WILAC  {per['simulator'] * 1e6:7.2f} us: "
           f"monitor.step / advance = {per['step'] / per['simulator']:.2f}")
 

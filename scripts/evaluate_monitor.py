@@ -12,7 +12,13 @@ Cases:
 * creep: 0.1 %, 0.2 % and 1 % creep at 30, 40 and 55 m/s, 2 seeds;
 * steady: no modulation, 0.5 % creep, at 30, 40 and 55 m/s, 2 seeds;
 * dry: 100 km of dry rail (runs from 30-55 m/s, random light braking and modulation);
-* traction: only if the simulator has ``inputs.torque`` (it has not yet).
+* traction only (no brake; the torque written into the simulator's ``inputs.torque`` and fed
+  to the monitor with 50 N m noise): every condition x 30-55 m/s x ``--seeds`` seeds at 0.5 %
+  creep; 0.1 %, 0.2 % and 1 % creep at 30, 40 and 55 m/s, 2 seeds; 100 km of dry rail under
+  traction (runs from 30-40 m/s, random light traction and modulation).
+
+``--only traction`` runs the traction cases alone (results in ``traction.json``; the braking
+figures are left as they are).
 
 Writes ``results.json`` into ``--out`` (not under version control) and the figures
 ``docs/figures/monitor_track_low.png``, ``monitor_track_damp.png``, ``monitor_delays.png``;
@@ -40,7 +46,7 @@ from railadhesion.monitor.evaluation import (
     run_dry_distance,
     run_traction_case,
 )
-from railadhesion.monitor.layout import LEVELS, LOW
+from railadhesion.monitor.layout import LEVELS, LOW, NORMAL
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURES = ROOT / "docs" / "figures"
@@ -55,6 +61,7 @@ def _pct(x, q):
 def _summarise(results):
     """Aggregate the cases of one (condition, creep, modulation) group."""
     delays = []
+    distances = []
     firsts = []
     errors = []
     inside = []
@@ -63,6 +70,8 @@ def _summarise(results):
     false_section = 0
     false_after = 0
     lingers = []
+    normal_low = [0, 0]  # samples 'normal' on a section whose truth is low, samples there
+    normal_last = []  # the last 'normal' on such a section, from the axle's entry [s]
     found_all = 0
     truth = []
     creeps = []
@@ -73,6 +82,7 @@ def _summarise(results):
         creeps.append(s["section_creep_median"])
         d = np.array([np.nan if x is None else x for x in s["delays_s"]], float)
         delays += d.tolist()
+        distances += [np.nan if x is None else x for x in s["distances_m"]]
         firsts.append(np.nan if s["delay_first_axle_s"] is None else s["delay_first_axle_s"])
         found_all += int(np.all(np.isfinite(d) & (d <= 2.0)))
         false_before += int(s["false_low_before_section"])
@@ -85,6 +95,12 @@ def _summarise(results):
             # whether the band holds the truth
             on = (h["time"] >= res.entry_time[i]) & (h["time"] <= res.exit_time[i])
             low = on & (h["level"][:, i] == LOW)
+            if res.expected == "low":
+                normal = on & (h["level"][:, i] == NORMAL)
+                normal_low[0] += int(np.sum(normal))
+                normal_low[1] += int(np.sum(on))
+                if normal.any():
+                    normal_last.append(float(h["time"][normal][-1] - res.entry_time[i]))
             if low.any():
                 e = (h["estimate"][:, i] - h["truth"][:, i])[low]
                 errors += np.abs(e[np.isfinite(e)]).tolist()
@@ -120,6 +136,9 @@ def _summarise(results):
         "delay_median_s": _pct(delays, 50),
         "delay_p95_s": _pct(delays, 95),
         "delay_max_s": _pct(delays, 100),
+        "distance_median_m": _pct(distances, 50),
+        "distance_p95_m": _pct(distances, 95),
+        "distance_max_m": _pct(distances, 100),
         "first_axle_delay_median_s": _pct(firsts, 50),
         "error_abs_median": _pct(errors, 50),
         "error_abs_p95": _pct(errors, 95),
@@ -132,6 +151,8 @@ def _summarise(results):
         "low_lingers_after_exit_max_s": _pct(lingers, 100),
         "axles_low_more_than_1s_after_exit": false_after,
         "cases_low_where_truth_not_low": false_section,
+        "normal_share_on_low_section": normal_low[0] / normal_low[1] if normal_low[1] else None,
+        "normal_on_low_section_until_s": _pct(normal_last, 100),
         "delays": [None if not math.isfinite(x) else float(x) for x in delays],
     }
 
@@ -173,7 +194,8 @@ def _track_figure(res, path, title):
     plt.close(fig)
 
 
-def _delay_figure(groups, path):
+def _delay_figure(groups, path,
+                  title="low after entry, 0.5 % creep, 30-55 m/s (per axle)"):
     import matplotlib
 
     matplotlib.use("Agg")
@@ -184,18 +206,19 @@ def _delay_figure(groups, path):
     series = {f"{c} (truth {g['truth_mean']:.3f})": np.array(
         [np.nan if d is None else d for d in g["delays"]]) for c, g in groups.items()
         if g["expected"] == "low"}
-    fig = plot_delays(series, title="low after entry, 0.5 % creep, 30-55 m/s (per axle)")
+    fig = plot_delays(series, title=title)
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
 
 def _table(groups, title):
     lines = [f"\n{title}", "| section | truth | creep | low within 2 s (axles) | all 4 axles "
-             "within 2 s (cases) | delay median / p95 [s] | abs. error on the section, median "
-             "/ p95 / max | "
+             "within 2 s (cases) | delay median / p95 / max [s] | distance median / p95 / "
+             "max [m] | abs. error on the section, median / p95 / max | "
              "band holds truth | level at the section's end | low where truth is not low | "
-             "low lingers after the exit, median / max [s] |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "low lingers after the exit, median / max [s] | normal on a low section "
+             "(share; last after entry [s]) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for cond, g in groups.items():
         def f(x, fmt="{:.3f}"):
             return "–" if x is None else fmt.format(x)
@@ -205,12 +228,17 @@ def _table(groups, title):
             f"{f(g['section_creep_median'], '{:.2%}')} | "
             f"{f(g['axles_low_within_2s'], '{:.0%}')} | "
             f"{g['cases_all_axles_within_2s']:.0%} | "
-            f"{f(g['delay_median_s'], '{:.2f}')} / {f(g['delay_p95_s'], '{:.2f}')} | "
+            f"{f(g['delay_median_s'], '{:.2f}')} / {f(g['delay_p95_s'], '{:.2f}')} / "
+            f"{f(g['delay_max_s'], '{:.2f}')} | "
+            f"{f(g['distance_median_m'], '{:.0f}')} / {f(g['distance_p95_m'], '{:.0f}')} / "
+            f"{f(g['distance_max_m'], '{:.0f}')} | "
             f"{f(g['error_abs_median'])} / {f(g['error_abs_p95'])} / {f(g['error_abs_max'])} | "
             f"{f(g['band_holds_truth'], '{:.0%}')} | {end} | "
             f"{g['cases_low_where_truth_not_low']} of {g['cases']} | "
             f"{f(g['low_lingers_after_exit_median_s'], '{:.2f}')} / "
-            f"{f(g['low_lingers_after_exit_max_s'], '{:.2f}')} |")
+            f"{f(g['low_lingers_after_exit_max_s'], '{:.2f}')} | "
+            f"{f(g['normal_share_on_low_section'], '{:.2%}')}; "
+            f"{f(g['normal_on_low_section_until_s'], '{:.2f}')} |")
     return "\n".join(lines)
 
 
@@ -220,6 +248,7 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=ROOT / "out" / "monitor-eval")
     ap.add_argument("--quick", action="store_true", help="a few cases only (a check)")
     ap.add_argument("--dry-km", type=float, default=100.0)
+    ap.add_argument("--only", choices=("all", "traction"), default="all")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     FIGURES.mkdir(parents=True, exist_ok=True)
@@ -237,6 +266,9 @@ def main() -> None:
         if done[0] % 20 == 0:
             print(f"  {done[0]} cases, {time.time() - t0:.0f} s", flush=True)
 
+    if args.only == "traction":
+        _traction(args, conditions, speeds, seeds, few, progress, t0)
+        return
     print(f"load average {os.getloadavg()[0]:.2f}; main cases", flush=True)
     main_groups = _run_group(conditions, speeds, 0.005, 0.25, seeds, progress)
     creep_groups = {}
@@ -247,11 +279,7 @@ def main() -> None:
     steady = _run_group(conditions, few, 0.005, 0.0, range(2), progress)
     print(f"dry rail, {args.dry_km:g} km", flush=True)
     dry = run_dry_distance(args.dry_km * 1e3, seed=11)
-    traction_groups = {}
-    for creep in (0.002, 0.005, 0.01):
-        print(f"traction only, {creep:.1%} creep", flush=True)
-        traction_groups[creep] = _run_group(conditions, few, creep, 0.25, range(1), progress,
-                                            runner=run_traction_case)
+    traction = _traction_groups(args, conditions, speeds, seeds, few, progress)
     # figures
     low_res = next(r for r in main_groups["polach_wet_0.08"][1] if r.case.speed == 40.0)
     _track_figure(low_res, FIGURES / "monitor_track_low.png",
@@ -262,13 +290,14 @@ def main() -> None:
                       "WILAC, 25 ul/s (damp), 40 m/s, 0.5 % creep")
     summaries = {c: g for c, (g, _) in main_groups.items()}
     _delay_figure(summaries, FIGURES / "monitor_delays.png")
+    _delay_figure(traction["0.005"], FIGURES / "monitor_delays_traction.png",
+                  "low after entry, traction only, 0.5 % creep, 30-55 m/s (per axle)")
     results = {
         "main_0.5pct_modulated": summaries,
         "creep": {f"{k:.3f}": {c: g for c, (g, _) in v.items()} for k, v in creep_groups.items()},
         "steady_0.5pct": {c: g for c, (g, _) in steady.items()},
         "dry": dry,
-        "traction": {f"{k:.3f}": {c: g for c, (g, _) in v.items()}
-                     for k, v in traction_groups.items()},
+        "traction": traction,
         "wall_s": time.time() - t0,
         "load_average_end": os.getloadavg()[0],
     }
@@ -279,10 +308,44 @@ def main() -> None:
     print(_table({c: g for c, (g, _) in steady.items()}, "steady demand, 0.5 % creep"))
     dry = {k: v for k, v in dry.items() if k != "low_examples"}
     print("\ndry rail:", json.dumps(dry))
-    for k, v in traction_groups.items():
-        print(_table({c: g for c, (g, _) in v.items()},
-                     f"traction only, {k:.1%} creep, {'/'.join(f'{x:g}' for x in few)} m/s"))
+    _print_traction(traction)
     print(f"\n{time.time() - t0:.0f} s; results in {args.out / 'results.json'}")
+
+
+def _traction_groups(args, conditions, speeds, seeds, few, progress):
+    """The traction-only cases (issue 21): summaries by creep, and the dry distance."""
+    out = {}
+    for creep, spd, sds in ((0.005, speeds, seeds), (0.001, few, range(2)),
+                            (0.002, few, range(2)), (0.01, few, range(2))):
+        print(f"traction only, {creep:.1%} creep", flush=True)
+        groups = _run_group(conditions, spd, creep, 0.25, sds, progress,
+                            runner=run_traction_case)
+        out[f"{creep:.3f}"] = {c: g for c, (g, _) in groups.items()}
+    print(f"traction only, dry rail, {args.dry_km:g} km", flush=True)
+    out["dry"] = run_dry_distance(args.dry_km * 1e3, seed=13, traction=True)
+    return out
+
+
+def _print_traction(traction):
+    for k, v in traction.items():
+        if k == "dry":
+            dry = {key: val for key, val in v.items() if key != "low_examples"}
+            print("\ntraction only, dry rail:", json.dumps(dry))
+        else:
+            print(_table(v, f"traction only, {float(k):.1%} creep"))
+
+
+def _traction(args, conditions, speeds, seeds, few, progress, t0):
+    traction = _traction_groups(args, conditions, speeds, seeds, few, progress)
+    _delay_figure({c: g for c, g in traction["0.005"].items()},
+                  FIGURES / "monitor_delays_traction.png",
+                  "low after entry, traction only, 0.5 % creep, 30-55 m/s (per axle)")
+    traction["wall_s"] = time.time() - t0
+    traction["load_average_end"] = os.getloadavg()[0]
+    (args.out / "traction.json").write_text(json.dumps(traction, indent=1), encoding="utf-8")
+    _print_traction({k: v for k, v in traction.items() if k not in ("wall_s",
+                                                                     "load_average_end")})
+    print(f"\n{time.time() - t0:.0f} s; results in {args.out / 'traction.json'}")
 
 
 if __name__ == "__main__":

@@ -80,10 +80,13 @@ def test_steady_braking_onto_the_section_claims_only_what_it_sees():
     assert not res.summary["false_low_before_section"]
 
 
-def test_dry_rail_gives_no_false_low():
-    out = run_dry_distance(3.0e3, seed=2)
+@pytest.mark.parametrize("traction", [False, True])
+def test_dry_rail_gives_no_false_low(traction):
+    out = run_dry_distance(3.0e3, seed=2, traction=traction)
     assert out["distance_km"] >= 3.0
     assert out["low_episodes"] == 0 and out["low_axle_seconds"] == 0.0
+    # the runs used the rail's curve, not only its straight part: the level was not all unknown
+    assert out["level_share"]["normal"] > 0.01
 
 
 def test_sensor_noise_of_the_issue():
@@ -100,6 +103,9 @@ def test_sensor_noise_of_the_issue():
     w = reads[:, 1:5] / sensors.factor
     assert np.std(w - Live.wheel_speeds, axis=0) == pytest.approx(np.full(4, 0.02), rel=0.1)
     assert np.std(reads[:, 5:], axis=0) == pytest.approx(np.full(4, 1e3), rel=0.1)
+    tq = np.array([sensors.read(Live, torque=np.full(4, 2.5e3))[3] for _ in range(4000)])
+    assert np.std(tq, axis=0) == pytest.approx(np.full(4, 50.0), rel=0.1)
+    assert np.mean(tq) == pytest.approx(2.5e3, abs=5.0)
     again = NoisySensors(4, SensorNoise(), seed=1)
     assert np.array_equal(again.factor, NoisySensors(4, SensorNoise(), seed=1).factor)
 
@@ -115,8 +121,12 @@ def test_traction_only_case(condition, speed, creep):
     assert s["error_abs_max"] <= 0.02
     assert not s["false_low_before_section"]
     assert math.isfinite(res.truth) and res.truth < 0.14
-    low = res.history["level"] == layout.LOW
-    assert (res.history["creep"][low] < 0).all()  # traction: xi < 0 (docs/CONVENTIONS.md)
+    h = res.history
+    low = h["level"] == layout.LOW
+    assert (h["creep"][low] < 0).all()  # traction: xi < 0 (docs/CONVENTIONS.md)
+    inside = (h["lower"][low] <= h["truth"][low] + 1e-3) & (h["truth"][low] <= h["upper"][low])
+    assert inside.mean() > 0.95
+    assert s["mean_torque_N_m"] > 1e3 and "mean_pressure_Pa" not in s
 
 
 def test_traction_onto_damp_wilac_is_not_called_low():

@@ -234,6 +234,73 @@ def test_bad_input_unknown_with_reason_then_recovery(low_run, low_levels, name):
     assert (low_levels["level"][k] == LOW).all()
 
 
+@pytest.fixture(scope="module")
+def traction_run():
+    sig = ms.make_signals(ms.braking_profile(level=0.045), duration=12.0, shape="polach",
+                          slope=40.0, mu=0.07, traction=True, seed=7)
+    return sig, ms.feed(AdhesionMonitor("coach_default", pressure=False, torque=True), sig)
+
+
+@pytest.mark.parametrize(("name", "value", "reason"),
+                         [("torque NaN", np.nan, 24), ("torque implausible", 5e6, 31),
+                          ("torque -inf", -np.inf, 31)])
+def test_bad_torque_unknown_with_reason_then_recovery(traction_run, name, value, reason):
+    """Traction only: a bad torque sample on axle 3 makes that axle unknown, with the reason,
+    for the recovery time; the clean run's low comes back."""
+    sig, clean = traction_run
+    k0 = _at(clean, 6.0)
+    assert (clean["level"][k0:] == LOW).all()
+    bad = _corrupt(sig, lambda s: s["torque"].__setitem__((slice(k0, k0 + 3), 2), value))
+    mon, res = _run(bad, pressure=False, torque=True)
+    assert np.isfinite(mon.bank).all()
+    assert res["level"][k0, 2] == UNKNOWN and res["reason"][k0, 2] == reason, name
+    assert (res["level"][k0 + 3:k0 + int(0.5 / 2.4e-3), 2] == UNKNOWN).all()
+    assert (res["level"][k0, [0, 1, 3]] == LOW).all()  # the other axles keep their level
+    assert (res["level"][_at(res, 9.0):] == LOW).all()
+
+
+def test_stuck_pressure():
+    """A brake pressure frozen for 8 s while the other axles' pressures vary: after
+    stuck_pressure_time (5 s) that axle is unknown, 'pressure stuck'; the others keep low."""
+    sig = ms.make_signals(ms.braking_profile(level=0.045), duration=20.0, shape="polach",
+                          slope=40.0, mu=0.07, seed=9)
+    k0, k1 = _at(sig, 5.0), _at(sig, 13.0)
+    bad = _corrupt(sig, lambda s: s["brake_pressure"].__setitem__((slice(k0, k1), 2),
+                                                                  s["brake_pressure"][k0, 2]))
+    _, res = _run(bad)
+    window = res["reason"][k0:k1, 2]
+    assert 27 in window  # "pressure stuck"
+    first = res["time"][k0 + int(np.argmax(window == 27))]
+    assert 10.0 <= first < 12.5  # a constant value is a valid number for 5 s
+    assert (res["level"][_at(res, first):k1, 2] == UNKNOWN).all()
+    assert (res["level"][_at(res, first), [0, 1, 3]] == LOW).all()
+    assert (res["level"][_at(res, 17.0):, 2] == LOW).all()
+
+
+def test_stuck_torque_under_traction():
+    """A torque frozen for 7 s while the other axles' torques vary: after stuck_pressure_time
+    (5 s) that axle is unknown, 'torque stuck'; the others keep low; it recovers after."""
+    sig = ms.make_signals(ms.braking_profile(level=0.045), duration=18.0, shape="polach",
+                          slope=40.0, mu=0.07, traction=True, seed=8)
+    k0, k1 = _at(sig, 5.0), _at(sig, 12.0)
+    bad = _corrupt(sig, lambda s: s["torque"].__setitem__((slice(k0, k1), 1),
+                                                          s["torque"][k0, 1]))
+    _, res = _run(bad, pressure=False, torque=True)
+    window = res["reason"][k0:k1, 1]
+    assert 34 in window  # "torque stuck"
+    first = res["time"][k0 + int(np.argmax(window == 34))]
+    assert 10.0 <= first < 11.5  # a constant value is a valid number for 5 s
+    assert (res["level"][:_at(res, 9.9), 1] == LOW).any()
+    assert (res["level"][_at(res, first):k1, 1] == UNKNOWN).all()
+    assert (res["level"][_at(res, 10.5), [0, 2, 3]] == LOW).all()
+    assert (res["level"][_at(res, 15.0):, 1] == LOW).all()
+    assert layout.reason_label(34) == "torque stuck"
+    # an unpowered axle (torque exactly 0 throughout) beside driven ones is not stuck
+    idle = _corrupt(sig, lambda s: s["torque"].__setitem__((slice(None), 1), 0.0))
+    _, res = _run(idle, pressure=False, torque=True)
+    assert not (res["reason"][:, 1] == 34).any()
+
+
 def test_stuck_wheel_speed(low_run):
     sig = _corrupt(low_run, lambda s: s["wheel_speed"].__setitem__(
         (slice(K0, K0 + 400), 1), s["wheel_speed"][K0, 1]))

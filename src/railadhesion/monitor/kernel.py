@@ -90,7 +90,7 @@ R_NO_FORCE, R_SIGN, R_UNCONFIRMED = 15, 16, 17
 R_TIME_ORDER, R_GAP, R_NAN_SPEED, R_NAN_WHEEL, R_NAN_FORCE = 20, 21, 22, 23, 24
 R_STUCK_SPEED, R_STUCK_WHEEL, R_STUCK_PRESSURE = 25, 26, 27
 R_BAD_SPEED, R_BAD_WHEEL, R_BAD_PRESSURE, R_BAD_TORQUE, R_BAD_ADHESION = 28, 29, 30, 31, 32
-R_TIME_NAN, R_RECOVERING, R_NUMERICAL = 33, 40, 41
+R_TIME_NAN, R_STUCK_TORQUE, R_RECOVERING, R_NUMERICAL = 33, 34, 40, 41
 
 # radius states
 _NOMINAL, _LEARNED, _UNCONFIRMED_R = 0, 1, 2
@@ -576,8 +576,10 @@ def _start(cfg, st, bank, t):
         st.w_ok[i] = 0
         st.w_value[i] = _NAN
         st.p_value[i] = _NAN
+        st.tau_value[i] = _NAN
         st.w_since[i] = t
         st.p_since[i] = t
+        st.tau_since[i] = t
         st.recover_until[i] = -_INF
         st.recover_code[i] = 0
         st.coasting[i] = 0
@@ -795,6 +797,23 @@ def step_record(cfg, inp, st, out, bank):
             elif (t - st.p_since[i] >= cfg.stuck_pressure_time and cnt > 0
                   and abs(others - st.p_oref[i]) > 1e4):
                 code, v1, v2 = R_STUCK_PRESSURE, p, t - st.p_since[i]
+        if code == 0 and ht and n > 1:  # the same for a torque: the others' mean moved by
+            # 4 sigma_tau (about 5 standard deviations of a change of a three-axle mean);
+            # exactly 0 is an unpowered or idle axle, not a stuck one
+            others = 0.0
+            cnt = 0
+            for j in range(n):
+                if j != i and cfg.has_torque[j] != 0 and _finite(inp.torque[j]):
+                    others += inp.torque[j]
+                    cnt += 1
+            others = others / cnt if cnt > 0 else _NAN
+            if tau != st.tau_value[i]:
+                st.tau_value[i] = tau
+                st.tau_since[i] = t
+                st.tau_oref[i] = others
+            elif (tau != 0.0 and t - st.tau_since[i] >= cfg.stuck_pressure_time and cnt > 0
+                  and abs(others - st.tau_oref[i]) > max(4.0 * cfg.sig_tau, 1.0)):
+                code, v1, v2 = R_STUCK_TORQUE, tau, t - st.tau_since[i]
         if code == 0 and st.w_ok[i] != 0 and st.filters_on[i] != 0:
             # a step of the wheel speed that no torque can give (wheel diameter or sensor)
             dtw = t - st.tw_last[i]

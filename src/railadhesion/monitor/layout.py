@@ -118,6 +118,8 @@ REASONS = {
     32: ("adhesion implausible",
          "adhesion in use {v1:.4g} implausible (units of pressure or torque?)"),
     33: ("time missing", "time missing (NaN): sample ignored"),
+    34: ("torque stuck",
+         "torque stuck at {v1:.4g} N m for {v2:.2f} s while the other axles' changed"),
     40: ("recovering", "recovering from bad data ({cause}) until t = {v2:.3f} s"),
     41: ("estimator restarted", "estimator state was not finite: restarted"),
 }
@@ -199,6 +201,7 @@ STATE_DTYPE = np.dtype([
     # stuck detectors
     ("w_value", "f8", _A), ("w_since", "f8", _A), ("w_vref", "f8", _A),
     ("p_value", "f8", _A), ("p_since", "f8", _A), ("p_oref", "f8", _A),
+    ("tau_value", "f8", _A), ("tau_since", "f8", _A), ("tau_oref", "f8", _A),
     # bad data: recovery
     ("recover_until", "f8", _A), ("recover_code", "i8", _A), ("recover_v1", "f8", _A),
     ("recover_v2", "f8", _A),

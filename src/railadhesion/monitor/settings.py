@@ -154,8 +154,11 @@ class MonitorSettings:
         After bad data the axle stays ``unknown`` this long [s] (default 0.5 s).
     stuck_time, stuck_pressure_time : float
         A channel that does not change at all for this long [s] while the signals it should
-        follow do is stuck (wheel speeds and speed reference 0.5 s; pressures 5 s, longer
-        than a WSP valve may hold, as the braking-log reader).
+        follow do is stuck (wheel speeds and speed reference 0.5 s; pressures and torques
+        5 s, longer than a WSP valve may hold, as the braking-log reader: a pressure is
+        stuck when the other axles' mean has moved by more than 0.1 bar meanwhile, a torque
+        when theirs has moved by more than four times ``torque_noise`` (a torque of exactly
+        0, an unpowered axle, is never stuck)).
     gap_factor : float
         A time step longer than this many sample periods is a gap (default 5): filters
         restart.
