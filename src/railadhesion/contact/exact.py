@@ -366,11 +366,14 @@ def _local_slip(ssx, ssy, kx, ky, g):
 
 @jit(error_model="python")
 def _fft_tables(n):
-    """Twiddle factors exp(-2 pi i k/n), k < n/2, and the bit-reversal permutation (n = 2^m)."""
-    tw = np.empty(max(n // 2, 1), np.complex128)
+    """Twiddle factors exp(-2 pi i k/n), k < n/2 (real, imaginary parts), and the bit-reversal
+    permutation, for FFTs of length n = 2^m."""
+    twr = np.ones(max(n // 2, 1))
+    twi = np.zeros(max(n // 2, 1))
     for k in range(n // 2):
         t = -2.0 * math.pi * k / n
-        tw[k] = complex(math.cos(t), math.sin(t))
+        twr[k] = math.cos(t)
+        twi[k] = math.sin(t)
     rev = np.zeros(n, np.int64)
     bits = 0
     while (1 << bits) < n:
@@ -382,33 +385,39 @@ def _fft_tables(n):
             r = (r << 1) | (v & 1)
             v >>= 1
         rev[i] = r
-    return tw, rev
+    return twr, twi, rev
 
 
 @jit(error_model="python", fastmath=True)
-def _fft(buf, tw, rev, inverse):
-    """In-place radix-2 FFT of ``buf`` (length n = 2^m; Cooley & Tukey 1965, iterative form).
-
-    Forward: ``X_k = sum_j x_j exp(-2 pi i jk/n)``; inverse without the factor 1/n."""
-    n = buf.size
+def _fft(re, im, twr, twi, rev, sign):
+    """In-place radix-2 FFT of ``re + i im`` (length n = 2^m; Cooley & Tukey 1965, iterative
+    form): ``X_k = sum_j x_j exp(-sign 2 pi i jk/n)``, sign = 1 forward, -1 inverse (without
+    the factor 1/n)."""
+    n = re.size
     for i in range(n):
         j = rev[i]
         if j > i:
-            t = buf[i]
-            buf[i] = buf[j]
-            buf[j] = t
+            t = re[i]
+            re[i] = re[j]
+            re[j] = t
+            t = im[i]
+            im[i] = im[j]
+            im[j] = t
     half = 1
     while half < n:
         step = n // (2 * half)
         for start in range(0, n, 2 * half):
             for k in range(half):
-                w = tw[k * step]
-                if inverse:
-                    w = w.conjugate()
-                u = buf[start + k]
-                v = w * buf[start + k + half]
-                buf[start + k] = u + v
-                buf[start + k + half] = u - v
+                wr = twr[k * step]
+                wi = sign * twi[k * step]
+                a = start + k
+                b = a + half
+                vr = wr * re[b] - wi * im[b]
+                vi = wr * im[b] + wi * re[b]
+                re[b] = re[a] - vr
+                im[b] = im[a] - vi
+                re[a] += vr
+                im[a] += vi
         half *= 2
 
 
@@ -421,90 +430,111 @@ def _kernel_spectra(kxx, kxy, kyy):
     ``z = dp_x + i dp_y`` and slip ``s_x + i s_y`` it is ``P * z + Q * conj(z)``, with
     ``P = (K_xx + K_yy)/2`` and ``Q = (K_xx - K_yy)/2 + i K_xy``. Zero padding to a length
     ``n >= 2 my - 1`` (a power of two) makes the circular convolution the linear one.
-    Returns ``(phat, qhat, tw, rev)``: the spectra of P and Q for every column offset, shape
-    (2 mx - 1, n), scaled by 1/n (the inverse FFT's factor), and the FFT tables.
+    ``K_xx`` and ``K_yy`` are even in y and ``K_xy`` odd (the half-space is symmetric about
+    the x axis), so the spectra of P and Q are real.
+    Returns ``(phat, qhat, twr, twi, rev)``: the spectra of P and Q for every column offset,
+    shape (2 mx - 1, n), scaled by 1/n (the inverse FFT's factor), and the FFT tables.
     """
     ny_off, nx_off = kxx.shape
     my = (ny_off + 1) // 2
     n = 1
     while n < ny_off:
         n *= 2
-    tw, rev = _fft_tables(n)
-    phat = np.zeros((nx_off, n), np.complex128)
-    qhat = np.zeros((nx_off, n), np.complex128)
+    twr, twi, rev = _fft_tables(n)
+    phat = np.zeros((nx_off, n))
+    qhat = np.zeros((nx_off, n))
+    re = np.empty(n)
+    im = np.empty(n)
     for k in range(nx_off):
-        for d in range(ny_off):
-            dj = d - (my - 1)
-            pos = dj % n
-            phat[k, pos] = 0.5 * (kxx[d, k] + kyy[d, k]) / n
-            qhat[k, pos] = complex(0.5 * (kxx[d, k] - kyy[d, k]) / n, kxy[d, k] / n)
-        _fft(phat[k], tw, rev, False)
-        _fft(qhat[k], tw, rev, False)
-    return phat, qhat, tw, rev
+        for which in range(2):
+            re[:] = 0.0
+            im[:] = 0.0
+            for d in range(ny_off):
+                pos = (d - (my - 1)) % n
+                if which == 0:
+                    re[pos] = 0.5 * (kxx[d, k] + kyy[d, k]) / n
+                else:
+                    re[pos] = 0.5 * (kxx[d, k] - kyy[d, k]) / n
+                    im[pos] = kxy[d, k] / n
+            _fft(re, im, twr, twi, rev, 1.0)
+            if which == 0:
+                phat[k, :] = re
+            else:
+                qhat[k, :] = re
+    return phat, qhat, twr, twi, rev
 
 
 @jit(error_model="python", fastmath=True)
-def _push_column(pend, zbuf, zcon, ix, cmin, cmax, phat, qhat, tw, rev, mx, skip_self):
-    """Add the effect of the traction change in ``zbuf`` (column ``ix``, complex, zero padded)
-    to the pending slip spectra ``pend`` of the columns ``cmin..cmax`` (except ``ix`` itself
-    when ``skip_self``). ``zbuf`` is transformed in place."""
-    n = zbuf.size
-    _fft(zbuf, tw, rev, False)
-    zcon[0] = zbuf[0].conjugate()
+def _push_column(pr_, pi_, zr, zi, cr, ci, ix, cmin, cmax, phat, qhat, spec_fft, mx, skip_self):
+    """Add the effect of the traction change ``zr + i zi`` (column ``ix``, zero padded) to the
+    pending slip spectra ``pr_ + i pi_`` of the columns ``cmin..cmax`` (except ``ix`` itself
+    when ``skip_self``). ``zr, zi`` are transformed in place; ``cr, ci`` are work arrays."""
+    twr, twi, rev = spec_fft
+    n = zr.size
+    _fft(zr, zi, twr, twi, rev, 1.0)
+    cr[0] = zr[0]  # conj(Z(-f))
+    ci[0] = -zi[0]
     for f in range(1, n):
-        zcon[f] = zbuf[n - f].conjugate()
+        cr[f] = zr[n - f]
+        ci[f] = -zi[n - f]
     for jx in range(cmin, cmax + 1):
         if skip_self and jx == ix:
             continue
         k = jx - ix + mx - 1
-        pr = phat[k]
-        qr = qhat[k]
-        dst = pend[jx]
+        ph = phat[k]
+        qh = qhat[k]
+        dr = pr_[jx]
+        di = pi_[jx]
         for f in range(n):
-            dst[f] += pr[f] * zbuf[f] + qr[f] * zcon[f]
+            dr[f] += ph[f] * zr[f] + qh[f] * cr[f]
+            di[f] += ph[f] * zi[f] + qh[f] * ci[f]
 
 
 @jit(error_model="python")
-def _flush_column(pend, zbuf, jx, my, sx, sy, tw, rev):
-    """Add the pending slip change of column ``jx`` (inverse FFT) to ``sx, sy``; clear it."""
-    n = zbuf.size
+def _flush_column(pr_, pi_, zr, zi, jx, my, sxt, syt, spec_fft):
+    """Add the pending slip change of column ``jx`` (inverse FFT) to ``sxt[jx], syt[jx]``
+    (transposed slip, one row per grid column); clear it."""
+    twr, twi, rev = spec_fft
+    n = zr.size
     for f in range(n):
-        zbuf[f] = pend[jx, f]
-        pend[jx, f] = 0.0
-    _fft(zbuf, tw, rev, True)
+        zr[f] = pr_[jx, f]
+        zi[f] = pi_[jx, f]
+        pr_[jx, f] = 0.0
+        pi_[jx, f] = 0.0
+    _fft(zr, zi, twr, twi, rev, -1.0)
     for jy in range(my):
-        sx[jy, jx] += zbuf[jy].real
-        sy[jy, jx] += zbuf[jy].imag
+        sxt[jx, jy] += zr[jy]
+        syt[jx, jy] += zi[jy]
 
 
 @jit(error_model="python")
-def _full_slip_field(px, py, wx, wy, cmin, cmax, spec, mx, my, sx, sy, pend, dirty, zbuf, zcon):
-    """s = w + K p on the contact columns, computed from scratch (influence sums by FFT)."""
-    phat, qhat, tw, rev = spec
-    n = zbuf.size
-    for jx in range(mx):
-        dirty[jx] = False
-        for f in range(n):
-            pend[jx, f] = 0.0
-    for iy in range(my):
-        for ix in range(mx):
-            sx[iy, ix] = wx[iy, ix]
-            sy[iy, ix] = wy[iy, ix]
+def _full_slip_field(pxt, pyt, wxt, wyt, cmin, cmax, spec, mx, my, sxt, syt, work, dirty):
+    """s = w + K p on the contact columns, computed from scratch (influence sums by FFT).
+    Transposed fields: ``[ix, iy]``."""
+    phat, qhat, twr, twi, rev = spec
+    pr_, pi_, zr, zi, cr, ci = work
+    sfft = (twr, twi, rev)
+    pr_[:] = 0.0
+    pi_[:] = 0.0
+    sxt[:] = wxt
+    syt[:] = wyt
+    dirty[:] = False
     for ix in range(cmin, cmax + 1):
         nz = False
-        for f in range(n):
-            zbuf[f] = 0.0
+        zr[:] = 0.0
+        zi[:] = 0.0
         for iy in range(my):
-            if px[iy, ix] != 0.0 or py[iy, ix] != 0.0:
-                zbuf[iy] = complex(px[iy, ix], py[iy, ix])
+            if pxt[ix, iy] != 0.0 or pyt[ix, iy] != 0.0:
+                zr[iy] = pxt[ix, iy]
+                zi[iy] = pyt[ix, iy]
                 nz = True
         if nz:
-            _push_column(pend, zbuf, zcon, ix, cmin, cmax, phat, qhat, tw, rev, mx, False)
+            _push_column(pr_, pi_, zr, zi, cr, ci, ix, cmin, cmax, phat, qhat, sfft, mx, False)
             for jx in range(cmin, cmax + 1):
                 dirty[jx] = True
     for jx in range(cmin, cmax + 1):
         if dirty[jx]:
-            _flush_column(pend, zbuf, jx, my, sx, sy, tw, rev)
+            _flush_column(pr_, pi_, zr, zi, jx, my, sxt, syt, sfft)
             dirty[jx] = False
 
 
@@ -524,123 +554,148 @@ def _gauss_seidel(g, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, tol, max_iter, px, p
     done by FFT and kept in Fourier space until the column is visited (:func:`_push_column`,
     :func:`_flush_column`). Columns not yet visited in the sweep thus see every update, as in
     the element-wise Gauss-Seidel iteration with full sums, which this reproduces up to
-    round-off, at O(nx ny log ny) instead of O((nx ny)^2) operations per sweep.
+    round-off, at O(nx ny log ny) instead of O((nx ny)^2) operations per sweep. The fields
+    are worked on transposed (``[ix, iy]``), so that a column is contiguous.
     """
-    phat, qhat, tw, rev = spec
+    phat, qhat, twr, twi, rev = spec
+    sfft = (twr, twi, rev)
     my, mx = g.shape
     n = rev.size
-    pend = np.zeros((mx, n), np.complex128)
+    work = (np.zeros((mx, n)), np.zeros((mx, n)), np.zeros(n), np.zeros(n), np.zeros(n),
+            np.zeros(n))  # fmt: skip
+    pr_, pi_, zr, zi, cr, ci = work
     dirty = np.zeros(mx, np.bool_)
-    zbuf = np.zeros(n, np.complex128)
-    zcon = np.zeros(n, np.complex128)
     dpx_col = np.zeros(my)
     dpy_col = np.zeros(my)
+    c0 = mx - 1  # kernel column of zero offset along x, contiguous
+    k0xx = np.ascontiguousarray(kxx[:, c0])
+    k0xy = np.ascontiguousarray(kxy[:, c0])
+    k0yy = np.ascontiguousarray(kyy[:, c0])
+    gt = np.ascontiguousarray(g.T)
+    wxt = np.ascontiguousarray(wx.T)
+    wyt = np.ascontiguousarray(wy.T)
+    pxt = np.ascontiguousarray(px.T)
+    pyt = np.ascontiguousarray(py.T)
+    sxt = np.zeros((mx, my))
+    syt = np.zeros((mx, my))
+    stt = np.zeros((mx, my), np.int8)
     cmin = mx
     cmax = -1
     gmax = 0.0
-    for iy in range(my):
-        for ix in range(mx):
-            if g[iy, ix] > 0.0:
+    for ix in range(mx):
+        for iy in range(my):
+            if gt[ix, iy] > 0.0:
                 cmin = min(cmin, ix)
                 cmax = max(cmax, ix)
-                gmax = max(gmax, g[iy, ix])
+                gmax = max(gmax, gt[ix, iy])
             else:
-                px[iy, ix] = 0.0
-                py[iy, ix] = 0.0
-                state[iy, ix] = _EXTERIOR
-    if gmax <= 0.0:
-        for iy in range(my):
-            for ix in range(mx):
-                sx[iy, ix] = wx[iy, ix]
-                sy[iy, ix] = wy[iy, ix]
-        return 0, 0.0
-    c0 = mx - 1  # kernel column of zero offset along x
-    k0x = dgx
-    k0y = dgy
-    _full_slip_field(px, py, wx, wy, cmin, cmax, spec, mx, my, sx, sy, pend, dirty, zbuf, zcon)
-    err = 0.0
-    pref = gmax
+                pxt[ix, iy] = 0.0
+                pyt[ix, iy] = 0.0
     sweeps = 0
-    err_min = np.inf
-    for _ in range(max_iter):
-        sweeps += 1
-        err = 0.0
-        pmax = 0.0
-        for ix in range(cmin, cmax + 1):  # from the trailing edge to the leading edge (+x)
-            if dirty[ix]:
-                _flush_column(pend, zbuf, ix, my, sx, sy, tw, rev)
-                dirty[ix] = False
-            changed = False
-            for iy in range(my):
-                dpx_col[iy] = 0.0
-                dpy_col[iy] = 0.0
-            for iy in range(my):
-                gi = g[iy, ix]
-                if gi <= 0.0:
-                    continue
-                ox = px[iy, ix]
-                oy = py[iy, ix]
-                ssx = sx[iy, ix] - k0x * ox
-                ssy = sy[iy, ix] - k0y * oy
-                tx = -ssx / k0x
-                ty = -ssy / k0y
-                if tx * tx + ty * ty <= gi * gi:
-                    nx_, ny_ = tx, ty
-                    state[iy, ix] = _STICK
-                else:
-                    nx_, ny_ = _local_slip(ssx, ssy, k0x, k0y, gi)
-                    state[iy, ix] = _SLIP
-                dpx = nx_ - ox
-                dpy = ny_ - oy
-                if dpx != 0.0 or dpy != 0.0:
-                    px[iy, ix] = nx_
-                    py[iy, ix] = ny_
-                    dpx_col[iy] = dpx
-                    dpy_col[iy] = dpy
-                    changed = True
-                    # the element's own column at once
-                    for jy in range(my):
-                        d = jy - iy + my - 1
-                        sx[jy, ix] += kxx[d, c0] * dpx + kxy[d, c0] * dpy
-                        sy[jy, ix] += kxy[d, c0] * dpx + kyy[d, c0] * dpy
-                    err = max(err, abs(dpx), abs(dpy))
-                pmax = max(pmax, abs(nx_), abs(ny_))
-            if changed:  # the other columns, by FFT
-                for f in range(n):
-                    zbuf[f] = 0.0
+    err = 0.0
+    pref = 1.0
+    if gmax > 0.0:
+        k0x = dgx
+        k0y = dgy
+        _full_slip_field(pxt, pyt, wxt, wyt, cmin, cmax, spec, mx, my, sxt, syt, work, dirty)
+        pref = gmax
+        err_min = np.inf
+        for _ in range(max_iter):
+            sweeps += 1
+            err = 0.0
+            pmax = 0.0
+            for ix in range(cmin, cmax + 1):  # from the trailing edge to the leading edge (+x)
+                if dirty[ix]:
+                    _flush_column(pr_, pi_, zr, zi, ix, my, sxt, syt, sfft)
+                    dirty[ix] = False
+                changed = False
+                dpx_col[:] = 0.0
+                dpy_col[:] = 0.0
+                scx = sxt[ix]
+                scy = syt[ix]
                 for iy in range(my):
-                    zbuf[iy] = complex(dpx_col[iy], dpy_col[iy])
-                _push_column(pend, zbuf, zcon, ix, cmin, cmax, phat, qhat, tw, rev, mx, True)
-                for jx in range(cmin, cmax + 1):
-                    if jx != ix:
-                        dirty[jx] = True
-        pref = max(pmax, 1e-12 * gmax)
-        if err <= tol * pref:
-            break
-        # divergence guard: relative change 1e3 x its minimum -> larger diagonal, restart
-        rel = err / pref
-        err_min = min(err_min, rel)
-        if rel > 1e3 * err_min or not math.isfinite(rel):
-            k0x *= 1.3
-            k0y *= 1.3
-            err_min = np.inf
-            for iy in range(my):
-                for ix in range(mx):
-                    px[iy, ix] = 0.0
-                    py[iy, ix] = 0.0
-            _full_slip_field(px, py, wx, wy, cmin, cmax, spec, mx, my, sx, sy, pend, dirty,
-                             zbuf, zcon)  # fmt: skip
-    # exact slip for the output (removes round-off accumulated by the updates)
-    _full_slip_field(px, py, wx, wy, cmin, cmax, spec, mx, my, sx, sy, pend, dirty, zbuf, zcon)
+                    gi = gt[ix, iy]
+                    if gi <= 0.0:
+                        continue
+                    ox = pxt[ix, iy]
+                    oy = pyt[ix, iy]
+                    ssx = scx[iy] - k0x * ox
+                    ssy = scy[iy] - k0y * oy
+                    tx = -ssx / k0x
+                    ty = -ssy / k0y
+                    if tx * tx + ty * ty <= gi * gi:
+                        nx_, ny_ = tx, ty
+                        stt[ix, iy] = _STICK
+                    else:
+                        nx_, ny_ = _local_slip(ssx, ssy, k0x, k0y, gi)
+                        stt[ix, iy] = _SLIP
+                    dpx = nx_ - ox
+                    dpy = ny_ - oy
+                    if dpx != 0.0 or dpy != 0.0:
+                        pxt[ix, iy] = nx_
+                        pyt[ix, iy] = ny_
+                        dpx_col[iy] = dpx
+                        dpy_col[iy] = dpy
+                        changed = True
+                        _column_update(scx, scy, k0xx, k0xy, k0yy, iy, my, dpx, dpy)
+                        err = max(err, abs(dpx), abs(dpy))
+                    pmax = max(pmax, abs(nx_), abs(ny_))
+                if changed:  # the other columns, by FFT
+                    zr[:] = 0.0
+                    zi[:] = 0.0
+                    zr[:my] = dpx_col
+                    zi[:my] = dpy_col
+                    _push_column(pr_, pi_, zr, zi, cr, ci, ix, cmin, cmax, phat, qhat, sfft, mx,
+                                 True)  # fmt: skip
+                    for jx in range(cmin, cmax + 1):
+                        if jx != ix:
+                            dirty[jx] = True
+            pref = max(pmax, 1e-12 * gmax)
+            if err <= tol * pref:
+                break
+            # divergence guard: relative change 1e3 x its minimum -> larger diagonal, restart
+            rel = err / pref
+            err_min = min(err_min, rel)
+            if rel > 1e3 * err_min or not math.isfinite(rel):
+                k0x *= 1.3
+                k0y *= 1.3
+                err_min = np.inf
+                pxt[:] = 0.0
+                pyt[:] = 0.0
+                _full_slip_field(pxt, pyt, wxt, wyt, cmin, cmax, spec, mx, my, sxt, syt, work,
+                                 dirty)  # fmt: skip
+        # exact slip for the output (removes round-off accumulated by the updates)
+        _full_slip_field(pxt, pyt, wxt, wyt, cmin, cmax, spec, mx, my, sxt, syt, work, dirty)
+    else:
+        sxt[:] = wxt
+        syt[:] = wyt
     for iy in range(my):
         for ix in range(mx):
-            if g[iy, ix] <= 0.0:
-                sx[iy, ix] = 0.0
-                sy[iy, ix] = 0.0
-            elif state[iy, ix] == _STICK:
-                sx[iy, ix] = 0.0  # zero up to the solver tolerance
-                sy[iy, ix] = 0.0
+            px[iy, ix] = pxt[ix, iy]
+            py[iy, ix] = pyt[ix, iy]
+            if gt[ix, iy] <= 0.0:
+                state[iy, ix] = _EXTERIOR
+                sx[iy, ix] = 0.0 if gmax > 0.0 else sxt[ix, iy]
+                sy[iy, ix] = 0.0 if gmax > 0.0 else syt[ix, iy]
+            else:
+                state[iy, ix] = stt[ix, iy]
+                if stt[ix, iy] == _STICK:
+                    sx[iy, ix] = 0.0  # zero up to the solver tolerance
+                    sy[iy, ix] = 0.0
+                else:
+                    sx[iy, ix] = sxt[ix, iy]
+                    sy[iy, ix] = syt[ix, iy]
     return sweeps, err / pref
+
+
+@jit(error_model="python", fastmath=True, inline="always")
+def _column_update(scx, scy, k0xx, k0xy, k0yy, iy, my, dpx, dpy):
+    """s_J += K(J - I) dp for the elements J of the column of element I (row ``iy``)."""
+    off = my - 1 - iy
+    for jy in range(my):
+        d = jy + off
+        scx[jy] += k0xx[d] * dpx + k0xy[d] * dpy
+        scy[jy] += k0xy[d] * dpx + k0yy[d] * dpy
 
 
 @jit(error_model="python")
