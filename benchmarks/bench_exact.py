@@ -1,7 +1,8 @@
 """Benchmark of the exact steady-rolling solver and of its table model.
 
 Run with ``PYTHONPATH=src python3 benchmarks/bench_exact.py`` (``--quick``: fewer repeats;
-``--table``: the table model only).
+``--table``: the table model only; ``--before REV``: the solver of this checkout beside the
+solver of git revision REV, side by side).
 Prints:
 
 * the exact solver's wall-clock time per case (median of the repeats, after compilation) at
@@ -15,17 +16,27 @@ Prints:
   contacts in the same run (issue 12 target: at most 10x Polach), with Coulomb friction,
   with falling friction, and at nu = 0.25. Both run in parallel at these sizes.
 
+* with ``--before REV`` (e.g. ``--before 2a7873f``, the solver before its influence sums were
+  done by FFT): the time per case at 30 x 30 and 60 x 60 of both solvers, each run in its own
+  process (``git archive REV src`` unpacked to a temporary directory), the two processes
+  taking turns; per case the median over the rounds and the median of the per-round ratios.
+
 Timings vary with the load of the machine: quote medians and ratios, with ``uptime``.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import os
 import platform
 import statistics
+import subprocess
+import sys
+import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -58,6 +69,69 @@ def bench_solver(repeat: int) -> None:
                     f"{name:<36} {law_name:<9} {n:>3}x{n:<3} {statistics.median(times):>11.3f} "
                     f"{min(times):>9.3f} {int(r.iterations):>7} {int(r.friction_iterations):>8}"
                 )
+
+
+#: The cases of ``--before``: (name, case, friction law, grid)
+VERSUS = [(name, case, law_name, n) for name, case in CASES.items()
+          for law_name in ("Coulomb", "falling") for n in (30, 60)]  # fmt: skip
+
+_CHILD = """
+import json, sys, time, warnings
+warnings.simplefilter("ignore")
+from railadhesion.contact.exact import exact_rolling
+cases, falling, repeat = json.loads(sys.argv[1])
+exact_rolling(1e-3, 0.0, 0.0, 1e5, 5e-3, 5e-3, 0.3, nx=8, ny=8)
+exact_rolling(1e-3, 0.0, 0.0, 1e5, 5e-3, 5e-3, 0.3, nx=8, ny=8, **falling)
+out = []
+for case, law, n in cases:
+    law = falling if law == "falling" else {}
+    best = float("inf")
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        r = exact_rolling(*case, nx=n, ny=n, **law)
+        best = min(best, time.perf_counter() - t0)
+    out.append([best, int(r.iterations), float(r.fx), float(r.fy)])
+print(json.dumps(out))
+"""
+
+
+def _run_child(src: str, repeat: int) -> list:
+    env = dict(os.environ, PYTHONPATH=src)
+    arg = json.dumps([[[list(c), law, n] for _, c, law, n in VERSUS], FALLING, repeat])
+    res = subprocess.run([sys.executable, "-c", _CHILD, arg], env=env, capture_output=True,
+                         text=True, check=True)  # fmt: skip
+    return json.loads(res.stdout.strip().splitlines()[-1])
+
+
+def bench_before(rev: str, repeat: int, rounds: int) -> None:
+    """The solver of this checkout beside the solver of git revision ``rev``, side by side."""
+    root = Path(__file__).resolve().parent.parent
+    here = str(root / "src")
+    with tempfile.TemporaryDirectory() as tmp:
+        archive = subprocess.run(["git", "-C", str(root), "archive", rev, "src"],
+                                 capture_output=True, check=True).stdout  # fmt: skip
+        subprocess.run(["tar", "-x", "-C", tmp], input=archive, check=True)
+        before = str(Path(tmp) / "src")
+        _run_child(before, 1)  # compile both (numba's cache), not timed
+        _run_child(here, 1)
+        runs = {"before": [], "now": []}
+        for _ in range(rounds):
+            runs["before"].append(_run_child(before, repeat))
+            runs["now"].append(_run_child(here, repeat))
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    print(f"\nexact solver per case, revision {rev} ('before') beside this checkout ('now'): "
+          f"best of {repeat} per round, median over {rounds} rounds taken in turn "
+          f"(load average {load:.2f})")  # fmt: skip
+    print(f"{'case':<36} {'friction':<9} {'grid':>7} {'before [s]':>11} {'now [s]':>9} "
+          f"{'ratio':>6} {'sweeps':>7} {'max |dF|/Fz':>12}")  # fmt: skip
+    for k, (name, case, law, n) in enumerate(VERSUS):
+        tb = [r[k][0] for r in runs["before"]]
+        tn = [r[k][0] for r in runs["now"]]
+        ratio = statistics.median(b / a for a, b in zip(tn, tb, strict=True))
+        rb, rn = runs["before"][0][k], runs["now"][0][k]
+        df = max(abs(rb[2] - rn[2]), abs(rb[3] - rn[3])) / case[3]
+        print(f"{name:<36} {law:<9} {n:>3}x{n:<3} {statistics.median(tb):>11.3f} "
+              f"{statistics.median(tn):>9.3f} {ratio:>6.1f} {rn[1]:>3}/{rb[1]:<3} {df:>12.1e}")
 
 
 def bench_table(repeat: int) -> None:
@@ -135,10 +209,15 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="one repeat (smoke run)")
     parser.add_argument("--table", action="store_true", help="the table model only")
+    parser.add_argument("--before", metavar="REV", help="solver of git revision REV beside "
+                        "this checkout's, side by side (then nothing else)")  # fmt: skip
     args = parser.parse_args(argv)
     repeat = 1 if args.quick else 5
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"python {platform.python_version()}, {platform.machine()}, load average {load:.2f}")
+    if args.before:
+        bench_before(args.before, 1 if args.quick else 3, 1 if args.quick else 3)
+        return
     if not args.table:
         bench_solver(repeat)
     bench_table(repeat)
