@@ -15,10 +15,14 @@ default mode, for two bodies of identical (quasi-identical) elastic materials:
 * Coulomb's law: ``|p| <= mu p_n``; ``s = 0`` where ``|p| < mu p_n`` (stick), else
   ``p = -mu p_n s/|s|`` (slip).
 
-The contact problem is solved by a block Gauss-Seidel iteration, sweeping from the leading to
-the trailing edge, with the exact local solution of Coulomb's law per element (stick trial,
-else a scalar Newton iteration for the slip direction), in numba-compiled code. Many cases
-are solved in one compiled loop (:func:`exact_rolling` broadcasts).
+The contact problem is solved by an element-wise Gauss-Seidel iteration, sweeping from the
+trailing to the leading edge, with the exact local solution of Coulomb's law per element
+(stick trial, else a scalar Newton iteration for the slip direction), in numba-compiled code.
+The influence sums are done by FFT along the columns of the grid (convolution in y, zero
+padded; the Toeplitz structure of the coefficients, as in CONTACT: Vollebregt, J. Comput.
+Phys. 257, 2014), which leaves the iteration unchanged and costs O(nx ny (nx + ny)) per sweep
+instead of O((nx ny)^2) (``_gauss_seidel``). Many cases are solved in one compiled loop
+(:func:`exact_rolling` broadcasts).
 
 Extensions, as in CONTACT: slip-velocity dependent (falling) friction, solved by an outer
 fixed-point iteration on the slip-velocity field (:func:`exact_rolling`, Notes); and the
@@ -554,7 +558,7 @@ def _gauss_seidel(g, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, tol, max_iter, px, p
     done by FFT and kept in Fourier space until the column is visited (:func:`_push_column`,
     :func:`_flush_column`). Columns not yet visited in the sweep thus see every update, as in
     the element-wise Gauss-Seidel iteration with full sums, which this reproduces up to
-    round-off, at O(nx ny log ny) instead of O((nx ny)^2) operations per sweep. The fields
+    round-off, at O(nx ny (nx + ny)) instead of O((nx ny)^2) operations per sweep. The fields
     are worked on transposed (``[ix, iy]``), so that a column is contiguous.
     """
     phat, qhat, twr, twi, rev = spec
@@ -1131,7 +1135,9 @@ def exact_rolling(
 
     Convergence: the discretisation error in the forces decreases about as 1/n; see
     ``docs/validation/exact_solver.md`` for a grid-convergence table and the comparison
-    with CONTACT. The cost per case grows as (nx ny)^2 per sweep.
+    with CONTACT. The influence sums of the Gauss-Seidel sweeps are done by FFT along the
+    grid's columns (the iteration is the same as with direct sums): the cost per sweep grows
+    as nx ny (nx + ny) (docs/exact-solver.md, "Solver: method and cost").
 
     Examples
     --------
