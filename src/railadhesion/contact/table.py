@@ -208,17 +208,23 @@ _PARALLEL_MIN = 100_000
 
 
 @jitable(inline="always")
-def table_scaled_creepages(xi, eta, phi, fz, a, b, mu, g, speed, ratio, decay, c11, c22, c23):
-    """Kalker-scaled creepages (X, Y, S) of the looked-up coefficient of friction, the force
-    scale ``kf`` (that coefficient times Fz) and ``c = sqrt(a b)`` of one contact (module
-    docstring). Falling friction: the coefficient ``mu ((1 - A) exp(-B V |(xi, eta)|) + A)``
-    (Polach's global slip velocity), which divides the creepages and scales the forces."""
+def table_friction_factor(xi, eta, speed, ratio, decay):
+    """The looked-up coefficient of friction over mu: the falling-friction law's factor
+    (:func:`falling_friction_factor`) at Polach's global slip velocity V |(xi, eta)|; 1 for
+    constant friction."""
+    w = speed * math.sqrt(xi * xi + eta * eta)
+    return falling_friction_factor(w, ratio, decay) if w > 0.0 else 1.0
+
+
+@jitable(inline="always")
+def table_scaled_creepages(xi, eta, phi, fz, a, b, mu, g, fac, c11, c22, c23):
+    """Kalker-scaled creepages (X, Y, S) of the looked-up coefficient of friction
+    ``fac mu`` (:func:`table_friction_factor`), the force scale ``kf = fac mu Fz`` and
+    ``c = sqrt(a b)`` of one contact (module docstring); ``fac`` divides the creepages and
+    scales the forces."""
     c = math.sqrt(a * b)
     tau = mu * (1.5 / math.pi) * fz / (a * b * g)  # mu p0 / G
-    f = (1.5 / math.pi) / tau if tau > 0.0 else 0.0
-    w = speed * math.sqrt(xi * xi + eta * eta)
-    fac = falling_friction_factor(w, ratio, decay) if w > 0.0 else 1.0
-    f = f / fac if fac > 0.0 else 0.0
+    f = (1.5 / math.pi) / (tau * fac) if tau * fac > 0.0 else 0.0
     return xi * f * c11, eta * f * c22, phi * c * f * c23, fac * mu * fz, c
 
 
@@ -293,12 +299,13 @@ def exact_table_law(xi, eta, phi, fz, a, b, mu, g, nu, speed, ratio, decay, tab,
 
     ``tab, dims, strides, origin, inv_step``: the 4-D table (:func:`_load`: ``padded_flat``
     and its axes). Kalker's coefficients at (a/b, nu) (:func:`kalker_law`) scale the
-    creepages; then :func:`table_scaled_creepages`, :func:`table_coordinates`,
+    creepages; then :func:`table_friction_factor`, :func:`table_scaled_creepages`,
+    :func:`table_coordinates`,
     :func:`table_sums`, :func:`table_forces` (the batch loop calls the same pieces in stages).
     """
     c11, c22, c23, _ = kalker_law(a / b, nu)
-    x, y, s, kf, c = table_scaled_creepages(xi, eta, phi, fz, a, b, mu, g, speed, ratio, decay,
-                                            c11, c22, c23)  # fmt: skip
+    fac = table_friction_factor(xi, eta, speed, ratio, decay)
+    x, y, s, kf, c = table_scaled_creepages(xi, eta, phi, fz, a, b, mu, g, fac, c11, c22, c23)
     t, th, u, sgn, sy = table_coordinates(x, y, s)
     f0, f1, f2 = table_sums(tab, dims, strides, origin, inv_step, math.log(a / b), t, th, u)
     return table_forces(f0, f1, f2, sgn, sy, kf, c)
@@ -313,10 +320,19 @@ _UNIT = (0.0, 0.0, 1.0, 1.0)
 # arguments, a/b, Kalker's coefficients, then the stages' results.
 _NIN = 12
 _R_RATIO, _R_C11 = 12, 13  # C11, C22, C23 in rows 13-15
-_R_T, _R_TH, _R_U, _R_SGN, _R_SY, _R_KF, _R_C, _R_BASE = range(16, 24)
-_R_W = 24  # 16 rows of cubic weights: t, theta, u, log(a/b)
-_R_F = 40  # the 3 interpolated outputs
-_TROWS = 43
+_R_T, _R_TH, _R_U, _R_SGN, _R_SY, _R_KF, _R_C, _R_BASE, _R_FAC = range(16, 25)
+_R_W = 25  # 16 rows of cubic weights: t, theta, u, log(a/b)
+_R_F = 41  # the 3 interpolated outputs
+_TROWS = 44
+
+
+@jit
+def _stage_friction(buf, m):
+    """Row _R_FAC of the chunk: :func:`table_friction_factor`."""
+    for k in range(m):
+        buf[_R_FAC * CHUNK + k] = table_friction_factor(
+            buf[k], buf[CHUNK + k], buf[9 * CHUNK + k], buf[10 * CHUNK + k],
+            buf[11 * CHUNK + k])  # fmt: skip
 
 
 @jit
@@ -325,9 +341,9 @@ def _stage_scaled(buf, m):
     for k in range(m):
         x, y, s, kf, c = table_scaled_creepages(
             buf[k], buf[CHUNK + k], buf[2 * CHUNK + k], buf[3 * CHUNK + k], buf[4 * CHUNK + k],
-            buf[5 * CHUNK + k], buf[6 * CHUNK + k], buf[7 * CHUNK + k], buf[9 * CHUNK + k],
-            buf[10 * CHUNK + k], buf[11 * CHUNK + k], buf[_R_C11 * CHUNK + k],
-            buf[(_R_C11 + 1) * CHUNK + k], buf[(_R_C11 + 2) * CHUNK + k])  # fmt: skip
+            buf[5 * CHUNK + k], buf[6 * CHUNK + k], buf[7 * CHUNK + k], buf[_R_FAC * CHUNK + k],
+            buf[_R_C11 * CHUNK + k], buf[(_R_C11 + 1) * CHUNK + k],
+            buf[(_R_C11 + 2) * CHUNK + k])  # fmt: skip
         t, th, u, sgn, sy = table_coordinates(x, y, s)
         buf[_R_T * CHUNK + k] = t
         buf[_R_TH * CHUNK + k] = th
@@ -339,17 +355,19 @@ def _stage_scaled(buf, m):
 
 
 @jit
-def _stage_weights(buf, m, row, v0, inv_h, n, stride, wrow):
-    """Cubic weights along one axis (coordinate in ``row``) into rows ``wrow`` to
-    ``wrow + 3``; the axis' part of the first table row of each contact added to _R_BASE."""
+def _stage_weights(v, v0, inv_h, n, stride, base, w, m):
+    """Cubic weights along one axis (coordinates ``v``) into the rows of ``w`` (4, CHUNK);
+    the axis' part of each contact's first table row (node index times ``stride``) added to
+    ``base`` (views of the chunk buffer: few arrays, so that the loop is SIMD code)."""
+    w0, w1, w2, w3 = w[0], w[1], w[2], w[3]
     for k in range(m):
-        i, f = _locate_uniform(buf[row * CHUNK + k], v0, inv_h, n)
+        i, f = _locate_uniform(v[k], v0, inv_h, n)
         c0, c1, c2, c3 = _catmull_rom(f)
-        buf[wrow * CHUNK + k] = c0
-        buf[(wrow + 1) * CHUNK + k] = c1
-        buf[(wrow + 2) * CHUNK + k] = c2
-        buf[(wrow + 3) * CHUNK + k] = c3
-        buf[_R_BASE * CHUNK + k] += i * stride
+        w0[k] = c0
+        w1[k] = c1
+        w2[k] = c2
+        w3[k] = c3
+        base[k] = base[k] + i * stride
 
 
 @jit
@@ -404,6 +422,11 @@ def _table_chunks(xi, eta, phi, fz, a, b, mu, g, nu, v, la, lb, kc, tab, dims, s
         for j in range(3):
             fill(buf[(_R_C11 + j) * CHUNK :], kc[j, 0], count)
     sa = strides[0]
+    # constant friction for every contact (A = 1 or B V = 0, values shared by all)
+    coulomb = la.size == 1 and lb.size == 1 and v.size == 1 and not (la[0] != 1.0
+                                                                      and lb[0] * v[0] > 0.0)
+    if coulomb:
+        fill(buf[_R_FAC * CHUNK :], 1.0, count)
     nbad = 0
     for c in range(first, last):
         lo = c * CHUNK
@@ -436,15 +459,24 @@ def _table_chunks(xi, eta, phi, fz, a, b, mu, g, nu, v, la, lb, kc, tab, dims, s
                 dst = buf[(_R_C11 + j) * CHUNK :]
                 for k in range(m):
                     dst[k] = kc[j, lo + k]
+        if not coulomb:
+            _stage_friction(buf, m)
         _stage_scaled(buf, m)
-        fill(buf[_R_BASE * CHUNK :], 0.0, m)
-        _stage_weights(buf, m, _R_T, origin[1], inv_step[1], dims[1], strides[1], _R_W)
-        _stage_weights(buf, m, _R_TH, origin[2], inv_step[2], dims[2], strides[2], _R_W + 4)
-        _stage_weights(buf, m, _R_U, origin[3], inv_step[3], dims[3], strides[3], _R_W + 8)
+        rows = buf.reshape(_TROWS, CHUNK)
+        base = rows[_R_BASE]
+        fill(base, 0.0, m)
+        _stage_weights(rows[_R_T], origin[1], inv_step[1], dims[1], strides[1], base,
+                       rows[_R_W : _R_W + 4], m)  # fmt: skip
+        _stage_weights(rows[_R_TH], origin[2], inv_step[2], dims[2], strides[2], base,
+                       rows[_R_W + 4 : _R_W + 8], m)  # fmt: skip
+        _stage_weights(rows[_R_U], origin[3], inv_step[3], dims[3], strides[3], base,
+                       rows[_R_W + 8 : _R_W + 12], m)  # fmt: skip
         if sa > 0:
+            laob = rows[_R_RATIO]
             for k in range(m):
-                buf[_R_RATIO * CHUNK + k] = math.log(buf[_R_RATIO * CHUNK + k])
-            _stage_weights(buf, m, _R_RATIO, origin[0], inv_step[0], dims[0], sa, _R_W + 12)
+                laob[k] = math.log(laob[k])
+            _stage_weights(laob, origin[0], inv_step[0], dims[0], sa, base,
+                           rows[_R_W + 12 : _R_W + 16], m)  # fmt: skip
         _stage_sums(tab, buf, m, strides[1], strides[2], sa)
         _stage_forces(buf, m, ox, oy, oz)
     return nbad
