@@ -11,10 +11,12 @@ Prints:
   Coulomb friction and with falling friction (Polach's dry law at 30 m/s), plus the number
   of Gauss-Seidel sweeps (and friction updates). CONTACT (Fortran) needs about 26 ms and
   0.6 s per case at these sizes (issue 12);
-* the table model's cost per contact, vectorised over 200 000 and 1 000 000 contacts with
-  spin (one a/b for all: the 3-D lookup), beside the package's vectorised Polach on the same
-  contacts in the same run (issue 12 target: at most 10x Polach), with Coulomb friction,
-  with falling friction, and at nu = 0.25. Both run in parallel at these sizes.
+* the table model's cost per contact, vectorised over 100 000 and 1 000 000 contacts with
+  spin, beside the package's vectorised Polach on the same inputs in the same run (issue 22
+  target: at most 3x Polach): a/b (and Fz) varying per contact (the 4-D lookup, Kalker's
+  coefficients per contact for both models), a and b as arrays of equal values, a and b
+  given once (the 3-D lookup); Coulomb friction, falling friction and nu = 0.25. Both run
+  in parallel at these sizes (``NUMBA_NUM_THREADS=1`` for one thread).
 
 * with ``--before REV`` (e.g. ``--before 2a7873f``, the solver before its influence sums were
   done by FFT): the time per case at 30 x 30 and 60 x 60 of both solvers, each run in its own
@@ -38,6 +40,7 @@ import tempfile
 import time
 from pathlib import Path
 
+import numba
 import numpy as np
 
 from railadhesion.contact.exact import exact_rolling
@@ -135,7 +138,7 @@ def bench_before(rev: str, repeat: int, rounds: int) -> None:
 
 
 def bench_table(repeat: int) -> None:
-    for n in (200_000, 1_000_000):
+    for n in (100_000, 1_000_000):
         _bench_table(n, repeat)
     bench_table_scalar(repeat)
 
@@ -171,6 +174,11 @@ def _bench_table(n: int, repeat: int) -> None:
     ys = rng.uniform(-3e-3, 3e-3, n)
     ps = rng.uniform(-1, 1, n)
     fz, mu, v, a, b = 1e5, 0.3, 30.0, 5e-3, 6e-3
+    # a/b varying per contact (as in a multibody run: every wheel its own ellipse), 0.4-2.7
+    av = rng.uniform(3e-3, 8e-3, n)
+    bv = rng.uniform(3e-3, 8e-3, n)
+    fzv = rng.uniform(5e4, 1.2e5, n)
+    ae, be = np.full(n, a), np.full(n, b)  # arrays of equal values
 
     def best(ft, fp):
         """Best times of the table and of Polach, run alternately (a change of the machine's
@@ -186,23 +194,33 @@ def _bench_table(n: int, repeat: int) -> None:
         return min(times[0]), min(times[1])
 
     rows = [
-        ("Coulomb",
+        ("Coulomb, a/b varying",
+         lambda: exact_table_forces(xs, ys, ps, fzv, av, bv, mu),
+         lambda: polach_forces(xs, ys, ps, fzv, v, av, bv, mu0=mu)),
+        ("falling, a/b varying",
+         lambda: exact_table_forces(xs, ys, ps, fzv, av, bv, mu, **FALLING),
+         lambda: polach_forces(xs, ys, ps, fzv, v, av, bv, mu0=mu, A=0.4, B=0.6)),
+        ("Coulomb, a, b equal arrays",
+         lambda: exact_table_forces(xs, ys, ps, fz, ae, be, mu),
+         lambda: polach_forces(xs, ys, ps, fz, v, ae, be, mu0=mu)),
+        ("Coulomb, a, b given once",
          lambda: exact_table_forces(xs, ys, ps, fz, a, b, mu),
          lambda: polach_forces(xs, ys, ps, fz, v, a, b, mu0=mu)),
-        ("falling (A 0.4, B 0.6)",
+        ("falling (A 0.4, B 0.6), once",
          lambda: exact_table_forces(xs, ys, ps, fz, a, b, mu, **FALLING),
          lambda: polach_forces(xs, ys, ps, fz, v, a, b, mu0=mu, A=0.4, B=0.6)),
-        ("Coulomb, nu = 0.25",
+        ("Coulomb, nu = 0.25, once",
          lambda: exact_table_forces(xs, ys, ps, fz, a, b, mu, poisson=0.25),
          lambda: polach_forces(xs, ys, ps, fz, v, a, b, mu0=mu, poisson=0.25)),
     ]  # fmt: skip
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
-    print(f"\ntable model vs Polach, {n:,} contacts with spin (best of {repeat}; load average "
-          f"{load:.2f}):")  # fmt: skip
-    print(f"{'friction':<24} {'table [us]':>11} {'Polach [us]':>12} {'ratio':>7}")
+    threads = numba.get_num_threads()
+    print(f"\ntable model vs Polach, {n:,} contacts with spin, the same inputs to both (best of "
+          f"{repeat}, {threads} threads; load average {load:.2f}):")  # fmt: skip
+    print(f"{'contacts':<30} {'table [us]':>11} {'Polach [us]':>12} {'ratio':>7}")
     for name, ft, fp in rows:
         tt, tp = best(ft, fp)
-        print(f"{name:<24} {tt / n * 1e6:>11.3f} {tp / n * 1e6:>12.3f} {tt / tp:>7.1f}")
+        print(f"{name:<30} {tt / n * 1e6:>11.3f} {tp / n * 1e6:>12.3f} {tt / tp:>7.1f}")
 
 
 def main(argv=None) -> None:

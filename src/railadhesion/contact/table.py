@@ -376,15 +376,24 @@ def _stage_sums(tab, buf, m, st, sd, sa):
     log(a/b), the planes sa apart) into rows _R_F to _R_F + 2."""
     for k in range(m):
         o = int(buf[_R_BASE * CHUNK + k])
-        w = buf[_R_W * CHUNK + k :: CHUNK]  # the 16 weights of contact k
-        f0 = f1 = f2 = 0.0
-        for q in range(4 if sa > 0 else 1):
-            wa = w[12 + q] if sa > 0 else 1.0
-            p0, p1, p2 = cubic_block_sums(tab, o + q * sa, st, sd, w[0], w[1], w[2], w[3], w[4],
-                                          w[5], w[6], w[7], w[8], w[9], w[10], w[11])  # fmt: skip
-            f0 += wa * p0
-            f1 += wa * p1
-            f2 += wa * p2
+        r = _R_W * CHUNK + k  # the 12 weights along t, theta, u, CHUNK apart
+        w0, w1, w2, w3 = buf[r], buf[r + CHUNK], buf[r + 2 * CHUNK], buf[r + 3 * CHUNK]
+        r += 4 * CHUNK
+        w4, w5, w6, w7 = buf[r], buf[r + CHUNK], buf[r + 2 * CHUNK], buf[r + 3 * CHUNK]
+        r += 4 * CHUNK
+        w8, w9, w10, w11 = buf[r], buf[r + CHUNK], buf[r + 2 * CHUNK], buf[r + 3 * CHUNK]
+        if sa == 0:
+            f0, f1, f2 = cubic_block_sums(tab, o, st, sd, w0, w1, w2, w3, w4, w5, w6, w7, w8,
+                                          w9, w10, w11)  # fmt: skip
+        else:
+            f0 = f1 = f2 = 0.0
+            for q in range(4):
+                wa = buf[(_R_W + 12 + q) * CHUNK + k]
+                p0, p1, p2 = cubic_block_sums(tab, o + q * sa, st, sd, w0, w1, w2, w3, w4, w5,
+                                              w6, w7, w8, w9, w10, w11)  # fmt: skip
+                f0 += wa * p0
+                f1 += wa * p1
+                f2 += wa * p2
         buf[_R_F * CHUNK + k] = f0
         buf[(_R_F + 1) * CHUNK + k] = f1
         buf[(_R_F + 2) * CHUNK + k] = f2
