@@ -651,9 +651,10 @@ def exact_table_forces(
                              float(speed) if _is_real(speed) else speed,
                              float(friction_ratio), float(friction_decay))  # fmt: skip
         if res is not None:
-            # implausible inputs warn (docs/checks.md)
-            _PLAUSIBLE((creep_long, creep_lat, spin, normal_force, a, b, speed, shear_modulus,
-                        poisson))  # fmt: skip
+            # implausible inputs warn (docs/checks.md); no speed: nothing to check (0.0 keeps
+            # the checker's fast test for floats)
+            _PLAUSIBLE((creep_long, creep_lat, spin, normal_force, a, b,
+                        0.0 if speed is None else speed, shear_modulus, poisson))  # fmt: skip
             return res
     names = ("creep_long", "creep_lat", "spin", "normal_force", "a", "b", "mu",
              "shear_modulus", "poisson", "speed", "friction_ratio", "friction_decay")  # fmt: skip
