@@ -558,7 +558,7 @@ def run_chunks(func, args, nchunk: int, parallel: bool) -> list:
 def cubic_block_sums(tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd2, wd3, wu0, wu1, wu2,
                      wu3):  # fmt: skip
     """Weighted sum of a 4 x 4 x 4 block of a table of rows of 3 values (the cubic
-    interpolation of a 3-D table, e.g. :mod:`railadhesion.contact.table`):
+    interpolation of a 3-D table, e.g. the table model ``railadhesion.contact.table``):
     ``sum over qt, qd, qu = 0..3 of wt[qt] wd[qd] wu[qu] tab[base + qt st + qd sd + 3 qu + j]``
     for j = 0, 1, 2; returns the three sums. The 4 nodes along the last axis are 12
     contiguous values.

@@ -70,7 +70,7 @@ from railadhesion.numerics import (
 )
 from railadhesion.plausibility import input_checker
 
-__all__ = ["exact_table_forces", "table_axes"]
+__all__ = ["exact_table_forces", "exact_table_law", "table_axes"]
 
 #: Poisson's ratio of the table.
 TABLE_POISSON = 0.28
@@ -295,13 +295,16 @@ def table_sums(tab, dims, strides, origin, inv_step, laob, t, th, u):
 def exact_table_law(xi, eta, phi, fz, a, b, mu, g, nu, speed, ratio, decay, tab, dims, strides,
                     origin, inv_step):  # fmt: skip
     """Creep forces (Fx, Fy, Mz) of one contact by the table model: the law of
-    :func:`exact_table_forces` (its Notes), without validation (inputs in its ranges).
+    :func:`exact_table_forces` (its Notes), without validation (inputs in its ranges), for
+    compiled code (``numba``; a :func:`~railadhesion.numerics.jitable` function).
 
-    ``tab, dims, strides, origin, inv_step``: the 4-D table (:func:`_load`: ``padded_flat``
-    and its axes). Kalker's coefficients at (a/b, nu) (:func:`kalker_law`) scale the
-    creepages; then :func:`table_friction_factor`, :func:`table_scaled_creepages`,
-    :func:`table_coordinates`,
-    :func:`table_sums`, :func:`table_forces` (the batch loop calls the same pieces in stages).
+    ``tab, dims, strides, origin, inv_step``: the 4-D table with its axes (the package data
+    as loaded by ``railadhesion.contact.table._load``: ``padded_flat``, ``dims``,
+    ``strides``, ``origin``, ``inv_step``). Kalker's coefficients at (a/b, nu)
+    (:func:`~railadhesion.contact.kalker.kalker_law`) scale the creepages; then the pieces
+    ``table_friction_factor``, ``table_scaled_creepages``, ``table_coordinates``,
+    ``table_sums`` and ``table_forces`` of the same module, which the batch loop of
+    :func:`exact_table_forces` calls in stages.
     """
     c11, c22, c23, _ = kalker_law(a / b, nu)
     fac = table_friction_factor(xi, eta, speed, ratio, decay)
