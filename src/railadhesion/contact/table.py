@@ -26,8 +26,13 @@ discretisation error (its excess stiffness).
 The table is solved with Coulomb friction at nu = 0.28 (steel); Poisson's ratios 0.25-0.30 are
 served by scaling with Kalker's coefficients at that nu, and falling friction by one
 coefficient per contact at Polach's global slip velocity (see :func:`exact_table_forces` for
-both and for where they are accurate). When all contacts share one a/b (the usual case) the
-table is first interpolated to that a/b and the lookup is 3-D.
+both and for where they are accurate). When all contacts share one a/b and nu (given once,
+or as arrays of equal values) the table is first interpolated to that a/b and the lookup is
+3-D.
+
+One law, one implementation: the lookup of one contact is :func:`exact_table_law` (a
+``jitable`` function for compiled code: drivers, integrators, FMUs), made of pieces that the
+batch loop of :func:`exact_table_forces` calls in stages over chunks of contacts.
 """
 
 from __future__ import annotations
