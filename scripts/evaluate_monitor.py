@@ -136,14 +136,14 @@ def _summarise(results):
     }
 
 
-def _run_group(conditions, speeds, creep, modulation, seeds, progress):
+def _run_group(conditions, speeds, creep, modulation, seeds, progress, runner=run_case):
     out = {}
     for cond in conditions:
         results = []
         for v in speeds:
             for seed in seeds:
-                results.append(run_case(MonitorCase(condition=cond, speed=v, creep=creep,
-                                                    modulation=modulation, seed=seed)))
+                results.append(runner(MonitorCase(condition=cond, speed=v, creep=creep,
+                                                  modulation=modulation, seed=seed)))
                 progress()
         out[cond] = (_summarise(results), results)
     return out
@@ -247,11 +247,11 @@ def main() -> None:
     steady = _run_group(conditions, few, 0.005, 0.0, range(2), progress)
     print(f"dry rail, {args.dry_km:g} km", flush=True)
     dry = run_dry_distance(args.dry_km * 1e3, seed=11)
-    try:
-        traction = run_traction_case(MonitorCase(condition="polach_wet_0.08", speed=30.0))
-        traction = traction.summary
-    except NotImplementedError as exc:
-        traction = {"skipped": str(exc)}
+    traction_groups = {}
+    for creep in (0.002, 0.005, 0.01):
+        print(f"traction only, {creep:.1%} creep", flush=True)
+        traction_groups[creep] = _run_group(conditions, few, creep, 0.25, range(1), progress,
+                                            runner=run_traction_case)
     # figures
     low_res = next(r for r in main_groups["polach_wet_0.08"][1] if r.case.speed == 40.0)
     _track_figure(low_res, FIGURES / "monitor_track_low.png",
@@ -266,7 +266,10 @@ def main() -> None:
         "main_0.5pct_modulated": summaries,
         "creep": {f"{k:.3f}": {c: g for c, (g, _) in v.items()} for k, v in creep_groups.items()},
         "steady_0.5pct": {c: g for c, (g, _) in steady.items()},
-        "dry": dry, "traction": traction, "wall_s": time.time() - t0,
+        "dry": dry,
+        "traction": {f"{k:.3f}": {c: g for c, (g, _) in v.items()}
+                     for k, v in traction_groups.items()},
+        "wall_s": time.time() - t0,
         "load_average_end": os.getloadavg()[0],
     }
     (args.out / "results.json").write_text(json.dumps(results, indent=1), encoding="utf-8")
@@ -276,7 +279,9 @@ def main() -> None:
     print(_table({c: g for c, (g, _) in steady.items()}, "steady demand, 0.5 % creep"))
     dry = {k: v for k, v in dry.items() if k != "low_examples"}
     print("\ndry rail:", json.dumps(dry))
-    print("traction:", json.dumps(traction)[:300])
+    for k, v in traction_groups.items():
+        print(_table({c: g for c, (g, _) in v.items()},
+                     f"traction only, {k:.1%} creep, {'/'.join(f'{x:g}' for x in few)} m/s"))
     print(f"\n{time.time() - t0:.0f} s; results in {args.out / 'results.json'}")
 
 

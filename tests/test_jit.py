@@ -90,3 +90,19 @@ def test_kernel_entry_calls_the_compiled_code():
 
     entry = kernel_entry(add, (1.0, 2.0))
     assert entry(3.0, 4.0) == 7.0
+    # fails loudly when numba's internals change: kernel_entry's fallback would keep the
+    # package working (through the dispatcher, a few hundred ns slower a call), unnoticed
+    assert entry is not add, "numba's overloads[...].entry_point is gone: see _jit.kernel_entry"
+
+
+def test_guard_cache_finds_numbas_cache_directory():
+    """guard_cache reads numba's private ``dispatcher._cache._cache_path``: fail loudly if
+    numba moves it."""
+    from numba import njit
+
+    @njit(cache=True)
+    def cached():
+        return 1
+
+    assert cached() == 1
+    assert isinstance(cached._cache._cache_path, str), "see _jit.guard_cache"

@@ -267,23 +267,3 @@ def test_installed_numba_and_llvmlite_are_within_the_declared_bounds(name):
     low, high = _declared_bound(name)
     installed = _version(metadata.version(name))
     assert _version(low) <= installed < _version(high), (name, installed, low, high)
-
-
-@numba.njit
-def _block_sums_compiled(tab, base, st, sd, w):
-    return numerics.cubic_block_sums(tab, base, st, sd, w[0], w[1], w[2], w[3], w[4], w[5], w[6],
-                                     w[7], w[8], w[9], w[10], w[11])  # fmt: skip
-
-
-def test_hand_written_block_sums_equal_the_plain_function():
-    """The package's one piece of hand-written LLVM IR (numerics.cubic_block_sums compiled)
-    against its plain Python definition, at strides and weights of every kind."""
-    rng = np.random.default_rng(8)
-    tab = rng.uniform(-1.0, 1.0, 4000)
-    for st, sd in ((300, 40), (48, 12), (12, 700)):
-        for _ in range(30):
-            base = int(rng.integers(0, 4000 - 3 * st - 3 * sd - 12))
-            w = rng.uniform(-0.2, 1.2, 12)
-            got = _block_sums_compiled(tab, base, st, sd, w)
-            want = numerics.cubic_block_sums(tab, base, st, sd, *w)
-            np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-14)

@@ -28,6 +28,9 @@ from rich.markup import escape
 EXIT_ERROR = 2
 #: Exit code when a result is not trustworthy (and ``--allow-untrusted`` was not given).
 EXIT_UNTRUSTED = 3
+#: Exit code of a test bench (``wsp-test``, ``odometry-test``) when a case or fit failed its
+#: checks or could not run: the unit under test failed, not the program (code 1 stays "a bug").
+EXIT_CHECKS_FAILED = 4
 
 ALLOW_HELP = ("Exit with code 0 even if a result is not trustworthy (an untrusted fit, a train "
               "that did not stop, NaN results, failed points); without it such results exit "

@@ -105,13 +105,21 @@ def export_fmu(
 def export_braking_fmu(
     scenario: Path = typer.Argument(..., help="Braking scenario TOML (docs/braking.md)."),
     out: Path = typer.Option(Path("braking.fmu"), help="The FMU file to write (.fmu)."),
+    native: bool = typer.Option(
+        False, "--native",
+        help="Compile the braking step into the FMU (linux64 binary and its sources): no "
+             "Python on the host. Needs a C compiler here. Default: the Python FMU.",
+    ),  # fmt: skip
 ) -> None:
     """Write the braking vehicle of SCENARIO as an FMI 2.0 co-simulation FMU (inputs: commanded
-    pressure and WSP valve per axle; needs Python on the host)."""
-    from railadhesion.export import build_braking_fmu
+    pressure and WSP valve per axle; the Python FMU needs Python on the host, --native not)."""
+    from railadhesion.export import NativeBuildError, build_braking_fmu, build_native_braking_fmu
 
+    build = build_native_braking_fmu if native else build_braking_fmu
     try:
-        path = build_braking_fmu(out, scenario)
+        path = build(out, scenario)
+    except NativeBuildError as exc:
+        _fail(f"no native FMU: {exc}")
     except ValueError as exc:
         _fail(exc)
     except OSError as exc:

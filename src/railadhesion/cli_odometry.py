@@ -10,6 +10,8 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
+from railadhesion.cli_checks import EXIT_CHECKS_FAILED
+
 console = Console()
 _ROUTINE = ("slide", "spin", "dead_reckoning")
 
@@ -40,7 +42,7 @@ def register(app: typer.Typer) -> None:
         quiet: bool = typer.Option(False, help="No progress lines."),
     ) -> None:
         """Run an odometry programme: per case and fit JSON/CSV, every violation of the
-        interval, figures; exit status 1 if a fit failed a check or could not run (the
+        interval, figures; exit status 4 if a fit failed a check or could not run (the
         results of the others are written)."""
         from railadhesion.braking.odometry_bench import (
             OdometryInterfaceError,
@@ -118,4 +120,4 @@ def register(app: typer.Typer) -> None:
             "without", highlight=False)
         console.print(f"outputs written to {escape(str(out))}")
         if result.failed or o["fit_errors"]:
-            raise typer.Exit(code=1)
+            raise typer.Exit(code=EXIT_CHECKS_FAILED)

@@ -10,6 +10,8 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
+from railadhesion.cli_checks import EXIT_CHECKS_FAILED
+
 console = Console()
 
 
@@ -39,7 +41,7 @@ def register(app: typer.Typer) -> None:
                                                    "(Parquet)."),
         quiet: bool = typer.Option(False, help="No progress lines."),
     ) -> None:
-        """Run a WSP test programme: per case and overall JSON/CSV, figures; exit status 1 if a
+        """Run a WSP test programme: per case and overall JSON/CSV, figures; exit status 4 if a
         case failed a check or could not run (the results of the others are written)."""
         from railadhesion.braking.bench import (
             WSPControllerError,
@@ -97,4 +99,4 @@ def register(app: typer.Typer) -> None:
             f"{_fmt(o['total_vented_air_l'], '.0f')} l", highlight=False)
         console.print(f"outputs written to {escape(str(out))}")
         if result.failed:
-            raise typer.Exit(code=1)
+            raise typer.Exit(code=EXIT_CHECKS_FAILED)

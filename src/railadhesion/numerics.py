@@ -56,7 +56,6 @@ __all__ = [
     "cache_directory",
     "chunk_of",
     "count_outside",
-    "cubic_block_sums",
     "exp",
     "fill",
     "fill_row",
@@ -121,7 +120,6 @@ def load_numba():
 
             for func, inline in _JITABLE:
                 _register(func, inline)
-            _register_block_sums(numba)
             _STATE["numba"] = numba
         return _STATE["numba"]
 
@@ -550,113 +548,3 @@ def run_chunks(func, args, nchunk: int, parallel: bool) -> list:
     for helper in helpers:
         helper.result()
     return results
-
-
-# --- cubic block sums: the one piece of hand-written LLVM IR ------------------------------------
-
-
-def cubic_block_sums(tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd2, wd3, wu0, wu1, wu2,
-                     wu3):  # fmt: skip
-    """Weighted sum of a 4 x 4 x 4 block of a table of rows of 3 values (the cubic
-    interpolation of a 3-D table, e.g. the table model ``railadhesion.contact.table``):
-    ``sum over qt, qd, qu = 0..3 of wt[qt] wd[qd] wu[qu] tab[base + qt st + qd sd + 3 qu + j]``
-    for j = 0, 1, 2; returns the three sums. The 4 nodes along the last axis are 12
-    contiguous values.
-
-    This plain function is the definition (and what Python calls); compiled code calls a
-    version written in LLVM vector operations (:func:`load_numba` registers it with numba's
-    public extension API, ``overload`` and ``intrinsic``), which loads the 12 contiguous values
-    as one vector. **Why hand-written IR**: numba does not vectorise such short fixed loops
-    (they are unrolled before its loop vectoriser runs, and its SLP vectoriser is off), and
-    the same sums in plain numba code made the table model's lookup about three times slower
-    (measured side by side, one thread: ``docs/kernels.md``). ``tests/test_numerics.py``
-    holds the compiled version to this one. The only LLVM IR of the package.
-    """
-    wt = (wt0, wt1, wt2, wt3)
-    wd = (wd0, wd1, wd2, wd3)
-    wu = (wu0, wu1, wu2, wu3)
-    out = [0.0, 0.0, 0.0]
-    for j in range(3):
-        for qu in range(4):
-            acc = 0.0
-            for qt in range(4):
-                part = 0.0
-                for qd in range(4):
-                    part += wd[qd] * tab[base + qt * st + qd * sd + 3 * qu + j]
-                acc += wt[qt] * part
-            out[j] += wu[qu] * acc
-    return out[0], out[1], out[2]
-
-
-def _register_block_sums(numba) -> None:
-    """Compiled :func:`cubic_block_sums`: an ``intrinsic`` in LLVM vector code, bound to the
-    plain function with ``overload`` (both numba's public extension API)."""
-    from llvmlite import ir
-    from numba import types
-    from numba.extending import intrinsic, overload
-
-    f64 = types.float64
-    nout = 3
-
-    @intrinsic
-    def block_sums(typingctx, tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd2, wd3, wu0,
-                   wu1, wu2, wu3):  # fmt: skip
-        weights = (wt0, wt1, wt2, wt3, wd0, wd1, wd2, wd3, wu0, wu1, wu2, wu3)
-        if not (isinstance(tab, types.Array) and tab.dtype == f64 and tab.ndim == 1
-                and tab.layout == "C"
-                and all(isinstance(v, types.Integer) for v in (base, st, sd))
-                and all(w == f64 for w in weights)):  # fmt: skip
-            return None
-        sig = types.UniTuple(f64, 3)(tab, base, st, sd, *([f64] * 12))
-
-        def codegen(context, builder, signature, args):
-            data = context.make_array(signature.args[0])(context, builder, args[0]).data
-            i64 = ir.IntType(64)
-            i32 = ir.IntType(32)
-            base_, st_, sd_ = (
-                context.cast(builder, v, t, types.int64)
-                for v, t in zip(args[1:4], signature.args[1:4], strict=True)
-            )
-            wt, wd, wu = args[4:8], args[8:12], args[12:16]
-            n = 4 * nout
-            vrun = ir.VectorType(ir.DoubleType(), n)  # the 4 nodes along the last axis
-            vnode = ir.VectorType(ir.DoubleType(), nout)
-            flags = ("contract",)
-
-            def splat(x, vty, width):
-                v = builder.insert_element(ir.Constant(vty, ir.Undefined), x,
-                                           ir.Constant(i32, 0))  # fmt: skip
-                mask = ir.Constant(ir.VectorType(i32, width), [0] * width)
-                return builder.shuffle_vector(v, ir.Constant(vty, ir.Undefined), mask)
-
-            acc = None
-            for qt in range(4):
-                row_t = builder.add(base_, builder.mul(st_, ir.Constant(i64, qt)))
-                part = None
-                for qd in range(4):
-                    row = builder.add(row_t, builder.mul(sd_, ir.Constant(i64, qd)))
-                    ptr = builder.bitcast(builder.gep(data, [row], inbounds=True),
-                                          vrun.as_pointer())  # fmt: skip
-                    term = builder.fmul(builder.load(ptr, align=8), splat(wd[qd], vrun, n),
-                                        flags=flags)  # fmt: skip
-                    part = term if part is None else builder.fadd(part, term, flags=flags)
-                term = builder.fmul(part, splat(wt[qt], vrun, n), flags=flags)
-                acc = term if acc is None else builder.fadd(acc, term, flags=flags)
-            res = None
-            for qu in range(4):
-                mask = ir.Constant(ir.VectorType(i32, nout), [nout * qu + j for j in range(nout)])
-                node = builder.shuffle_vector(acc, ir.Constant(vrun, ir.Undefined), mask)
-                term = builder.fmul(node, splat(wu[qu], vnode, nout), flags=flags)
-                res = term if res is None else builder.fadd(res, term, flags=flags)
-            vals = [builder.extract_element(res, ir.Constant(i32, j)) for j in range(nout)]
-            return context.make_tuple(builder, signature.return_type, vals)
-
-        return sig, codegen
-
-    @overload(cubic_block_sums, jit_options={"error_model": "numpy"})
-    def _ol(tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd2, wd3, wu0, wu1, wu2, wu3):
-        def impl(tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd2, wd3, wu0, wu1, wu2, wu3):
-            return block_sums(tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd2, wd3, wu0,
-                              wu1, wu2, wu3)  # fmt: skip
-
-        return impl

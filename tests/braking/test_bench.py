@@ -321,7 +321,7 @@ def test_cli_wsp_test_runs_writes_and_sets_the_exit_status(tmp_path):
                         "strict.toml")
     r = runner.invoke(app, ["wsp-test", str(strict), "--out", str(tmp_path / "s"),
                             "--no-figures", "--quiet", "--case", "a"])
-    assert r.exit_code == 1 and (tmp_path / "s" / "summary.json").is_file()
+    assert r.exit_code == 4 and (tmp_path / "s" / "summary.json").is_file()
     # a bad programme or controller: exit 2 with the field
     bad = _programme(tmp_path, SMALL.replace("mu0 = 0.05", "mu0 = -1"), "bad.toml")
     r = runner.invoke(app, ["wsp-test", str(bad), "--out", str(tmp_path / "b")])

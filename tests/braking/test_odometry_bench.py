@@ -398,4 +398,35 @@ def test_cli_odometry_test_runs_writes_and_sets_the_exit_status(tmp_path):
                                      f"{DATA / 'odometry_cf_fmu.py'}:ComplementaryOdometry"])
     finally:
         sys.path.remove(str(DATA))
-    assert result.exit_code in (0, 1), result.output
+    assert result.exit_code in (0, 4), result.output
+
+
+LONG_SPIN = """
+format = "railadhesion-odometry-programme"
+version = 1
+name = "long spin, then the brake"
+[defaults]
+vehicle = "coach_default"
+coast_time_s = 2.0
+odometry_axles = [1, 4]
+fits = ["accelerometer"]
+[[case]]
+name = "spin30-mu030"
+initial_speed_m_s = 15.0
+traction_torque_N_m = 2900.0
+traction_time_s = 30.0
+release_time_s = 3.0
+adhesion = { model = "polach", mu0 = 0.03 }
+"""
+
+
+@pytest.mark.xfail(strict=True, reason="known, not fixed (docs/odometry.md): spinning "
+                   "wheels push the train forward for 12 s after the brake command, which "
+                   "the odometry's brake regime rules out; its upper bound falls below the "
+                   "true position")
+def test_long_spin_then_brake_keeps_the_true_position_inside(tmp_path):
+    """Found in review: 30 s of traction at twice the adhesion torque, then an emergency brake
+    with every axle sliding. The guaranteed interval must hold here too."""
+    res = run_odometry_programme(_programme(tmp_path, LONG_SPIN), figures=False)
+    f = res.frame().iloc[0]
+    assert f.inside, f"outside at {f.violation_samples} samples, by up to {f.worst_violation_m} m"

@@ -186,6 +186,8 @@ def test_polach_data_checks():
 # found by hypothesis: k_S an eighth of k_A, a curve still rising at 60 % creep (a local
 # minimum near k_S/k_A = 0.3 caught every start until the (0.05, 0.005) pair was added)
 @example(k_A=0.0625, ratio=0.125, mu0=0.5, A=0.5, B=2.0)
+# and: a slow rise (k_S = 0.11 k_A) that hides a fall to A = 0.5 (the tail/peak guess says A ~ 1)
+@example(k_A=0.0508, ratio=0.109, mu0=0.5, A=0.5, B=1.5)
 def test_polach_noise_free_curves_are_reproduced(k_A, ratio, mu0, A, B):
     """Property: a noise-free Polach curve is fitted to (near) zero residual (whether the gate
     trusts it, e.g. with few points before an early peak, is not what this checks)."""

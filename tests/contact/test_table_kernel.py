@@ -7,6 +7,7 @@ import pytest
 
 from railadhesion.contact import kalker_coefficients
 from railadhesion.contact import table as tm
+from railadhesion.simd import contract_rows
 
 #: The compiled kernels against their references over the whole input domain, implausible
 #: inputs included: the policy's warnings (docs/checks.md) are what tests/test_plausibility.py
@@ -108,3 +109,59 @@ def test_parallel_lookup_equals_serial(monkeypatch, shared_aob):
     one = tm.exact_table_forces(xi[0], eta[0], phi[0], FZ, 5e-3, np.atleast_1d(b)[0], MU,
                                 speed=speed[0], friction_ratio=0.4, friction_decay=0.6)  # fmt: skip
     assert one == pytest.approx([v[0] for v in serial], rel=1e-12, abs=1e-9)
+
+
+@numba.njit
+def _contract_plain(tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd2, wd3, wu0, wu1, wu2,
+                    wu3):  # fmt: skip
+    """The table's hand-written LLVM contraction (``railadhesion.simd.contract_rows``) in
+    plain numba code, the sums in the same order."""
+    wt = (wt0, wt1, wt2, wt3)
+    wd = (wd0, wd1, wd2, wd3)
+    wu = (wu0, wu1, wu2, wu3)
+    f0 = 0.0
+    f1 = 0.0
+    f2 = 0.0
+    for qu in range(4):
+        a0 = 0.0
+        a1 = 0.0
+        a2 = 0.0
+        for qt in range(4):
+            p0 = 0.0
+            p1 = 0.0
+            p2 = 0.0
+            for qd in range(4):
+                r = base + qt * st + qd * sd + tm._NOUT * qu
+                w = wd[qd]
+                p0 += tab[r] * w
+                p1 += tab[r + 1] * w
+                p2 += tab[r + 2] * w
+            w = wt[qt]
+            a0 += p0 * w
+            a1 += p1 * w
+            a2 += p2 * w
+        w = wu[qu]
+        f0 += a0 * w
+        f1 += a1 * w
+        f2 += a2 * w
+    return f0, f1, f2
+
+
+@numba.njit
+def _contract_ir(tab, base, st, sd, w):
+    return contract_rows(tab, base, st, sd, w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7], w[8],
+                        w[9], w[10], w[11])  # fmt: skip
+
+
+def test_llvm_contraction_equals_plain_numba_code():
+    """The one piece of hand-written LLVM IR (the table's 4 x 4 x 4 contraction) against the
+    same sums in plain numba code, at strides and weights of every kind."""
+    rng = np.random.default_rng(8)
+    tab = rng.uniform(-1.0, 1.0, 4000)
+    for st, sd in ((300, 40), (48, 12), (12, 700)):
+        for _ in range(50):
+            base = int(rng.integers(0, 4000 - 3 * st - 3 * sd - 4 * tm._NOUT))
+            w = rng.uniform(-0.2, 1.2, 12)
+            got = _contract_ir(tab, base, st, sd, w)
+            want = _contract_plain(tab, base, st, sd, *w)
+            np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-14)

@@ -12,10 +12,8 @@ import math
 import numpy as np
 import pytest
 
-from railadhesion.braking.simulator import StepInputs
 from railadhesion.monitor import layout
 from railadhesion.monitor.evaluation import (
-    TRACTION_HOOK,
     MonitorCase,
     NoisySensors,
     SensorNoise,
@@ -106,27 +104,23 @@ def test_sensor_noise_of_the_issue():
     assert np.array_equal(again.factor, NoisySensors(4, SensorNoise(), seed=1).factor)
 
 
-HAS_TRACTION = hasattr(StepInputs, "__slots__") and TRACTION_HOOK in StepInputs.__slots__
-
-
-def test_traction_case_needs_the_simulator_hook():
-    """Until the simulator has ``inputs.torque``, the traction case says what it needs."""
-    if HAS_TRACTION:
-        pytest.skip("the simulator has its traction input")
-    with pytest.raises(NotImplementedError, match="sim.inputs.torque"):
-        run_traction_case(MonitorCase())
-
-
-@pytest.mark.skipif(not HAS_TRACTION, reason="the braking simulator has no traction input yet "
-                    "(sim.inputs.torque, N m per axle, positive = traction): issue 21's "
-                    "traction-only case is wired once it exists")
-def test_traction_only_case():
+@pytest.mark.parametrize(("condition", "speed", "creep"),
+                         [("polach_wet_0.08", 30.0, 0.005), ("polach_wet_0.055", 55.0, 0.002)])
+def test_traction_only_case(condition, speed, creep):
     """No brake, traction torque with the same varying demand onto the low section."""
-    res = run_traction_case(MonitorCase(condition="polach_wet_0.08", speed=30.0, creep=0.005,
-                                        seed=6))
+    res = run_traction_case(MonitorCase(condition=condition, speed=speed, creep=creep, seed=6))
     s = res.summary
     delays = np.array(s["delays_s"], dtype=float)
     assert np.all(np.isfinite(delays) & (delays < 2.0))
     assert s["error_abs_max"] <= 0.02
     assert not s["false_low_before_section"]
     assert math.isfinite(res.truth) and res.truth < 0.14
+    low = res.history["level"] == layout.LOW
+    assert (res.history["creep"][low] < 0).all()  # traction: xi < 0 (docs/CONVENTIONS.md)
+
+
+def test_traction_onto_damp_wilac_is_not_called_low():
+    """As under braking: WILAC at 25 ul/s peaks above 0.14 for this coach, so never low."""
+    res = run_traction_case(MonitorCase(condition="wilac_25", speed=42.0, creep=0.005, seed=7))
+    assert res.truth > 0.14
+    assert not (res.history["level"] == layout.LOW).any()

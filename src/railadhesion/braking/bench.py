@@ -85,6 +85,8 @@ __all__ = [
     "adhesion_limited_stop",
     "load_attribute",
     "programme_from_document",
+    "save_figure",
+    "write_json",
     "read_cosim_fmu",
     "run_wsp_case",
     "run_wsp_programme",
@@ -1049,6 +1051,25 @@ def json_safe(obj):
     return obj
 
 
+def write_json(path: Path, doc) -> Path:
+    """Write ``doc`` (made :func:`json_safe`) as indented UTF-8 JSON, through a temporary file
+    so that a reader never sees half a file (the benches rewrite their summary after every
+    case). Returns ``path``."""
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp.write_text(json.dumps(json_safe(doc), indent=2, ensure_ascii=False) + "\n",
+                   encoding="utf-8")
+    tmp.replace(path)
+    return path
+
+
+def save_figure(fig, out: Path, name: str, dpi: int) -> Path:
+    """Save a bench figure as ``out/figures/<name>.png`` and return its path."""
+    (out / "figures").mkdir(exist_ok=True)
+    path = out / "figures" / f"{name}.png"
+    fig.savefig(path, dpi=dpi)
+    return path
+
+
 def write_programme_outputs(result: WSPProgrammeResult, out, *, case=None,
                             figures: bool = True, histories: bool = False,
                             summary_figure: bool = False) -> list:
@@ -1061,12 +1082,7 @@ def write_programme_outputs(result: WSPProgrammeResult, out, *, case=None,
     written = []
     doc = {"format": "railadhesion-wsp-results", "programme": result.programme,
            "controller": result.controller, "overall": result.overall, "cases": result.cases}
-    path = out / "summary.json"
-    tmp = path.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(json_safe(doc), indent=2, ensure_ascii=False) + "\n",
-                   encoding="utf-8")
-    tmp.replace(path)
-    written.append(path)
+    written.append(write_json(out / "summary.json", doc))
     result.frame().to_csv(out / "cases.csv", index=False, float_format="%.6g")
     written.append(out / "cases.csv")
     axles = result.axle_frame()
@@ -1075,19 +1091,13 @@ def write_programme_outputs(result: WSPProgrammeResult, out, *, case=None,
     if case is not None:
         bench_case, summary, h, trace = case
         (out / "cases").mkdir(exist_ok=True)
-        path = out / "cases" / f"{bench_case.name}.json"
-        path.write_text(json.dumps(json_safe(summary), indent=2, ensure_ascii=False) + "\n",
-                        encoding="utf-8")
-        written.append(path)
+        written.append(write_json(out / "cases" / f"{bench_case.name}.json", summary))
         if h is not None and figures:
             from railadhesion.braking.figures import wsp_case_figure
 
-            (out / "figures").mkdir(exist_ok=True)
             fig = wsp_case_figure(h, trace, bench_case.vehicle.wheel_radius,
                                   title=f"{bench_case.name}: {bench_case.adhesion.describe()}")
-            path = out / "figures" / f"{bench_case.name}.png"
-            fig.savefig(path, dpi=90)
-            written.append(path)
+            written.append(save_figure(fig, out, bench_case.name, 90))
         if h is not None and histories:
             (out / "histories").mkdir(exist_ok=True)
             path = out / "histories" / f"{bench_case.name}.parquet"
@@ -1096,10 +1106,6 @@ def write_programme_outputs(result: WSPProgrammeResult, out, *, case=None,
     if summary_figure:
         from railadhesion.braking.figures import wsp_summary_figure
 
-        (out / "figures").mkdir(exist_ok=True)
-        fig = wsp_summary_figure(result.cases)
-        path = out / "figures" / "summary.png"
-        fig.savefig(path, dpi=90)
-        written.append(path)
+        written.append(save_figure(wsp_summary_figure(result.cases), out, "summary", 90))
     return written
 

@@ -25,7 +25,6 @@ the others go on.
 from __future__ import annotations
 
 import copy
-import json
 import math
 import os
 import time as _time
@@ -47,11 +46,12 @@ from railadhesion.braking._fields import (
 )
 from railadhesion.braking.bench import (
     BenchCase,
-    json_safe,
     load_attribute,
     load_controller,
     programme_from_document,
     read_cosim_fmu,
+    save_figure,
+    write_json,
 )
 from railadhesion.braking.odometry import STATUS_BITS, ReferenceOdometry
 from railadhesion.braking.sensors import (
@@ -1094,31 +1094,20 @@ def write_odometry_outputs(result: OdometryProgrammeResult, out, *, case=None,
     written = []
     doc = {"format": "railadhesion-odometry-results", "programme": result.programme,
            "odometry": result.odometry, "overall": result.overall, "cases": result.cases}
-    path = out / "summary.json"
-    tmp = path.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(json_safe(doc), indent=2, ensure_ascii=False) + "\n",
-                   encoding="utf-8")
-    tmp.replace(path)
-    written.append(path)
+    written.append(write_json(out / "summary.json", doc))
     result.frame().to_csv(out / "fits.csv", index=False, float_format="%.6g")
     result.violation_frame().to_csv(out / "violations.csv", index=False, float_format="%.6g")
     written += [out / "fits.csv", out / "violations.csv"]
     if case is not None:
         ocase, summary, tr = case
         (out / "cases").mkdir(exist_ok=True)
-        path = out / "cases" / f"{ocase.name}.json"
-        path.write_text(json.dumps(json_safe(summary), indent=2, ensure_ascii=False) + "\n",
-                        encoding="utf-8")
-        written.append(path)
+        written.append(write_json(out / "cases" / f"{ocase.name}.json", summary))
         if tr is not None and figures:
             from railadhesion.braking.figures import odometry_case_figure
 
-            (out / "figures").mkdir(exist_ok=True)
             fig = odometry_case_figure(tr, summary, title=f"{ocase.name}: "
                                        f"{ocase.run.adhesion.describe()}")
-            path = out / "figures" / f"{ocase.name}.png"
-            fig.savefig(path, dpi=80)
-            written.append(path)
+            written.append(save_figure(fig, out, ocase.name, 80))
         if tr is not None and histories:
             import pandas as pd
 
@@ -1136,9 +1125,5 @@ def write_odometry_outputs(result: OdometryProgrammeResult, out, *, case=None,
     if summary_figure:
         from railadhesion.braking.figures import odometry_summary_figure
 
-        (out / "figures").mkdir(exist_ok=True)
-        fig = odometry_summary_figure(result.cases)
-        path = out / "figures" / "summary.png"
-        fig.savefig(path, dpi=80)
-        written.append(path)
+        written.append(save_figure(odometry_summary_figure(result.cases), out, "summary", 80))
     return written

@@ -630,9 +630,13 @@ def fit_polach(
     variants = [(1.5 * k_mean, 0.5 * k_mean, b0) for b0 in b_starts] if k_mean else []
     variants += [(k_mean, k_mean, b_starts[0])] if k_mean else []
     variants += [(ka, ks, b_starts[-1]) for ka, ks in spread]
+    variants = [(*v, guess["A"]) for v in variants]
+    # A curve that rises slowly (small k_S) hides its fall: the data's tail says A ~ 1 when
+    # the friction has fallen by half. One start assumes the fall.
+    variants.append((*spread[-1], b_starts[-1], 0.5))
     starts = []
-    for ka, ks, b0 in variants:
-        cand = {**guess, "k_A": ka, "k_S": ks, "B": b0, **init}
+    for ka, ks, b0, a0 in variants:
+        cand = {**guess, "k_A": ka, "k_S": ks, "B": b0, "A": a0, **init}
         x0 = [cand[n] for n in fitted]
         if x0 not in starts:
             starts.append(x0)

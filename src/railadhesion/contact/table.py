@@ -64,7 +64,6 @@ from railadhesion.numerics import (
     POSITIVE,
     atan_nonneg,
     count_outside,
-    cubic_block_sums,
     fill,
     fill_row,
     flatten,
@@ -74,6 +73,7 @@ from railadhesion.numerics import (
     run_chunks,
 )
 from railadhesion.plausibility import input_checker
+from railadhesion.simd import NOUT, contract_rows
 
 __all__ = ["exact_table_forces", "exact_table_law", "table_axes"]
 
@@ -204,7 +204,7 @@ def _slice_at(laob: float) -> np.ndarray:
 
 
 #: Values per table node in memory: Fx, Fy, Mz.
-_NOUT = 3
+_NOUT = NOUT  # values per node (Fx, Fy, Mz), as contract_rows reads them
 #: Contacts from which the lookup runs in parallel (as the package's Polach kernels).
 _PARALLEL_MIN = 100_000
 
@@ -282,13 +282,13 @@ def table_sums(tab, dims, strides, origin, inv_step, laob, t, th, u):
     sa = strides[0]
     o = int(it) * st + int(id_) * sd + int(iu) * strides[3]
     if sa == 0:
-        return cubic_block_sums(tab, o, st, sd, t0, t1, t2, t3, d0, d1, d2, d3, u0, u1, u2, u3)
+        return contract_rows(tab, o, st, sd, t0, t1, t2, t3, d0, d1, d2, d3, u0, u1, u2, u3)
     ia, fa = _locate_uniform(laob, origin[0], inv_step[0], dims[0])
     w = _catmull_rom(fa)
     o += int(ia) * sa
     f0 = f1 = f2 = 0.0
     for q in range(4):
-        p0, p1, p2 = cubic_block_sums(tab, o + q * sa, st, sd, t0, t1, t2, t3, d0, d1, d2, d3,
+        p0, p1, p2 = contract_rows(tab, o + q * sa, st, sd, t0, t1, t2, t3, d0, d1, d2, d3,
                                       u0, u1, u2, u3)  # fmt: skip
         f0 += w[q] * p0
         f1 += w[q] * p1
@@ -380,8 +380,8 @@ def _stage_weights(v, v0, inv_h, n, stride, base, w, m):
 
 @jit
 def _stage_sums(tab, buf, m, st, sd, sa):
-    """The interpolated outputs of each contact (:func:`cubic_block_sums`; sa > 0: also along
-    log(a/b), the planes sa apart) into rows _R_F to _R_F + 2."""
+    """The interpolated outputs of each contact (:func:`~railadhesion.simd.contract_rows`;
+    sa > 0: also along log(a/b), the planes sa apart) into rows _R_F to _R_F + 2."""
     for k in range(m):
         o = int(buf[_R_BASE * CHUNK + k])
         r = _R_W * CHUNK + k  # the 12 weights along t, theta, u, CHUNK apart
@@ -391,13 +391,13 @@ def _stage_sums(tab, buf, m, st, sd, sa):
         r += 4 * CHUNK
         w8, w9, w10, w11 = buf[r], buf[r + CHUNK], buf[r + 2 * CHUNK], buf[r + 3 * CHUNK]
         if sa == 0:
-            f0, f1, f2 = cubic_block_sums(tab, o, st, sd, w0, w1, w2, w3, w4, w5, w6, w7, w8,
+            f0, f1, f2 = contract_rows(tab, o, st, sd, w0, w1, w2, w3, w4, w5, w6, w7, w8,
                                           w9, w10, w11)  # fmt: skip
         else:
             f0 = f1 = f2 = 0.0
             for q in range(4):
                 wa = buf[(_R_W + 12 + q) * CHUNK + k]
-                p0, p1, p2 = cubic_block_sums(tab, o + q * sa, st, sd, w0, w1, w2, w3, w4, w5,
+                p0, p1, p2 = contract_rows(tab, o + q * sa, st, sd, w0, w1, w2, w3, w4, w5,
                                               w6, w7, w8, w9, w10, w11)  # fmt: skip
                 f0 += wa * p0
                 f1 += wa * p1

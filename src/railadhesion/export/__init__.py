@@ -32,6 +32,7 @@ from railadhesion.export.monitor_fmu import (
     monitor_step_model,
 )
 from railadhesion.export.native import NativeBuildError
+from railadhesion.export.native_braking import build_native_braking_fmu
 from railadhesion.export.native_creepforce import build_native_creep_force_fmu
 from railadhesion.export.tables import (
     DEFAULT_GRID,
@@ -55,6 +56,7 @@ __all__ = [
     "build_fmu",
     "build_monitor_fmu",
     "build_native_creep_force_fmu",
+    "build_native_braking_fmu",
     "build_native_monitor_fmu",
     "creep_force_table",
     "creep_force_variables",

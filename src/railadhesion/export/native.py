@@ -106,6 +106,8 @@ _PORTABLE_INTRINSICS = (
     "llvm.umax.", "llvm.abs.", "llvm.ctpop.", "llvm.ctlz.", "llvm.cttz.", "llvm.lifetime.",
     "llvm.memcpy.", "llvm.memmove.", "llvm.memset.", "llvm.assume", "llvm.expect.",
     "llvm.is.fpclass.", "llvm.vector.reduce.", "llvm.experimental.noalias.scope.decl",
+    "llvm.uadd.with.overflow.", "llvm.usub.with.overflow.", "llvm.sadd.with.overflow.",
+    "llvm.ssub.with.overflow.", "llvm.umul.with.overflow.", "llvm.smul.with.overflow.",
 )  # fmt: skip
 # glibc gave these libm functions new symbol versions (exp, log, pow, exp2, log2 in 2.29,
 # without the old SVID error wrapper; hypot in 2.35): a binary linked on this machine would
@@ -125,6 +127,7 @@ _C_TYPES = {
     "i4": ("int32_t", "RA_I32"),
     "u1": ("uint8_t", "RA_U8"),
     "b1": ("uint8_t", "RA_U8"),
+    "u8": ("uint64_t", None),  # in records only (a random seed), not as a variable
 }
 _RECORDS = {"output": "state", "parameter": "settings", "input": "inputs"}
 # Values fmi2SetReal may store in integer fields (exact in a double, in the C type's range).
@@ -336,7 +339,7 @@ def _c_scalar(dtype: np.dtype, where: str) -> str:
     key = f"{dtype.kind}{dtype.itemsize}"
     if key not in _C_TYPES:
         raise ValueError(f"{where}: dtype {dtype} is not supported "
-                         "(float64, int64, int32, uint8, bool)")  # fmt: skip
+                         "(float64, int64, int32, uint8, bool; uint64 in records only)")
     return _C_TYPES[key][0]
 
 
@@ -553,7 +556,10 @@ class StepModel:
             ):
                 raise ValueError(f"variables: {v.name}: {rv.record}.{rv.field}{list(rv.index)} "
                                  f"is not one number of shape {shape}")  # fmt: skip
-            _c_scalar(base, f"{rv.record}.{rv.field}")
+            if _C_TYPES.get(f"{base.kind}{base.itemsize}", (None, None))[1] is None:
+                _c_scalar(base, f"{rv.record}.{rv.field}")
+                raise ValueError(f"variables: {v.name}: {rv.record}.{rv.field} is a uint64 "
+                                 "field, which cannot hold an FMU variable")  # fmt: skip
             limits = _INTEGER_LIMITS.get(f"{base.kind}{base.itemsize}")
             if limits and v.causality != "output" and (
                 v.min is None or v.max is None or v.min < limits[0] or v.max > limits[1]

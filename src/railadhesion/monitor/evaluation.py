@@ -42,7 +42,6 @@ __all__ = [
     "run_dry_distance",
     "run_traction_case",
     "CONDITIONS",
-    "TRACTION_HOOK",
 ]
 
 #: Modulation frequencies [Hz] of the brake demand (our choice).
@@ -59,11 +58,6 @@ CONDITIONS = {
     "polach_wet_0.24": ("polach", 0.24),
     "polach2005_wet": ("polach", 0.30),
 }
-#: The simulator's input a traction case needs (not there yet): torque per axle [N m],
-#: positive = traction (accelerating the wheel), written in place like the other inputs.
-TRACTION_HOOK = "torque"
-
-
 @dataclass(frozen=True)
 class SensorNoise:
     """Sensor noise of the evaluation (issue 21): standard deviations per sample and the range
@@ -439,9 +433,8 @@ def run_dry_distance(distance: float = 100e3, settings: MonitorSettings | None =
 def run_traction_case(case: MonitorCase, settings: MonitorSettings | None = None, *,
                       vehicle=None, noise: SensorNoise | None = None, period: float = 2.4e-3):
     """The traction-only case: no brake, a traction torque per axle with the same varying
-    demand. Needs the simulator input ``sim.inputs.torque`` [N m per axle, positive =
-    traction] (:data:`TRACTION_HOOK`), which the braking simulator does not have yet: raises
-    ``NotImplementedError`` saying so until it does."""
+    demand, written in place into the simulator's ``sim.inputs.torque`` [N m per axle,
+    positive = traction]; the monitor reads the torques, not the pressures."""
     from railadhesion.braking import BrakingSimulator, load_vehicle
 
     vehicle = load_vehicle(vehicle or "coach_default")
@@ -452,19 +445,13 @@ def run_traction_case(case: MonitorCase, settings: MonitorSettings | None = None
     end = start + v0 * case.section_time
     adhesion = section_adhesion(case.condition, start, end)
     sim = BrakingSimulator(vehicle, adhesion, v0, record=False)
-    if not hasattr(sim.inputs, TRACTION_HOOK):
-        raise NotImplementedError(
-            "the braking simulator has no traction input yet: the traction case needs "
-            "sim.inputs.torque (N m per axle, positive = traction), written in place like "
-            "pressure_command"
-        )
     p_mean, mu_mean = _mean_demand(vehicle, case.condition, start, end, v0, case.creep)
     torque_mean = p_mean * vehicle.brake_coefficient  # the same wheel torque, driving
     rng = np.random.default_rng(case.seed + 7919)
     modulate = _modulation(case, rng)
     mon = AdhesionMonitor(vehicle, settings, pressure=False, torque=True)
     sensors = NoisySensors(n, noise, seed=case.seed)
-    torque_in = getattr(sim.inputs, TRACTION_HOOK)
+    torque_in = sim.inputs.torque
     total = case.coast_time + case.dry_time + case.section_time + case.after_time
     steps = int(total / period)
     offsets = vehicle.axle_offsets()

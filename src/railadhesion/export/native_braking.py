@@ -1,0 +1,252 @@
+"""The native braking-vehicle FMU: the braking step compiled ahead of time, no Python at run time.
+
+Same variables as the Python braking FMU (:func:`railadhesion.export.braking_fmu_variables`:
+commanded pressure and WSP valve per axle in; train speed, distance, deceleration, stopped,
+and per axle wheel speed, cylinder pressure, creep force, adhesion used, normal load out). The
+model is a step function on the three records of :mod:`railadhesion.export.native`:
+
+* ``state``: the braking simulator's machine (the record of
+  :data:`railadhesion.braking.step.MACHINE`), copied from a
+  :class:`~railadhesion.braking.BrakingSimulator` built from the scenario, and a ``stopped``
+  flag as a number;
+* ``settings``: the simulator's constant tables (adhesion sets, track, water profile);
+* ``inputs``: the commanded pressure and the valve state of every axle.
+
+Each ``doStep`` copies the inputs into the machine (valves rounded, as the Python FMU does)
+and calls :func:`railadhesion.braking.step.advance_buffer_unrecorded`, the compiled step the
+stepping API calls: the physics is not retyped, and the outputs equal the stepping API's.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import html
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from railadhesion.export.braking_fmu import braking_fmu_variables
+from railadhesion.export.native import RecordVariable, StepModel, build_step_fmu
+
+__all__ = ["braking_step_model", "build_native_braking_fmu"]
+
+_SCENARIO_FILE = "scenario.toml"
+# per-axle outputs: FMU variable prefix -> field of the braking state record
+_AXLE_OUTPUTS = {"wheel_speed": "omega", "brake_pressure": "pressure", "creep_force": "force",
+                 "adhesion_used": "mu", "normal_load": "load"}  # fmt: skip
+_SCALAR_OUTPUTS = {"train_speed": "machine.state.speed", "distance": "machine.state.distance",
+                   "deceleration": "machine.state.deceleration", "stopped": "stopped"}  # fmt: skip
+
+
+def _messages() -> dict[int, str]:
+    from railadhesion.braking import records as r
+
+    return {
+        r.NONFINITE: "the adhesion model gave a non-finite value; the simulation cannot proceed",
+        r.BAD_DT: "the step size must be in (0, inf) s",
+        r.BAD_COMMAND: "a pressure_command is outside [0, inf) Pa",
+        r.BAD_VALVE: "a valve is not 0 (apply), 1 (hold) or 2 (vent)",
+        r.ROWS_FULL: "internal: history rows full (not recording)",
+        r.BAD_TORQUE: "a traction torque is not finite",
+        r.STALE: "the compiled braking step was built from other sources than this machine",
+    }
+
+
+def _braking_step(state_t, settings_t, inputs_t, n_axles: int):
+    """The FMU's step on the records of one export: inputs into the machine, the compiled
+    braking step, the stop flag."""
+    from numba import carray
+
+    from railadhesion.braking.records import STOPPED
+    from railadhesion.braking.step import MACHINE, advance_unrecorded
+
+    n = n_axles
+    n_tables = settings_t.fields["tables"][0].shape[0]
+
+    def step(state, settings, inputs, dt):
+        machine = carray(state, 1, MACHINE)  # the first field of the state record
+        tables = carray(settings, n_tables, np.float64)  # the only field of the settings
+        x = carray(inputs, 1, inputs_t)[0]
+        u = machine[0].inputs
+        for i in range(n):
+            u.pressure_command[i] = x.pressure_command[i]
+            u.valves[i] = np.round(x.valves[i])
+        status = advance_unrecorded(machine, tables, dt, 0)
+        out = carray(state, 1, state_t)[0]
+        out.stopped = 1.0 if machine[0].state.stopped != 0 else 0.0
+        if status == 0 or status == STOPPED:
+            return 0
+        return status
+
+    return step
+
+
+def braking_step_model(simulator, identifier: str = "railadhesion_braking") -> StepModel:
+    """The braking vehicle of ``simulator`` (a :class:`~railadhesion.braking.BrakingSimulator`
+    in its current state, not recording) as a :class:`StepModel` with the braking FMU's
+    variables."""
+    from railadhesion.braking.records import INPUTS, POLACH, WILAC
+    from railadhesion.braking.step import MACHINE, split_buffer
+
+    if simulator._rows is not None:  # noqa: SLF001
+        raise ValueError("simulator: build it with record=False")
+    buffer = simulator._buffer  # noqa: SLF001
+    machine, tables = split_buffer(buffer)
+    n = int(machine[0]["settings"]["n_axles"])
+    if int(machine[0]["settings"]["model"]) not in (POLACH, WILAC):
+        raise ValueError("simulator: the native braking FMU compiles the built-in adhesion "
+                         "models (Polach sets, WILAC) only; this simulator's model is a "
+                         "Python function or a user's law: use the Python braking FMU")
+    if int(machine[0]["settings"]["wsp_on"]) != 0:
+        raise ValueError("simulator: build it without the built-in WSP (the FMU's master "
+                         "commands the valves)")
+    state_t = np.dtype([("machine", MACHINE), ("stopped", "f8")], align=True)
+    settings_t = np.dtype([("tables", "f8", (max(tables.size, 1),))], align=True)
+    state = np.zeros(1, state_t)
+    state["machine"] = machine
+    settings = np.zeros(1, settings_t)
+    settings["tables"][0, : tables.size] = tables
+    state["stopped"] = float(machine[0]["state"]["stopped"] != 0)
+    inputs = np.zeros(1, INPUTS)
+    inputs["pressure_command"][0] = machine[0]["inputs"]["pressure_command"]
+    variables = []
+    for v in braking_fmu_variables(n):
+        name = v.name
+        if v.causality == "input":
+            prefix, k = name.rsplit("_", 1)
+            fieldname = "pressure_command" if prefix == "pressure_command" else "valves"
+            variables.append(RecordVariable(v, fieldname, (int(k) - 1,)))
+        elif name in _SCALAR_OUTPUTS:
+            variables.append(RecordVariable(v, _SCALAR_OUTPUTS[name]))
+        else:
+            prefix, k = name.rsplit("_", 1)
+            variables.append(RecordVariable(v, f"machine.state.{_AXLE_OUTPUTS[prefix]}",
+                                            (int(k) - 1,)))  # fmt: skip
+    return StepModel(
+        identifier=identifier,
+        step=_braking_step(state_t, settings_t, INPUTS, n),
+        state=state,
+        settings=settings,
+        inputs=inputs,
+        variables=variables,
+        errors=_messages(),
+    )
+
+
+def build_native_braking_fmu(out, scenario) -> Path:
+    """Write a native FMI 2.0 co-simulation FMU of a braking vehicle: no Python at run time.
+
+    Same scenario file, variables and outputs as :func:`railadhesion.export.build_braking_fmu`;
+    the braking step (``railadhesion.braking.step``) is compiled in with the vehicle, the
+    cylinders, the adhesion model and the track of the scenario (binary for linux64, sources
+    in ``sources/``; ``docs/fmu.md``). Building needs a C compiler and FMPy.
+
+    Parameters
+    ----------
+    out : str or os.PathLike
+        The ``.fmu`` file to write.
+    scenario : str or os.PathLike
+        A braking scenario TOML file (``docs/braking.md``), embedded as documentation.
+
+    Returns
+    -------
+    pathlib.Path
+        ``out``.
+
+    Notes
+    -----
+    A NaN or out-of-range input is refused by ``fmi2SetReal`` (``fmi2Error``, logged, naming
+    the variable); a failed step returns ``fmi2Error`` with the reason logged.
+    ``fmi2GetFMUstate``/``fmi2SetFMUstate`` save and restore the whole vehicle.
+    """
+    path = Path(scenario)
+    if not path.is_file():
+        raise ValueError(f"scenario must be an existing TOML file, got {str(path)!r}")
+    if not _generic_cpu():
+        return _build_in_generic_process(out, path)
+    return _build(out, path)
+
+
+def _generic_cpu() -> bool:
+    from numba.core import config
+
+    return config.CPU_NAME == "generic"
+
+
+def _build_in_generic_process(out, path: Path) -> Path:
+    """Build in a Python process whose numba compiles for a generic x86-64: the braking
+    step's IR then holds no vector intrinsics of this machine's processor (AVX masked loads),
+    which the portable binary may not contain."""
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, NUMBA_CPU_NAME="generic", NUMBA_CPU_FEATURES="")
+    code = ("import sys; from railadhesion.export.native_braking import _build; "
+            "_build(sys.argv[1], sys.argv[2])")  # fmt: skip
+    done = subprocess.run([sys.executable, "-c", code, str(out), str(path)], env=env,
+                          capture_output=True, text=True)  # fmt: skip
+    if done.returncode != 0:
+        last = (done.stderr.strip().splitlines() or ["(no message)"])[-1]
+        from railadhesion.export.native import NativeBuildError
+
+        if "NativeBuildError" in last:
+            raise NativeBuildError(last.split(": ", 1)[-1])
+        if "ValueError" in last:
+            raise ValueError(last.split(": ", 1)[-1])
+        raise RuntimeError(f"building the native braking FMU failed: {last}")
+    return Path(out)
+
+
+def _build(out, path) -> Path:
+    import railadhesion
+    from railadhesion.braking import BrakingSimulator
+    from railadhesion.braking.scenario import load_scenario
+
+    path = Path(path)
+    text = path.read_text(encoding="utf-8")
+    with tempfile.TemporaryDirectory() as tmp:  # the copy must load on its own
+        copy = Path(tmp) / _SCENARIO_FILE
+        copy.write_text(text, encoding="utf-8")
+        try:
+            loaded = load_scenario(copy)
+        except ValueError as exc:
+            raise ValueError(
+                f"scenario {str(path)!r} does not load on its own (files it names must be "
+                f"built-in names or absolute paths): {exc}"
+            ) from exc
+    sim = BrakingSimulator(
+        loaded.vehicle, loaded.adhesion(), loaded.initial_speed, cylinders=loaded.cylinders,
+        gradient=loaded.gradient, refresh_period=loaded.refresh_period, record=False,
+    )  # fmt: skip
+    model = braking_step_model(sim)
+    vehicle = loaded.vehicle
+    sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    description = (
+        f"railadhesion {railadhesion.__version__}: braking vehicle '{vehicle.name}' "
+        f"({vehicle.n_axles} axles) from scenario '{loaded.name}', initial speed "
+        f"{loaded.initial_speed:g} m/s; inputs: commanded cylinder pressure and WSP valve per "
+        f"axle. Native: no Python at run time. Scenario in documentation/{_SCENARIO_FILE} "
+        f"(sha256 {sha[:12]}...)."
+    )
+    rows = "".join(
+        f"<tr><td>{html.escape(rv.variable.name)}</td><td>{rv.variable.causality}</td>"
+        f"<td>{html.escape(rv.variable.unit)}</td><td>{html.escape(rv.variable.description)}"
+        "</td></tr>" for rv in model.variables
+    )
+    documentation = (
+        "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>Braking-vehicle FMU "
+        "(native)</title></head><body>\n<h1>Braking-vehicle FMU (railadhesion, native)</h1>\n"
+        f"<p>{html.escape(description)}</p>\n<table border='1'><tr><th>name</th>"
+        f"<th>causality</th><th>unit</th><th>description</th></tr>{rows}</table>\n"
+        f"<h2>Scenario</h2>\n<pre>{html.escape(text)}</pre>\n</body></html>\n"
+    )
+    return build_step_fmu(
+        model, out,
+        model_name=f"railadhesion braking vehicle '{vehicle.name}' (native)",
+        description=description,
+        documentation=documentation,
+        version=f"railadhesion {railadhesion.__version__}, scenario {sha[:12]}",
+        extra_documentation={_SCENARIO_FILE: text},
+    )  # fmt: skip

@@ -1,0 +1,153 @@
+"""The native braking-vehicle FMU (issue 25) in the C host (no Python in its process).
+
+Reference: the stepping API (:meth:`railadhesion.braking.BrakingSimulator.step`) driven with
+the same inputs in this process. The C host and its helpers are those of test_native.py.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("fmpy")
+
+from fmpy.validation import validate_fmu  # noqa: E402
+
+from railadhesion.braking import BrakingSimulator  # noqa: E402
+from railadhesion.braking.scenario import load_scenario  # noqa: E402
+from railadhesion.export import build_native_braking_fmu, native  # noqa: E402
+
+from .test_native import Unzipped, host  # noqa: E402, F401
+
+pytestmark = pytest.mark.skipif(
+    not sys.platform.startswith("linux") or native.find_c_compiler() is None,
+    reason="native FMUs are built for linux64 with a C compiler",
+)
+
+SCENARIO = Path(__file__).parents[2] / "examples" / "brake_damp.toml"
+N = 4
+INPUTS = [f"pressure_command_{k}" for k in range(1, N + 1)] + [f"valve_{k}"
+                                                               for k in range(1, N + 1)]
+OUTPUTS = (["train_speed", "distance", "deceleration", "stopped"]
+           + [f"{p}_{k}" for k in range(1, N + 1) for p in
+              ("wheel_speed", "brake_pressure", "creep_force", "adhesion_used", "normal_load")])
+
+
+@pytest.fixture(scope="module")
+def fmu(host, tmp_path_factory):  # noqa: F811
+    tmp = tmp_path_factory.mktemp("native_braking")
+    path = build_native_braking_fmu(tmp / "braking.fmu", SCENARIO)
+    return Unzipped(path, host, tmp)
+
+
+def _rows(n_steps):
+    """Emergency pressure on every axle, valve commands changing (apply, hold, vent) with a
+    different phase per axle."""
+    rows = np.zeros((n_steps, 2 * N))
+    rows[:, :N] = 5.5e5
+    k = np.arange(n_steps)
+    for i in range(N):
+        phase = (k // 120 + i) % 6
+        rows[:, N + i] = np.where(phase == 0, 2.0, np.where(phase == 1, 1.0, 0.0))
+    return rows
+
+
+def _reference(rows):
+    sc = load_scenario(SCENARIO)
+    sim = BrakingSimulator(sc.vehicle, sc.adhesion(), sc.initial_speed, cylinders=sc.cylinders,
+                           gradient=sc.gradient, refresh_period=sc.refresh_period,
+                           record=False)  # fmt: skip
+    out = np.empty((len(rows), len(OUTPUTS)))
+    for j, row in enumerate(rows):
+        s = sim.step(0.001, {"pressure_command": row[:N],
+                             "valves": row[N:].astype(np.int64)})  # fmt: skip
+        out[j, :4] = s.train_speed, s.distance, s.deceleration, float(s.stopped)
+        for i in range(N):
+            out[j, 4 + 5 * i: 9 + 5 * i] = (s.wheel_speeds[i], s.brake_pressures[i],
+                                            s.creep_forces[i], s.adhesion_used[i],
+                                            s.normal_loads[i])  # fmt: skip
+    return out
+
+
+def test_equals_the_stepping_api_over_a_damp_rail_stop(fmu):
+    rows = _rows(40000)
+    status, got = fmu.sweep(INPUTS, rows, OUTPUTS)
+    assert (status == 0).all()
+    want = _reference(rows)
+    assert got[-1, OUTPUTS.index("stopped")] == 1.0  # the whole stop, to rest
+    assert want[-1, OUTPUTS.index("stopped")] == 1.0
+    np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9)
+    assert 50.0 < want[-1, 1]  # reached the damp section
+
+
+def test_state_rollback_gives_identical_results(fmu):
+    v = fmu.vr
+    speed, valve = v["train_speed"], v["valve_1"]
+    sets = "".join(f"set 0 {v[f'pressure_command_{k}']} 550000\n" for k in range(1, N + 1))
+    steps = "".join(f"step 0 {j * 1e-3!r} 0.001\n" for j in range(300))
+    vent = f"set 0 {valve} 2\n"
+    lines, _ = fmu.run(f"new 0\ninit 0\n{sets}{steps}save 0 0\n{vent}{steps}get 0 {speed}\n"
+                       f"load 0 0\n{vent}{steps}get 0 {speed}\nload 0 0\n"
+                       f"set 0 {valve} 0\n{steps}get 0 {speed}\n")  # fmt: skip
+    # the FMU state holds the inputs too: the valve is set again after each load
+    gets = [line for line in lines if line.startswith("get")]
+    assert gets[0] == gets[1]  # rolled back, same inputs: bit-identical
+    assert gets[2] != gets[0]  # other inputs after the rollback: another result
+    assert all(line.split()[2] == "0" for line in lines if line.startswith(("step", "load")))
+
+
+@pytest.mark.parametrize(("name", "value", "message"), [
+    ("pressure_command_2", "nan", "fmi2SetReal: pressure_command_2 = NaN"),
+    ("valve_3", "3", "fmi2SetReal: valve_3 = 3 is out of range [0, 2]"),
+])  # fmt: skip
+def test_bad_input_is_an_error_naming_the_variable(fmu, name, value, message):
+    lines, err = fmu.run(f"new 0\ninit 0\nset 0 {fmu.vr[name]} {value}\n")
+    assert lines[-1] == "set 0 3"
+    assert message in err
+
+
+def test_fmpy_validates(fmu):
+    assert validate_fmu(str(fmu.fmu)) == []
+
+
+def test_cli_writes_a_native_braking_fmu(tmp_path):
+    from typer.testing import CliRunner
+
+    from railadhesion.cli import app
+
+    out = tmp_path / "b.fmu"
+    result = CliRunner().invoke(app, ["export", "braking-fmu", str(SCENARIO), "--out", str(out),
+                                      "--native"])  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert "passes FMPy's validation" in result.output
+    import zipfile
+
+    names = zipfile.ZipFile(out).namelist()
+    assert "binaries/linux64/railadhesion_braking.so" in names
+    assert "sources/buildDescription.xml" in names
+
+
+def test_two_instances_side_by_side_and_no_allocation_in_steps(fmu):
+    v = fmu.vr
+    speed, valve = v["train_speed"], v["valve_2"]
+    sets = "".join(f"set {i} {v[f'pressure_command_{k}']} 550000\n" for i in (0, 1)
+                   for k in range(1, N + 1))  # fmt: skip
+    steps = "".join(f"step 0 {j * 1e-3!r} 0.001\nstep 1 {j * 1e-3!r} 0.001\n"
+                    for j in range(200))  # fmt: skip
+    lines, _ = fmu.run(f"new 0\nnew 1\ninit 0\ninit 1\n{sets}set 1 {valve} 2\nallocs\n{steps}"
+                       f"allocs\nget 0 {speed}\nget 1 {speed}\n")  # fmt: skip
+    allocs = [line for line in lines if line.startswith("allocs")]
+    assert allocs[0] == allocs[1]  # nothing allocated while stepping
+    gets = [float(line.split()[3]) for line in lines if line.startswith("get")]
+    assert gets[0] < gets[1]  # instance 1 vents axle 2: it brakes less than instance 0
+    assert all(line.split()[2] == "0" for line in lines if line.startswith("step"))
+
+
+@pytest.mark.parametrize("h", ["0", "-0.001", "nan"])
+def test_step_size_must_be_positive(fmu, h):
+    lines, err = fmu.run(f"new 0\ninit 0\nstep 0 0 {h}\n")
+    assert lines[-1] == "step 0 3"
+    assert "fmi2DoStep: communicationStepSize must be > 0 and finite" in err
