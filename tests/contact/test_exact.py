@@ -453,3 +453,67 @@ def test_contact_tractcurv_points_with_discrete_pressure():
     r = exact_rolling(xi, 0.0, 0.0, 106.7e3, float(h.a), float(h.b), 0.33, nx=48, ny=44,
                       scale=1.1, pressure="discrete")  # fmt: skip
     np.testing.assert_allclose(r.fx / (0.33 * 106.7e3), contact, rtol=0.002, atol=0.00005)
+
+
+# --------------------------------------------------------------------------- influence sums by FFT
+
+
+def test_slip_field_equals_dense_influence_sums():
+    # the solver's influence sums (FFT along the columns) against a dense sum built here from
+    # the closed-form coefficients: in slip, s = w + (u - u')/dx must hold element by element
+    # (rectangular elements, a grid not a power of two, spin: every coupling Kxx, Kxy, Kyy)
+    ny, nx, dx, dy, nu = 9, 13, 0.4e-3, 0.7e-3, 0.27
+    x = dx * (np.arange(nx) - (nx - 1) / 2)
+    y = dy * (np.arange(ny) - (ny - 1) / 2)
+    q = 1 - (x[None, :] / (0.5 * nx * dx)) ** 2 - (y[:, None] / (0.5 * ny * dy)) ** 2
+    pn = 1e9 * np.sqrt(np.clip(q, 0, None))
+    xi, eta, phi, mu = 4e-4, -3e-4, 0.6, 0.3
+    r = solve_tangential(pn, dx, dy, xi, eta, phi, mu, poisson=nu, tol=1e-12, max_iter=20000)
+    xx, yy = np.meshgrid(x, y)
+    ox = xx.ravel()[:, None] - xx.ravel()[None, :]  # field point minus loaded element
+    oy = yy.ravel()[:, None] - yy.ravel()[None, :]
+    axx, axy, ayy = tangential_influence(ox, oy, dx, dy, poisson=nu, shear_modulus=G)
+    bxx, bxy, byy = tangential_influence(ox + dx, oy, dx, dy, poisson=nu, shear_modulus=G)
+    px, py = r.px.ravel(), r.py.ravel()
+    ux, uy = axx @ px + axy @ py, axy @ px + ayy @ py
+    ux2, uy2 = bxx @ px + bxy @ py, bxy @ px + byy @ py  # displacement one step downstream+
+    wx = xi - phi * yy.ravel()
+    wy = eta + phi * (xx.ravel() + dx / 6)
+    sx = wx + (ux - ux2) / dx
+    sy = wy + (uy - uy2) / dx
+    slip = r.state.ravel() == 2
+    assert slip.sum() > 10 and (r.state == 1).sum() > 10
+    scale = math.hypot(xi, eta) + abs(phi) * x.max()
+    np.testing.assert_allclose(r.sx.ravel()[slip], sx[slip], atol=1e-9 * scale)
+    np.testing.assert_allclose(r.sy.ravel()[slip], sy[slip], atol=1e-9 * scale)
+    # stick: the dense slip vanishes up to the iteration tolerance
+    assert np.abs(np.hypot(sx, sy)[r.state.ravel() == 1]).max() < 1e-8 * scale
+
+
+#: Forces of the solver before its influence sums were done by FFT (element-wise Gauss-Seidel
+#: with direct sums, commit 2a7873f), 30 x 30 elements, Fz = 100 kN, mu = 0.3, G = 82 GPa:
+#: (xi, eta, phi [rad/m], a, b [m], options) -> (Fx/(mu Fz), Fy/(mu Fz), Mz [N m], sweeps).
+BEFORE_FFT = [
+    ((0.0, -0.000625, 0.625, 8e-3, 4e-3, {}), (8.57e-10, -0.52781813382, -51.205100693, 108)),
+    ((2e-4, 1e-4, 0.3, 2e-3, 10e-3, {}), (-0.032826378923, -0.059092483730, -37.397123494, 100)),
+    ((3e-4, -2e-4, -0.5, 10e-3, 2e-3, {}), (-0.10803759266, 0.84701159904, 12.080497493, 181)),
+    ((1e-3, 5e-4, 0.0, 5e-3, 5e-3, {}), (-0.26827059578, -0.11799446292, 5.4260701245, 63)),
+    ((0.0, 0.0, 1.5, 6e-3, 4e-3, {}), (5.98e-10, -0.69379687473, -48.913103183, 38)),
+    ((1.5e-3, 0.0, 0.2, 5e-3, 6e-3, dict(speed=30.0, friction_ratio=0.4, friction_decay=0.6)),
+     (-0.41925114386, -0.11518241698, -13.073225559, 137)),
+    ((4e-4, 3e-4, -0.4, 10e-3, 2e-3, dict(poisson=0.25)),
+     (-0.15082957636, 0.51273378681, 23.523003050, 244)),
+]  # fmt: skip
+
+
+@ANY_INPUT
+@pytest.mark.parametrize("case, before", BEFORE_FFT)
+def test_same_results_as_the_solver_with_direct_sums(case, before):
+    # a/b 0.2 and 5, spin, combined creepage, falling friction, nu = 0.25: within 1e-4 mu Fz
+    # (the FFT sums change only the round-off: the same iteration, the same sweeps)
+    xi, eta, phi, a, b, opts = case
+    r = exact_rolling(xi, eta, phi, 1e5, a, b, 0.3, nx=30, ny=30, **opts)
+    assert float(r.fx) / 3e4 == pytest.approx(before[0], abs=1e-4)
+    assert float(r.fy) / 3e4 == pytest.approx(before[1], abs=1e-4)
+    assert float(r.mz) == pytest.approx(before[2], rel=1e-4, abs=1e-4 * 3e4 * min(a, b))
+    assert abs(int(r.iterations) - before[3]) <= 2

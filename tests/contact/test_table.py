@@ -238,3 +238,58 @@ def test_integer_and_mixed_type_inputs_work():
     assert fx[0] == want[0]
     with pytest.raises(ValueError, match="creep_long"):
         exact_table_forces("x", 0, 0, 1e5, 6e-3, 6e-3, 0.3)
+
+
+def test_equal_valued_arrays_take_the_shared_path():
+    """Issue 22: a and b given as arrays of equal values are looked up as when given once (the
+    table's slice at that a/b); a/b varying per contact (4-D lookup) agrees to rounding."""
+    rng = np.random.default_rng(11)
+    n = 1500  # three chunks
+    xi, eta, phi = rng.uniform(-3e-3, 3e-3, n), rng.uniform(-3e-3, 3e-3, n), rng.uniform(-1, 1, n)
+    once = exact_table_forces(xi, eta, phi, FZ, 5e-3, 6e-3, MU)
+    arrays = exact_table_forces(xi, eta, phi, FZ, np.full(n, 5e-3), np.full(n, 6e-3), MU,
+                                poisson=np.full(n, 0.28))  # fmt: skip
+    for u, v in zip(once, arrays, strict=True):
+        np.testing.assert_array_equal(u, v)
+    b = np.full(n, 6e-3)
+    b[-1] = 7e-3  # one contact differs: every contact takes the 4-D lookup
+    varying = exact_table_forces(xi, eta, phi, FZ, 5e-3, b, MU)
+    scale = (MU * FZ, MU * FZ, MU * FZ * math.sqrt(5e-3 * 6e-3))
+    for u, v, q in zip(once, varying, scale, strict=True):
+        np.testing.assert_allclose(v[:-1], u[:-1], rtol=0, atol=1e-12 * q)
+
+
+@pytest.mark.parametrize(
+    ("kw", "name"),
+    [
+        ({"creep_lat": "nan"}, "creep_lat"),
+        ({"normal_force": -1.0}, "normal_force"),
+        ({"a": 0.3e-3}, "a/b"),  # a/b below 0.2 at one contact, a/b varying
+        ({"poisson": 0.31}, "poisson"),
+        ({"mu": -0.1}, "mu"),
+        ({"speed": -5.0}, "speed"),
+        ({"friction_ratio": 1.5}, "friction_ratio"),
+    ],
+)
+def test_one_bad_value_in_a_large_array_names_the_argument(kw, name):
+    """The compiled loop validates chunk by chunk; a single bad value deep in an array (chunk
+    5 of 8) raises the error naming its argument, as for scalars."""
+    n = 4000
+    args = {"creep_long": np.full(n, 1e-3), "creep_lat": np.zeros(n), "spin": np.zeros(n),
+            "normal_force": np.full(n, FZ), "a": np.full(n, 5e-3), "b": np.full(n, 6e-3),
+            "mu": np.full(n, MU)}  # fmt: skip
+    opts = {"speed": np.full(n, 20.0), "friction_ratio": np.full(n, 0.4),
+            "friction_decay": np.full(n, 0.6), "poisson": np.full(n, 0.28)}  # fmt: skip
+    for key, value in kw.items():
+        target = args if key in args else opts
+        target[key][2345] = np.nan if value == "nan" else value
+    with pytest.raises(ValueError, match=name):
+        exact_table_forces(**args, **opts)
+
+
+def test_integer_arrays_and_mixed_lists_are_floats():
+    want = exact_table_forces(np.array([1e-3, 2e-3]), 0.0, 0.0, 1e5, 6e-3, 5e-3, 0.3)
+    got = exact_table_forces([1e-3, 2e-3], [0, 0], np.zeros(2, dtype=int),
+                             np.array([100000, 100000]), 6e-3, [5e-3, 0.005], 0.3)  # fmt: skip
+    for u, v in zip(want, got, strict=True):
+        np.testing.assert_array_equal(u, v)

@@ -29,6 +29,7 @@ _LAZY = {
     "solve_tangential": "railadhesion.contact.exact",
     "tangential_influence": "railadhesion.contact.exact",
     "exact_table_forces": "railadhesion.contact.table",
+    "exact_table_law": "railadhesion.contact.table",
 }
 
 
@@ -53,6 +54,7 @@ __all__ = [
     "contact_semi_axes",
 
     "exact_table_forces",
+    "exact_table_law",
     "fastsim",
     "hertz_3d",
     "hertz_3d_from_curvatures",

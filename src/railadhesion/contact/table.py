@@ -26,8 +26,13 @@ discretisation error (its excess stiffness).
 The table is solved with Coulomb friction at nu = 0.28 (steel); Poisson's ratios 0.25-0.30 are
 served by scaling with Kalker's coefficients at that nu, and falling friction by one
 coefficient per contact at Polach's global slip velocity (see :func:`exact_table_forces` for
-both and for where they are accurate). When all contacts share one a/b (the usual case) the
-table is first interpolated to that a/b and the lookup is 3-D.
+both and for where they are accurate). When all contacts share one a/b and nu (given once,
+or as arrays of equal values) the table is first interpolated to that a/b and the lookup is
+3-D.
+
+One law, one implementation: the lookup of one contact is :func:`exact_table_law` (a
+``jitable`` function for compiled code: drivers, integrators, FMUs), made of pieces that the
+batch loop of :func:`exact_table_forces` calls in stages over chunks of contacts.
 """
 
 from __future__ import annotations
@@ -46,12 +51,31 @@ from railadhesion._validate import (
 )
 from railadhesion.contact.exact import check_friction_law
 from railadhesion.contact.friction import falling_friction_factor
-from railadhesion.contact.kalker import kalker_coefficients, kalker_scalar
-from railadhesion.numerics import atan_nonneg, chunk_of, fill, jit, run_chunks
+from railadhesion.contact.kalker import (
+    kalker_coefficients,
+    kalker_law,
+    kalker_rows,
+    kalker_scalar,
+)
+from railadhesion.numerics import (
+    CHUNK,
+    FINITE,
+    NONNEGATIVE,
+    POSITIVE,
+    atan_nonneg,
+    count_outside,
+    fill,
+    fill_row,
+    flatten,
+    jit,
+    jitable,
+    load_row,
+    run_chunks,
+)
 from railadhesion.plausibility import input_checker
 from railadhesion.simd import NOUT, contract_rows
 
-__all__ = ["exact_table_forces", "table_axes"]
+__all__ = ["exact_table_forces", "exact_table_law", "table_axes"]
 
 #: Poisson's ratio of the table.
 TABLE_POISSON = 0.28
@@ -144,6 +168,7 @@ def _read_only(x):
     return x
 
 
+@jitable
 def _catmull_rom(w):
     """Catmull-Rom weights of the nodes i-1 .. i+2 at the fraction w of [i, i+1]."""
     w2 = w * w
@@ -152,6 +177,7 @@ def _catmull_rom(w):
             0.5 * (-3.0 * w3 + 4.0 * w2 + w), 0.5 * (w3 - w2))  # fmt: skip
 
 
+@jitable
 def _locate_uniform(v, v0, inv_h, n):
     """Index i and fraction w of v between the uniform nodes i and i+1 (clipped to the
     nodes; NaN goes to the first node): float i, w (vectorisable)."""
@@ -160,10 +186,6 @@ def _locate_uniform(v, v0, inv_h, n):
     q = q if q < n - 1.0 else n - 1.0
     i = min(np.floor(q), n - 2.0)
     return i, q - i
-
-
-_catmull_rom_jit = jit(inline="always")(_catmull_rom)
-_locate_jit = jit(inline="always")(_locate_uniform)
 
 
 @lru_cache(maxsize=32)
@@ -181,88 +203,174 @@ def _slice_at(laob: float) -> np.ndarray:
     return _read_only(out.reshape(-1))
 
 
-#: Values per table node in memory: Fx, Fy, Mz (rows padded to 4 were measured slower: the
-#: table is larger, and the lookup is bound by its memory accesses as much as by arithmetic).
+#: Values per table node in memory: Fx, Fy, Mz.
 _NOUT = NOUT  # values per node (Fx, Fy, Mz), as contract_rows reads them
-#: Contacts per chunk of the kernel (its scratch rows stay in the level-2 cache).
-_CHUNK = 512
 #: Contacts from which the lookup runs in parallel (as the package's Polach kernels).
 _PARALLEL_MIN = 100_000
 
-# Rows of the kernel's scratch array (shape (_ROWS, _CHUNK)): the Kalker-scaled creepages
-# (X, Y, S), turned in place into the table coordinates (t, theta, u); the signs of the
-# symmetries; the friction coefficient's factor and its inverse; the first table row of the
-# contact's 4^3 (or 4^4) nodes; the cubic weights along t, theta, u and log(a/b); the
-# interpolated outputs; scratch.
-_R_X, _R_Y, _R_S, _R_SGN, _R_SY, _R_FAC, _R_INV, _R_BASE = range(8)
-_R_WT, _R_WD, _R_WU, _R_WA = 8, 12, 16, 20
-_R_F0, _R_F1, _R_F2, _R_ARG, _R_TMP = range(24, 29)
-_ROWS = 29
+
+# --- the law: one contact, in pieces that the batch loop calls in stages -----------------------
 
 
-# Each stage below is one short loop over a chunk, with few arrays (few run-time aliasing
-# checks) and no float -> int conversion, so that it compiles to SIMD code (as the package's
-# Polach kernels, railadhesion.models.kernels).
+@jitable(inline="always")
+def table_friction_factor(xi, eta, speed, ratio, decay):
+    """The looked-up coefficient of friction over mu: the falling-friction law's factor
+    (:func:`falling_friction_factor`) at Polach's global slip velocity V |(xi, eta)|; 1 for
+    constant friction."""
+    w = speed * math.sqrt(xi * xi + eta * eta)
+    return falling_friction_factor(w, ratio, decay) if w > 0.0 else 1.0
+
+
+@jitable(inline="always")
+def table_scaled_creepages(xi, eta, phi, fz, a, b, mu, g, fac, c11, c22, c23):
+    """Kalker-scaled creepages (X, Y, S) of the looked-up coefficient of friction
+    ``fac mu`` (:func:`table_friction_factor`), the force scale ``kf = fac mu Fz`` and
+    ``c = sqrt(a b)`` of one contact (module docstring); ``fac`` divides the creepages and
+    scales the forces."""
+    c = math.sqrt(a * b)
+    tau = mu * (1.5 / math.pi) * fz / (a * b * g)  # mu p0 / G
+    f = (1.5 / math.pi) / (tau * fac) if tau * fac > 0.0 else 0.0
+    return xi * f * c11, eta * f * c22, phi * c * f * c23, fac * mu * fz, c
+
+
+@jitable(inline="always")
+def table_coordinates(x, y, s):
+    """Table coordinates (t, theta, u) of Kalker-scaled creepages (X, Y, S), reflected into
+    X, Y >= 0, and the signs (sgn, sy) of the symmetries: (xi, eta, phi) -> -(xi, eta, phi)
+    changes every output's sign, (eta, phi) -> -(eta, phi) those of Fy and Mz."""
+    sgn = -1.0 if x < 0.0 else 1.0
+    x = sgn * x
+    y = sgn * y
+    s = sgn * s
+    sy = -1.0 if y < 0.0 else 1.0
+    y = sy * y
+    s = sy * s
+    t = _TWO_PI * atan_nonneg(math.sqrt(x * x + y * y) / R0)
+    hi = max(x, y)
+    lo = min(x, y)  # direction in [0, pi/2] from the smaller over the larger
+    ang = atan_nonneg(lo / (hi if hi > 0.0 else 1.0))
+    th = 0.5 * math.pi - ang if y > x else ang
+    u = _TWO_PI * atan_nonneg(abs(s) / S0)
+    return t, th, -u if s < 0.0 else u, sgn, sy
+
+
+@jitable(inline="always")
+def table_forces(f0, f1, f2, sgn, sy, kf, c):
+    """(Fx, Fy, Mz) from the interpolated normalised outputs: |(Fx, Fy)| capped at mu Fz
+    (the cubic may overshoot it by a few 0.1 % near full sliding; the exact solution never
+    does), the signs of the symmetries, the scales mu Fz and mu Fz c."""
+    ft = math.sqrt(f0 * f0 + f1 * f1)
+    scale = kf / (ft if ft > 1.0 else 1.0)
+    return sgn * scale * f0, sgn * sy * scale * f1, sgn * sy * kf * c * f2
+
+
+@jitable
+def table_sums(tab, dims, strides, origin, inv_step, laob, t, th, u):
+    """The cubic (Catmull-Rom) interpolation of the normalised (Fx, Fy, Mz/c)/(mu Fz) at table
+    coordinates (log a/b, t, theta, u). ``tab``: the table with ghost nodes, flat
+    (:func:`_load`'s ``padded_flat``), its four axes' ``dims``, ``strides``, ``origin``,
+    ``inv_step``; or its slice at one a/b (:func:`_slice_at`, ``strides[0] = 0``; ``laob``
+    unused)."""
+    it, ft = _locate_uniform(t, origin[1], inv_step[1], dims[1])
+    id_, fd = _locate_uniform(th, origin[2], inv_step[2], dims[2])
+    iu, fu = _locate_uniform(u, origin[3], inv_step[3], dims[3])
+    t0, t1, t2, t3 = _catmull_rom(ft)
+    d0, d1, d2, d3 = _catmull_rom(fd)
+    u0, u1, u2, u3 = _catmull_rom(fu)
+    st = strides[1]
+    sd = strides[2]
+    sa = strides[0]
+    o = int(it) * st + int(id_) * sd + int(iu) * strides[3]
+    if sa == 0:
+        return contract_rows(tab, o, st, sd, t0, t1, t2, t3, d0, d1, d2, d3, u0, u1, u2, u3)
+    ia, fa = _locate_uniform(laob, origin[0], inv_step[0], dims[0])
+    w = _catmull_rom(fa)
+    o += int(ia) * sa
+    f0 = f1 = f2 = 0.0
+    for q in range(4):
+        p0, p1, p2 = contract_rows(tab, o + q * sa, st, sd, t0, t1, t2, t3, d0, d1, d2, d3,
+                                      u0, u1, u2, u3)  # fmt: skip
+        f0 += w[q] * p0
+        f1 += w[q] * p1
+        f2 += w[q] * p2
+    return f0, f1, f2
+
+
+@jitable
+def exact_table_law(xi, eta, phi, fz, a, b, mu, g, nu, speed, ratio, decay, tab, dims, strides,
+                    origin, inv_step):  # fmt: skip
+    """Creep forces (Fx, Fy, Mz) of one contact by the table model: the law of
+    :func:`exact_table_forces` (its Notes), without validation (inputs in its ranges), for
+    compiled code (``numba``; a :func:`~railadhesion.numerics.jitable` function).
+
+    ``tab, dims, strides, origin, inv_step``: the 4-D table with its axes (the package data
+    as loaded by ``railadhesion.contact.table._load``: ``padded_flat``, ``dims``,
+    ``strides``, ``origin``, ``inv_step``). Kalker's coefficients at (a/b, nu)
+    (:func:`~railadhesion.contact.kalker.kalker_law`) scale the creepages; then the pieces
+    ``table_friction_factor``, ``table_scaled_creepages``, ``table_coordinates``,
+    ``table_sums`` and ``table_forces`` of the same module, which the batch loop of
+    :func:`exact_table_forces` calls in stages.
+    """
+    c11, c22, c23, _ = kalker_law(a / b, nu)
+    fac = table_friction_factor(xi, eta, speed, ratio, decay)
+    x, y, s, kf, c = table_scaled_creepages(xi, eta, phi, fz, a, b, mu, g, fac, c11, c22, c23)
+    t, th, u, sgn, sy = table_coordinates(x, y, s)
+    f0, f1, f2 = table_sums(tab, dims, strides, origin, inv_step, math.log(a / b), t, th, u)
+    return table_forces(f0, f1, f2, sgn, sy, kf, c)
+
+
+# --- the batch loop (stages over chunks of contacts) and the scalar entry point ----------------
+
+#: Bounds (numerics.count_outside) of Poisson's ratio for the table and of the ratio A.
+_POISSON_TABLE = (POISSON_MIN, POISSON_MIN, POISSON_MAX, POISSON_MAX)
+_UNIT = (0.0, 0.0, 1.0, 1.0)
+# Rows of the chunk buffer (rows of CHUNK values): the 12 inputs in the order of the kernel's
+# arguments, a/b, Kalker's coefficients, then the stages' results.
+_NIN = 12
+_R_RATIO, _R_C11 = 12, 13  # C11, C22, C23 in rows 13-15
+_R_T, _R_TH, _R_U, _R_SGN, _R_SY, _R_KF, _R_C, _R_BASE, _R_FAC = range(16, 25)
+_R_W = 25  # 16 rows of cubic weights: t, theta, u, log(a/b)
+_R_F = 41  # the 3 interpolated outputs
+_TROWS = 44
 
 
 @jit
-def _friction_factor(xs, ys, lvs, las, lbs, rows, m):
-    """Falling friction: the coefficient's factor mu/mu0 (:func:`falling_friction_factor`) at
-    Polach's global slip velocity V |(xi, eta)|, and its inverse, into rows."""
-    fac, inv = rows[_R_FAC], rows[_R_INV]
+def _stage_friction(buf, m):
+    """Row _R_FAC of the chunk: :func:`table_friction_factor`."""
     for k in range(m):
-        w = lvs[k] * math.sqrt(xs[k] * xs[k] + ys[k] * ys[k])
-        fac[k] = falling_friction_factor(w, las[k], lbs[k])
-    for k in range(m):
-        f = fac[k]
-        inv[k] = 1.0 / (f if f > 0.0 else 1.0) if f > 0.0 else 0.0
+        buf[_R_FAC * CHUNK + k] = table_friction_factor(
+            buf[k], buf[CHUNK + k], buf[9 * CHUNK + k], buf[10 * CHUNK + k],
+            buf[11 * CHUNK + k])  # fmt: skip
 
 
 @jit
-def _scaled(cs, factor, inv, out, m):
-    """out = cs factor inv (Kalker-scaled creepage of the looked-up coefficient)."""
+def _stage_scaled(buf, m):
+    """Rows of the chunk: :func:`table_scaled_creepages` and :func:`table_coordinates`."""
     for k in range(m):
-        out[k] = cs[k] * factor[k] * inv[k]
+        x, y, s, kf, c = table_scaled_creepages(
+            buf[k], buf[CHUNK + k], buf[2 * CHUNK + k], buf[3 * CHUNK + k], buf[4 * CHUNK + k],
+            buf[5 * CHUNK + k], buf[6 * CHUNK + k], buf[7 * CHUNK + k], buf[_R_FAC * CHUNK + k],
+            buf[_R_C11 * CHUNK + k], buf[(_R_C11 + 1) * CHUNK + k],
+            buf[(_R_C11 + 2) * CHUNK + k])  # fmt: skip
+        t, th, u, sgn, sy = table_coordinates(x, y, s)
+        buf[_R_T * CHUNK + k] = t
+        buf[_R_TH * CHUNK + k] = th
+        buf[_R_U * CHUNK + k] = u
+        buf[_R_SGN * CHUNK + k] = sgn
+        buf[_R_SY * CHUNK + k] = sy
+        buf[_R_KF * CHUNK + k] = kf
+        buf[_R_C * CHUNK + k] = c
 
 
 @jit
-def _coordinates(rows, m):
-    """Kalker-scaled (X, Y, S) -> table coordinates (t, theta, u) in place, reflected into
-    X >= 0, Y >= 0 (point symmetry: all outputs change sign; mirror in y: Fy and Mz change
-    sign); the signs into their rows."""
-    xr, yr, pr, sgr, syr = rows[_R_X], rows[_R_Y], rows[_R_S], rows[_R_SGN], rows[_R_SY]
-    for k in range(m):
-        x = xr[k]
-        y = yr[k]
-        p = pr[k]
-        sgn = -1.0 if x < 0.0 else 1.0
-        x = sgn * x
-        y = sgn * y
-        p = sgn * p
-        sy = -1.0 if y < 0.0 else 1.0
-        y = sy * y
-        p = sy * p
-        r = math.sqrt(x * x + y * y)
-        xr[k] = _TWO_PI * atan_nonneg(r / R0)
-        # direction in [0, pi/2] from the smaller over the larger of x, y (both >= 0 here)
-        hi = max(x, y)
-        lo = min(x, y)
-        a = atan_nonneg(lo / (hi if hi > 0.0 else 1.0))
-        yr[k] = 0.5 * math.pi - a if y > x else a
-        u = _TWO_PI * atan_nonneg(abs(p) / S0)
-        pr[k] = -u if p < 0.0 else u
-        sgr[k] = sgn
-        syr[k] = sy
-
-
-@jit
-def _weights(v, v0, inv_h, n, stride, base, w, m):
-    """Cubic weights along one axis into w[0..3]; the axis' part of the contact's first
-    table row (node index times ``stride``) added to base."""
+def _stage_weights(v, v0, inv_h, n, stride, base, w, m):
+    """Cubic weights along one axis (coordinates ``v``) into the rows of ``w`` (4, CHUNK);
+    the axis' part of each contact's first table row (node index times ``stride``) added to
+    ``base`` (views of the chunk buffer: few arrays, so that the loop is SIMD code)."""
     w0, w1, w2, w3 = w[0], w[1], w[2], w[3]
     for k in range(m):
-        i, f = _locate_jit(v[k], v0, inv_h, n)
-        c0, c1, c2, c3 = _catmull_rom_jit(f)
+        i, f = _locate_uniform(v[k], v0, inv_h, n)
+        c0, c1, c2, c3 = _catmull_rom(f)
         w0[k] = c0
         w1[k] = c1
         w2[k] = c2
@@ -271,146 +379,143 @@ def _weights(v, v0, inv_h, n, stride, base, w, m):
 
 
 @jit
-def _gather(tab, rows, m, st, sd, sa):
-    """The interpolated outputs of each contact (sa > 0: also along log(a/b), the planes sa
-    apart)."""
-    base, f0, f1, f2 = rows[_R_BASE], rows[_R_F0], rows[_R_F1], rows[_R_F2]
-    wt, wd, wu, wa = rows[_R_WT:_R_WT + 4], rows[_R_WD:_R_WD + 4], rows[_R_WU:_R_WU + 4], \
-        rows[_R_WA:_R_WA + 4]  # fmt: skip
+def _stage_sums(tab, buf, m, st, sd, sa):
+    """The interpolated outputs of each contact (:func:`~railadhesion.simd.contract_rows`;
+    sa > 0: also along log(a/b), the planes sa apart) into rows _R_F to _R_F + 2."""
     for k in range(m):
-        b = int(base[k])
+        o = int(buf[_R_BASE * CHUNK + k])
+        r = _R_W * CHUNK + k  # the 12 weights along t, theta, u, CHUNK apart
+        w0, w1, w2, w3 = buf[r], buf[r + CHUNK], buf[r + 2 * CHUNK], buf[r + 3 * CHUNK]
+        r += 4 * CHUNK
+        w4, w5, w6, w7 = buf[r], buf[r + CHUNK], buf[r + 2 * CHUNK], buf[r + 3 * CHUNK]
+        r += 4 * CHUNK
+        w8, w9, w10, w11 = buf[r], buf[r + CHUNK], buf[r + 2 * CHUNK], buf[r + 3 * CHUNK]
         if sa == 0:
-            a0, a1, a2 = contract_rows(tab, b, st, sd, wt[0, k], wt[1, k], wt[2, k], wt[3, k],
-                                   wd[0, k], wd[1, k], wd[2, k], wd[3, k], wu[0, k], wu[1, k],
-                                   wu[2, k], wu[3, k])  # fmt: skip
+            f0, f1, f2 = contract_rows(tab, o, st, sd, w0, w1, w2, w3, w4, w5, w6, w7, w8,
+                                          w9, w10, w11)  # fmt: skip
         else:
-            a0 = 0.0
-            a1 = 0.0
-            a2 = 0.0
-            for qa in range(4):
-                s0, s1, s2 = contract_rows(tab, b + qa * sa, st, sd, wt[0, k], wt[1, k], wt[2, k],
-                                       wt[3, k], wd[0, k], wd[1, k], wd[2, k], wd[3, k],
-                                       wu[0, k], wu[1, k], wu[2, k], wu[3, k])  # fmt: skip
-                w = wa[qa, k]
-                a0 += w * s0
-                a1 += w * s1
-                a2 += w * s2
-        f0[k] = a0
-        f1[k] = a1
-        f2[k] = a2
+            f0 = f1 = f2 = 0.0
+            for q in range(4):
+                wa = buf[(_R_W + 12 + q) * CHUNK + k]
+                p0, p1, p2 = contract_rows(tab, o + q * sa, st, sd, w0, w1, w2, w3, w4, w5,
+                                              w6, w7, w8, w9, w10, w11)  # fmt: skip
+                f0 += wa * p0
+                f1 += wa * p1
+                f2 += wa * p2
+        buf[_R_F * CHUNK + k] = f0
+        buf[(_R_F + 1) * CHUNK + k] = f1
+        buf[(_R_F + 2) * CHUNK + k] = f2
 
 
 @jit
-def _cap(f0, f1, m):
-    """|(Fx, Fy)| / (mu Fz) capped at 1 (Coulomb's bound)."""
+def _stage_forces(buf, m, fx, fy, mz):
+    """:func:`table_forces` of the chunk into the outputs (views of the chunk)."""
     for k in range(m):
-        a0 = f0[k]
-        a1 = f1[k]
-        ft = math.sqrt(a0 * a0 + a1 * a1)
-        c = ft if ft > 1.0 else 1.0
-        f0[k] = a0 / c
-        f1[k] = a1 / c
-
-
-@jit
-def _forces(rows, kfs, kms, ox, oy, oz, m):
-    """Forces and moment from the normalised outputs: signs, mu Fz and mu Fz c scales."""
-    sgr, syr, fac = rows[_R_SGN], rows[_R_SY], rows[_R_FAC]
-    f0, f1, f2 = rows[_R_F0], rows[_R_F1], rows[_R_F2]
-    for k in range(m):
-        sgn = sgr[k]
-        sy = syr[k]
-        f = sgn * fac[k] * kfs[k]
-        ox[k] = f * f0[k]
-        oy[k] = f * sy * f1[k]
-        oz[k] = sgn * sy * fac[k] * kms[k] * f2[k]
+        fx[k], fy[k], mz[k] = table_forces(
+            buf[_R_F * CHUNK + k], buf[(_R_F + 1) * CHUNK + k], buf[(_R_F + 2) * CHUNK + k],
+            buf[_R_SGN * CHUNK + k], buf[_R_SY * CHUNK + k], buf[_R_KF * CHUNK + k],
+            buf[_R_C * CHUNK + k])  # fmt: skip
 
 
 @jit(nogil=True)
-def _lookup_chunks(tab, dims, strides, origin, inv_step, laob, xi, eta, phi, kx, ky, ks, kf,
-                   km, lv, la, lb, out, first, last):  # fmt: skip
-    """Cubic (Catmull-Rom) interpolation, per axis, of the 3 outputs at Kalker-scaled
-    creepages, for the chunks ``first`` to ``last - 1`` (of _CHUNK contacts) of ``out``.
-
-    ``tab`` is the table with ghost nodes (:func:`_load`'s ``padded``, flat: rows of _NOUT
-    values, node (ia, it, id, iu), counting the ghosts, at row ``ia strides[0] + it
-    strides[1] + id strides[2] + iu strides[3]``, strides[3] = _NOUT), or its slice at one
-    a/b (:func:`_slice_at`; then ``laob`` is empty). The four axes (log a/b, t, theta, u)
-    have ``dims`` nodes (ghosts not counted), uniform, the first at ``origin`` and spaced
-    1/``inv_step``.
-
-    Inputs per contact (arrays of length n, or 1 for a value shared by all): log(a/b) (or
-    empty), the creepages xi, eta, phi and their factors to Kalker-scaled creepages kx, ky, ks
-    (``X = xi kx`` ...); the force and moment scales kf = mu Fz, km = mu Fz c. The
-    interpolated |(Fx, Fy)| is capped at mu Fz (the cubic may overshoot it by a few 0.1 %
-    near full sliding, the exact solution never does). Falling friction: speed lv, ratio la
-    and decay lb; the coefficient is mu ((1 - A) exp(-B V |(xi, eta)|) + A), which divides
-    the scaled creepages and multiplies the forces. ``out`` (3, n) receives Fx, Fy, Mz.
-
-    Stages per chunk (each a short loop, SIMD code): the friction factor, the scaled
-    creepages, the table coordinates, the weights and first row, the interpolation (LLVM
-    vector code, :func:`_contract`), the cap, the forces.
-    """
-    n = out.shape[1]
-    na, nt, nd, nu = dims[0], dims[1], dims[2], dims[3]
-    sa = strides[0] if laob.size > 0 else 0
-    st, sd, su = strides[1], strides[2], strides[3]
-    m0 = max(min(_CHUNK, n), 1)
-    single = np.empty((12, m0))  # values shared by all contacts, repeated over a chunk
-    for j, x in enumerate((laob, xi, eta, phi, kx, ky, ks, kf, km, lv, la, lb)):
-        fill(single[j], x[0] if x.size > 0 else 0.0, m0)
-    rows = np.empty((_ROWS, m0))
-    # Coulomb friction for every contact (one test for the whole call)
-    coulomb = (
-        la.size == 1
-        and lb.size == 1
-        and lv.size == 1
-        and not (la[0] != 1.0 and lb[0] * lv[0] > 0.0)
-    )
+def _table_chunks(xi, eta, phi, fz, a, b, mu, g, nu, v, la, lb, kc, tab, dims, strides, origin,
+                  inv_step, fx, fy, mz, first, last):  # fmt: skip
+    """:func:`exact_table_law` of the contacts of chunks ``first`` to ``last - 1`` (of CHUNK
+    contacts) into fx, fy, mz (length n); the inputs are 1-d float64 arrays of length n or 1
+    (one value for every contact). ``kc`` (3, m): Kalker's (C11, C22, C23), m = 1 (shared by
+    every contact) or n, or m = 0: looked up per contact at its a/b and nu
+    (:func:`kalker_law`, through :func:`kalker_rows`). ``tab`` with ``strides[0] = 0`` is the
+    table's slice at the one a/b of every contact. The pieces of the law run in stages over
+    a chunk (short loops, SIMD code; the sums contact by contact). Validates in the same
+    pass; returns the number of chunks with an input out of range (their forces are NaN)."""
+    n = fx.size
+    count = min(CHUNK, n)
+    buf = np.zeros(_TROWS * CHUNK)
+    inputs = (xi, eta, phi, fz, a, b, mu, g, nu, v, la, lb)
+    for j in range(_NIN):
+        fill_row(buf, j, inputs[j], count)
+    nkc = kc.shape[1]
+    if nkc == 1:
+        for j in range(3):
+            fill(buf[(_R_C11 + j) * CHUNK :], kc[j, 0], count)
+    sa = strides[0]
+    # constant friction for every contact (A = 1 or B V = 0, values shared by all)
+    coulomb = la.size == 1 and lb.size == 1 and v.size == 1 and not (la[0] != 1.0
+                                                                      and lb[0] * v[0] > 0.0)
     if coulomb:
-        fill(rows[_R_FAC], 1.0, m0)
-        fill(rows[_R_INV], 1.0, m0)
+        fill(buf[_R_FAC * CHUNK :], 1.0, count)
+    nbad = 0
     for c in range(first, last):
-        lo = c * _CHUNK
-        hi = min(lo + _CHUNK, n)
-        m = hi - lo
-        xs = chunk_of(xi, single[1], lo, hi)
-        ys = chunk_of(eta, single[2], lo, hi)
+        lo = c * CHUNK
+        m = min(CHUNK, n - lo)
+        bad = (count_outside(xi, FINITE, lo, m) + count_outside(eta, FINITE, lo, m)
+               + count_outside(phi, FINITE, lo, m) + count_outside(fz, NONNEGATIVE, lo, m)
+               + count_outside(a, POSITIVE, lo, m) + count_outside(b, POSITIVE, lo, m)
+               + count_outside(mu, NONNEGATIVE, lo, m) + count_outside(g, POSITIVE, lo, m)
+               + count_outside(nu, _POISSON_TABLE, lo, m)
+               + count_outside(v, NONNEGATIVE, lo, m) + count_outside(la, _UNIT, lo, m)
+               + count_outside(lb, NONNEGATIVE, lo, m))  # fmt: skip
+        for j in range(_NIN):
+            load_row(buf, j, inputs[j], lo, m)
+        if bad == 0 and sa > 0:
+            for k in range(m):
+                r = buf[4 * CHUNK + k] / buf[5 * CHUNK + k]
+                buf[_R_RATIO * CHUNK + k] = r
+                bad += 0 if AOB_MIN * (1 - 1e-12) <= r <= AOB_MAX * (1 + 1e-12) else 1
+        ox, oy, oz = fx[lo : lo + m], fy[lo : lo + m], mz[lo : lo + m]
+        if bad > 0:
+            nbad += 1
+            fill(ox, math.nan, m)
+            fill(oy, math.nan, m)
+            fill(oz, math.nan, m)
+            continue
+        if nkc == 0:
+            kalker_rows(buf, _R_RATIO, 8, _R_C11, CHUNK, m)
+        elif nkc > 1:
+            for j in range(3):
+                dst = buf[(_R_C11 + j) * CHUNK :]
+                for k in range(m):
+                    dst[k] = kc[j, lo + k]
         if not coulomb:
-            _friction_factor(xs, ys, chunk_of(lv, single[9], lo, hi),
-                             chunk_of(la, single[10], lo, hi), chunk_of(lb, single[11], lo, hi),
-                             rows, m)  # fmt: skip
-        inv = rows[_R_INV]
-        _scaled(xs, chunk_of(kx, single[4], lo, hi), inv, rows[_R_X], m)
-        _scaled(ys, chunk_of(ky, single[5], lo, hi), inv, rows[_R_Y], m)
-        _scaled(chunk_of(phi, single[3], lo, hi), chunk_of(ks, single[6], lo, hi), inv, rows[_R_S],
-                m)  # fmt: skip
-        _coordinates(rows, m)
+            _stage_friction(buf, m)
+        _stage_scaled(buf, m)
+        rows = buf.reshape(_TROWS, CHUNK)
         base = rows[_R_BASE]
         fill(base, 0.0, m)
-        _weights(rows[_R_X], origin[1], inv_step[1], nt, st, base, rows[_R_WT : _R_WT + 4], m)
-        _weights(rows[_R_Y], origin[2], inv_step[2], nd, sd, base, rows[_R_WD : _R_WD + 4], m)
-        _weights(rows[_R_S], origin[3], inv_step[3], nu, su, base, rows[_R_WU : _R_WU + 4], m)
+        _stage_weights(rows[_R_T], origin[1], inv_step[1], dims[1], strides[1], base,
+                       rows[_R_W : _R_W + 4], m)  # fmt: skip
+        _stage_weights(rows[_R_TH], origin[2], inv_step[2], dims[2], strides[2], base,
+                       rows[_R_W + 4 : _R_W + 8], m)  # fmt: skip
+        _stage_weights(rows[_R_U], origin[3], inv_step[3], dims[3], strides[3], base,
+                       rows[_R_W + 8 : _R_W + 12], m)  # fmt: skip
         if sa > 0:
-            laobs = chunk_of(laob, single[0], lo, hi)
-            _weights(laobs, origin[0], inv_step[0], na, sa, base, rows[_R_WA : _R_WA + 4], m)
-        _gather(tab, rows, m, st, sd, sa)
-        _cap(rows[_R_F0], rows[_R_F1], m)
-        _forces(rows, chunk_of(kf, single[7], lo, hi), chunk_of(km, single[8], lo, hi),
-                out[0, lo:hi], out[1, lo:hi], out[2, lo:hi], m)  # fmt: skip
+            laob = rows[_R_RATIO]
+            for k in range(m):
+                laob[k] = math.log(laob[k])
+            _stage_weights(laob, origin[0], inv_step[0], dims[0], sa, base,
+                           rows[_R_W + 12 : _R_W + 16], m)  # fmt: skip
+        _stage_sums(tab, buf, m, strides[1], strides[2], sa)
+        _stage_forces(buf, m, ox, oy, oz)
+    return nbad
 
 
 @jit(nogil=True)
-def _lookup_one(tab, dims, strides, origin, inv_step, laob, xi, eta, phi, kx, ky, ks, kf, km,
-                lv, la, lb):  # fmt: skip
-    """:func:`_lookup_chunks` for one contact given as floats, on the full 4-D table
-    (``laob`` = log(a/b)): (Fx, Fy, Mz). The scalar path of :func:`exact_table_forces`."""
-    out = np.empty((3, 1))
-    _lookup_chunks(tab, dims, strides, origin, inv_step, np.array([laob]), np.array([xi]),
-                   np.array([eta]), np.array([phi]), np.array([kx]), np.array([ky]),
-                   np.array([ks]), np.array([kf]), np.array([km]), np.array([lv]),
-                   np.array([la]), np.array([lb]), out, 0, 1)  # fmt: skip
-    return out[0, 0], out[1, 0], out[2, 0]
+def _constant(x):
+    """True if every value of x equals the first (stops at the first that does not)."""
+    first = x[0]
+    for k in range(1, x.size):
+        if x[k] != first:
+            return False
+    return True
+
+
+@jit
+def _table_one(xi, eta, phi, fz, a, b, mu, g, nu, speed, ratio, decay, tab, dims, strides,
+               origin, inv_step):  # fmt: skip
+    """:func:`exact_table_law` for one contact given as floats (the scalar path of
+    :func:`exact_table_forces`)."""
+    return exact_table_law(xi, eta, phi, fz, a, b, mu, g, nu, speed, ratio, decay, tab, dims,
+                           strides, origin, inv_step)  # fmt: skip
 
 
 def _is_real(x) -> bool:
@@ -439,48 +544,9 @@ def _scalar_forces(xi, eta, phi, fz, a, b, mu, g, nu, speed, ratio, decay):
     aob = a / b
     if not AOB_MIN * (1 - 1e-12) <= aob <= AOB_MAX * (1 + 1e-12):
         return None
-    c11, c22, c23, _ = kalker_scalar(aob, nu)
-    c = math.sqrt(a * b)
-    tau = mu * (1.5 / math.pi) * fz / (a * b * g)
-    f = (1.5 / math.pi) / tau if tau > 0.0 else 0.0
-    scale = mu * fz
     d = _load()
-    return _lookup_one(d["padded_flat"], d["dims"], d["strides"], d["origin"], d["inv_step"],
-                       math.log(aob), xi, eta, phi, f * c11, f * c22, c * f * c23, scale,
-                       scale * c, speed, ratio, decay)  # fmt: skip
-
-
-def _interp(d, laob, shape, xi, eta, phi, kx, ky, ks, kf, km, lv, la, lb):
-    """Fx, Fy, Mz of the contacts (``shape``); every input broadcasts to ``shape``. One a/b
-    for all contacts (the usual case) is looked up in a 3-D slice of the table.
-
-    From _PARALLEL_MIN contacts on, the chunks run on ``numba.get_num_threads()`` threads
-    (:func:`railadhesion.numerics.run_chunks`; the kernel releases the GIL)."""
-    n = math.prod(shape)
-
-    def flat(v):  # length 1 (shared) or n; anything else is broadcast out; read-only
-        v = np.asarray(v, dtype=float)
-        if v.size == 1:
-            v = v.reshape(1)
-        else:
-            if v.shape != shape:
-                v = np.broadcast_to(v, shape)
-            v = np.ascontiguousarray(v).reshape(-1)
-        return _read_only(v)
-
-    args = tuple(flat(v) for v in (xi, eta, phi, kx, ky, ks, kf, km, lv, la, lb))
-    out = np.empty((3, n))
-    if laob.size == 1 or np.all(laob == laob.flat[0]):
-        table, laobs = _slice_at(float(laob.flat[0])), _NO_AOB
-    else:
-        table, laobs = d["padded_flat"], flat(laob)
-    head = (table, d["dims"], d["strides"], d["origin"], d["inv_step"], laobs, *args, out)
-    nchunk = (n + _CHUNK - 1) // _CHUNK
-    run_chunks(_lookup_chunks, head, nchunk, n >= _PARALLEL_MIN)
-    return out.reshape(3, *shape)
-
-
-_NO_AOB = _read_only(np.empty(0))
+    return _table_one(xi, eta, phi, fz, a, b, mu, g, nu, speed, ratio, decay, d["padded_flat"],
+                      d["dims"], d["strides"], d["origin"], d["inv_step"])  # fmt: skip
 
 
 #: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
@@ -593,55 +659,90 @@ def exact_table_forces(
                              float(speed) if _is_real(speed) else speed,
                              float(friction_ratio), float(friction_decay))  # fmt: skip
         if res is not None:
-            # implausible inputs warn (docs/checks.md)
-            _PLAUSIBLE((creep_long, creep_lat, spin, normal_force, a, b, speed, shear_modulus,
-                        poisson))  # fmt: skip
+            # implausible inputs warn (docs/checks.md); no speed: nothing to check (0.0 keeps
+            # the checker's fast test for floats)
+            _PLAUSIBLE((creep_long, creep_lat, spin, normal_force, a, b,
+                        0.0 if speed is None else speed, shear_modulus, poisson))  # fmt: skip
             return res
-    xi = check_finite(creep_long, "creep_long")
-    eta = check_finite(creep_lat, "creep_lat")
-    phi = check_finite(spin, "spin")
-    fz = check_nonnegative(normal_force, "normal_force")
+    names = ("creep_long", "creep_lat", "spin", "normal_force", "a", "b", "mu",
+             "shear_modulus", "poisson", "speed", "friction_ratio", "friction_decay")  # fmt: skip
+    if speed is None:  # Coulomb friction unless the law says otherwise (then an error)
+        check_friction_law(speed, friction_ratio, friction_decay)
+    values = (creep_long, creep_lat, spin, normal_force, a, b, mu, shear_modulus, poisson,
+              0.0 if speed is None else speed, friction_ratio, friction_decay)  # fmt: skip
+    arrays = [as_float_array(x, name) for x, name in zip(values, names, strict=True)]
+    shape, n, flat = flatten(arrays)
+    xi, eta, phi, fz, a_, b_, mu_, g, nu, v, ratio, decay = flat
+    d = _load()
+    tab, strides = d["padded_flat"], d["strides"]
+    # one a/b and nu for every contact (values given once, or arrays of equal values): the
+    # table's slice at that a/b and one Kalker lookup
+    shared = all(x.size == 1 or _constant(x) for x in (a_, b_, nu))
+    kc = np.empty((3, 0))
+    if shared:
+        a0, b0, nu0 = float(a_[0]), float(b_[0]), float(nu[0])
+        if a0 > 0.0 and b0 > 0.0 and AOB_MIN * (1 - 1e-12) <= a0 / b0 <= AOB_MAX * (1 + 1e-12):
+            tab, strides = _slice_at(math.log(a0 / b0)), _slice_strides(strides)
+            if POISSON_MIN <= nu0 <= POISSON_MAX:
+                kc = np.array(kalker_scalar(a0 / b0, nu0)[:3], dtype=float).reshape(3, 1)
+    if not kalker_correction:  # the build grid's own coefficients, interpolated in log(a/b)
+        kc = _grid_coefficients(d, a_, b_, nu, shared)
+    fx, fy, mz = np.empty(n), np.empty(n), np.empty(n)
+    nbad = run_chunks(_table_chunks, (xi, eta, phi, fz, a_, b_, mu_, g, nu, v, ratio, decay, kc,
+                                      tab, d["dims"], strides, d["origin"], d["inv_step"], fx,
+                                      fy, mz), -(-n // CHUNK), n >= _PARALLEL_MIN)  # fmt: skip
+    if sum(nbad):
+        _check_inputs(values)
+        raise AssertionError("table kernel flagged an input the checks accept")
+    # implausible inputs warn (docs/checks.md)
+    _PLAUSIBLE((creep_long, creep_lat, spin, normal_force, a, b, speed, shear_modulus,
+                poisson))  # fmt: skip
+    if not shape:
+        return float(fx[0]), float(fy[0]), float(mz[0])
+    return fx.reshape(shape), fy.reshape(shape), mz.reshape(shape)
+
+
+def _slice_strides(strides):
+    """Strides of :func:`_slice_at`'s slice: those of the table, none along a/b."""
+    out = np.array(strides)
+    out[0] = 0
+    return _read_only(out)
+
+
+def _grid_coefficients(d, a, b, nu, shared):
+    """Kalker's coefficients scaled to the build grid's own (``kalker_correction=False``),
+    interpolated in log(a/b): (3, 1) if ``shared``, else (3, n)."""
+    if shared:
+        a, b, nu = a[:1], b[:1], nu[:1]
+    aob = np.broadcast_to(a / b, np.broadcast_shapes(a.shape, b.shape, nu.shape))
+    laob = np.log(aob)
+    k = kalker_coefficients(aob, nu)
+    k0 = kalker_coefficients(aob, TABLE_POISSON)
+    ln = np.log(d["aob"])
+    return np.array([np.interp(laob, ln, d["cgrid"][:, j]) * cn / c0
+                     for j, cn, c0 in zip(range(3), (k.c11, k.c22, k.c23),
+                                          (k0.c11, k0.c22, k0.c23), strict=True)])  # fmt: skip
+
+
+def _check_inputs(values):
+    """Raise the ValueError naming the first input of :func:`exact_table_forces` out of its
+    range (the compiled loop validates in the same pass and calls this to raise)."""
+    xi, eta, phi, fz, a, b, mu, g, nu, v, ratio, decay = values
+    check_finite(xi, "creep_long")
+    check_finite(eta, "creep_lat")
+    check_finite(phi, "spin")
+    check_nonnegative(fz, "normal_force")
     a_ = check_positive(a, "a")
     b_ = check_positive(b, "b")
-    mu_ = check_nonnegative(mu, "mu")
-    g = check_positive(shear_modulus, "shear_modulus")
-    nu = as_float_array(poisson, "poisson")
-    if not np.all((nu >= POISSON_MIN) & (nu <= POISSON_MAX)):
+    check_nonnegative(mu, "mu")
+    check_positive(g, "shear_modulus")
+    nu_ = as_float_array(nu, "poisson")
+    if not np.all((nu_ >= POISSON_MIN) & (nu_ <= POISSON_MAX)):
         raise ValueError(
             f"poisson must be in [{POISSON_MIN}, {POISSON_MAX}] for the table model (tabulated "
-            f"at {TABLE_POISSON}, validated over that range), got {poisson!r}"
+            f"at {TABLE_POISSON}, validated over that range), got {nu!r}"
         )
-    ratio, decay, v = check_friction_law(speed, friction_ratio, friction_decay)
+    check_friction_law(v, ratio, decay)
     aob = a_ / b_
     if not np.all((aob >= AOB_MIN * (1 - 1e-12)) & (aob <= AOB_MAX * (1 + 1e-12))):
         raise ValueError(f"a/b must be in [{AOB_MIN}, {AOB_MAX}] for the table model")
-    # per-contact arrays only where needed: the geometry is often shared by all contacts
-    shape = np.broadcast_shapes(xi.shape, eta.shape, phi.shape, fz.shape, a_.shape, b_.shape,
-                                mu_.shape, g.shape, nu.shape, ratio.shape, decay.shape,
-                                v.shape)  # fmt: skip
-    c = np.sqrt(a_ * b_)
-    tau = mu_ * (1.5 / np.pi) * fz / (a_ * b_ * g)  # mu p0 / G
-    with np.errstate(divide="ignore", invalid="ignore"):
-        f = np.where(tau > 0.0, (1.5 / np.pi) / tau, 0.0)
-    d = _load()
-    # a/b before broadcasting: one Kalker lookup when the geometry is shared by all contacts
-    laob = np.log(aob)
-    k = kalker_coefficients(aob, float(nu) if nu.ndim == 0 else nu)
-    coef = (k.c11, k.c22, k.c23)
-    if not kalker_correction:  # the build grid's own coefficients, interpolated in log(a/b)
-        ln = np.log(d["aob"])
-        k0 = kalker_coefficients(aob, TABLE_POISSON)
-        coef = tuple(
-            np.interp(laob, ln, d["cgrid"][:, j]) * cn / c0
-            for j, cn, c0 in zip(range(3), coef, (k0.c11, k0.c22, k0.c23), strict=True)
-        )
-
-    scale = mu_ * fz
-    # with falling friction the compiled lookup scales mu per contact by the law at Polach's
-    # global slip velocity V |(xi, eta)| (spin not counted)
-    fx, fy, mz = _interp(d, laob, shape, xi, eta, phi, f * coef[0], f * coef[1],
-                         c * f * coef[2], scale, scale * c, v, ratio, decay)  # fmt: skip
-    _PLAUSIBLE((xi, eta, phi, fz, a_, b_, speed, g, nu))  # implausible inputs warn
-    if fx.ndim == 0:
-        return float(fx), float(fy), float(mz)
-    return fx, fy, mz
