@@ -53,11 +53,16 @@ from railadhesion.identification.signals import (
     gradient_coefficients,
     gradient_weighted,
 )
+from railadhesion.numerics import jitable, load_numba
+
+load_numba()  # numba with the laws registry: the @jitable laws below register as they are defined
 
 __all__ = [
     "BrakeCoefficient",
     "BrakingIdentification",
+    "axle_adhesion_law",
     "brake_coefficient",
+    "brake_coefficient_law",
     "brake_coefficient_per_sample",
     "identify_adhesion",
     "identification_windows",
@@ -354,20 +359,44 @@ def brake_coefficient_per_sample(deceleration, wheel_acceleration_sum, pressure_
     >>> round(float(c[0] / veh.brake_coefficient), 9)
     1.0
     """
-    r = float(vehicle.wheel_radius)
-    force = np.multiply(np.asarray(deceleration, dtype=float), float(vehicle.total_mass))
-    inertia = np.multiply(np.asarray(wheel_acceleration_sum, dtype=float),
-                          float(vehicle.wheelset_inertia))
-    np.divide(inertia, r, out=inertia)
-    np.subtract(force, inertia, out=force)
-    if resistance is not None:
-        np.subtract(force, np.asarray(resistance, dtype=float), out=force)
-    np.divide(np.asarray(pressure_sum, dtype=float), r, out=inertia)  # sum p / R
-    if where is None:
-        return np.divide(force, inertia, out=force)
-    c = np.full(force.shape, np.nan)
-    np.divide(force, inertia, out=c, where=np.asarray(where, dtype=bool))
+    d = np.asarray(deceleration, dtype=float)
+    f_res = 0.0 if resistance is None else np.asarray(resistance, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = brake_coefficient_law(float(vehicle.total_mass), d, f_res,
+                                  float(vehicle.wheelset_inertia),
+                                  np.asarray(wheel_acceleration_sum, dtype=float),
+                                  np.asarray(pressure_sum, dtype=float),
+                                  float(vehicle.wheel_radius))
+    c = np.array(c, dtype=float, copy=True).reshape(np.broadcast(d, c).shape)
+    if where is not None:
+        c[~np.broadcast_to(np.asarray(where, dtype=bool), c.shape)] = np.nan
     return c
+
+
+@jitable
+def brake_coefficient_law(mass, deceleration, resistance, inertia, wheel_acceleration_sum,
+                          pressure_sum, radius):
+    """Eq. 14 of seed 002 (Allotta et al.), the brake coefficient c [N m/Pa]:
+    ``c = (M_tot d - F_res - J sum_i w_dot_i / R) / (sum_i p_i / R)``.
+
+    The one writing of eq. 14: :func:`brake_coefficient_per_sample` calls it on arrays (it is
+    plain arithmetic, so floats and NumPy arrays both serve), the on-board monitor's compiled
+    step on its filtered sums. ``resistance`` F_res [N] is 0 where it is neglected (eq. 7).
+    """
+    return ((mass * deceleration - resistance - inertia * wheel_acceleration_sum / radius)
+            / (pressure_sum / radius))
+
+
+@jitable
+def axle_adhesion_law(inertia, wheel_acceleration, brake_coefficient, pressure, torque, radius,
+                      load):
+    """Eq. 10 of seed 002, the adhesion coefficient of one axle [-]:
+    ``mu = (J w_dot + c p - tau) / (R N)``, from the wheelset's rotation (eq. 6) with the
+    traction torque ``tau`` [N m] (0 in a braking test, the paper's case; the monitor passes
+    the measured torque under traction). The one writing of eq. 10: the identification's
+    compiled axle loop and the monitor's step call it.
+    """
+    return (inertia * wheel_acceleration + brake_coefficient * pressure - torque) / (radius * load)
 
 
 def _brake_window(t, deceleration, wheel_acceleration_sum, pressure_sum, pressure_mean,
@@ -586,7 +615,7 @@ def _axle_adhesion(i, wd, p, slip, v, d, wheel, train, valid, substituted, edge,
             loads[k, i] = x if x > 0.0 else 0.0
         fast = v[k] >= min_speed
         vr = max(train[k], 1e-9)
-        x = (j * wd[k, i] + c * p[k, i]) / (r * loads[k, i])
+        x = axle_adhesion_law(j, wd[k, i], c, p[k, i], 0.0, r, loads[k, i])
         mu[k, i] = x
         rel[k, i] = slip[k, i] / v[k] if fast else np.nan
         use[k, i] = (valid[k, i] and not substituted and fast and wheel[k, i] * r > 0.05 * vr

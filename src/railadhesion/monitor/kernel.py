@@ -24,7 +24,8 @@ division by zero gives inf or NaN, which the checks catch), as a C function need
    filters, the coefficients of :class:`railadhesion.identification.signals.FirstOrderFilter`
    in causal mode); the axle load N = N0 + N1 d (eqs. 11-12, affine in d); the creepage
    (v - omega R)/v and the adhesion in use, eq. 10 with the traction torque tau:
-   ``mu = (J omega_dot / R + c p / R - tau / R) / N`` (braking positive).
+   ``mu = (J omega_dot + c p - tau) / (R N)`` (braking positive;
+   :func:`railadhesion.identification.brake_tests.axle_adhesion_law`).
 4. **Wheel radius**: learned while the axle coasts (no pressure, no torque) as the ratio of
    the sums of v and omega over the coasting samples after ``coast_settle``; a coasting
    radius away from the learned one is a changed wheel.
@@ -54,7 +55,8 @@ division by zero gives inf or NaN, which the checks catch), as a C function need
 8. **Brake coefficient**, eq. 14 causally: ``c = (M d - J sum(omega_dot)/R) / (sum(p)/R)``
    with d, the angular accelerations and the pressures filtered alike at the vehicle cut-off,
    averaged over braking (mean pressure >= 0.5 bar, all wheels turning) with a 10 s
-   exponential memory (running resistance and gradient neglected, as in the paper).
+   exponential memory (running resistance and gradient neglected, as in the paper;
+   :func:`railadhesion.identification.brake_tests.brake_coefficient_law`).
 """
 
 from __future__ import annotations
@@ -64,6 +66,7 @@ import math
 from numba import njit
 
 from railadhesion import _jit
+from railadhesion.identification.brake_tests import axle_adhesion_law, brake_coefficient_law
 from railadhesion.models import kernels as _models_kernels
 from railadhesion.models import polach as _polach
 from railadhesion.models import twod as _twod
@@ -869,7 +872,8 @@ def step_record(cfg, inp, st, out, bank):
         force = hp or ht
         mu = _NAN
         if force:  # eq. 10 of seed 002 with the traction torque
-            mu = (cfg.inertia * st.wd_f[i] / r + c_used * st.p_f[i] / r - st.tau_f[i] / r) / load
+            mu = axle_adhesion_law(cfg.inertia, st.wd_f[i], c_used, st.p_f[i], st.tau_f[i], r,
+                                   load)
             if not (abs(mu) <= 1.5):
                 out.creep[i] = creep
                 out.adhesion_used[i] = _NAN
@@ -951,8 +955,8 @@ def step_record(cfg, inp, st, out, bank):
                 nbar = st.b_sn[i] / m
                 x = 1.0 - r * (st.b_sw[i] / m) / vbar
                 wdot = (st.b_w_end[i] - st.b_w_first[i]) / span
-                mu_b = (cfg.inertia * wdot / r + c_used * (st.b_sp[i] / m) / r
-                        - (st.b_stau[i] / m) / r) / nbar
+                mu_b = axle_adhesion_law(cfg.inertia, wdot, c_used, st.b_sp[i] / m,
+                                         st.b_stau[i] / m, r, nbar)
                 var_x = (cfg.sig_v ** 2 + (r * cfg.sig_w) ** 2) / (m * vbar * vbar)
                 g = cfg.inertia / (r * nbar * span)
                 var_mu = (2.0 * (cfg.sig_w * g) ** 2
@@ -1023,8 +1027,8 @@ def step_record(cfg, inp, st, out, bank):
                 turning = False
         if (turning and st.psum_f / n >= _C_MIN_PRESSURE and st.v_f >= cfg.min_speed
                 and dt > 0.0):
-            c_k = ((cfg.mass * st.d_f - cfg.inertia * st.jsum_f / cfg.radius)
-                   / (st.psum_f / cfg.radius))
+            c_k = brake_coefficient_law(cfg.mass, st.d_f, 0.0, cfg.inertia, st.jsum_f, st.psum_f,
+                                        cfg.radius)
             if _finite(c_k):
                 decay = math.exp(-dt / _C_MEMORY)
                 st.c_sum = st.c_sum * decay + c_k * dt
