@@ -95,12 +95,25 @@ def export_braking_fmu(
         help="Compile the braking step into the FMU (linux64 binary and its sources): no "
              "Python on the host. Needs a C compiler here. Default: the Python FMU.",
     ),  # fmt: skip
+    wsp: bool = typer.Option(
+        False, "--wsp",
+        help="Run the package's WSP inside the FMU (the scenario's [wsp] settings, ideal "
+             "sensors): the valve states become outputs. Native FMU only.",
+    ),  # fmt: skip
 ) -> None:
     """Write the braking vehicle of SCENARIO as an FMI 2.0 co-simulation FMU (inputs: commanded
-    pressure and WSP valve per axle; the Python FMU needs Python on the host, --native not)."""
+    pressure and WSP valve per axle, or with --wsp the pressure only; the Python FMU needs
+    Python on the host, --native not)."""
     from railadhesion.export import build_braking_fmu, build_native_braking_fmu
 
-    path = _write_fmu(build_native_braking_fmu if native else build_braking_fmu, out, scenario)
+    if wsp and not native:
+        _fail("--wsp: the built-in WSP runs in the native braking FMU only (add --native)")
+    if native:
+        path = _write_fmu(build_native_braking_fmu, out, scenario, wsp=wsp)
+    else:
+        path = _write_fmu(build_braking_fmu, out, scenario)
+    if wsp:
+        console.print("built-in WSP inside the FMU: valve_k are outputs")
     _check_fmu(path, required=True)
 
 

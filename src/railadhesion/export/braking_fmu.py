@@ -24,18 +24,22 @@ _CONFIG_FILE = "railadhesion_fmu.json"
 _SCENARIO_FILE = "scenario.toml"
 
 
-def braking_fmu_variables(n_axles: int) -> list[FmuVariable]:
-    """The variables of a braking FMU with ``n_axles`` axles (axle 1 leading)."""
+def braking_fmu_variables(n_axles: int, wsp: bool = False) -> list[FmuVariable]:
+    """The variables of a braking FMU with ``n_axles`` axles (axle 1 leading).
+
+    ``wsp=True``: the FMU runs the package's built-in WSP, and ``valve_k`` is an output (the
+    valve state the WSP chose) instead of an input; the other variables are the same."""
     variables = []
     for k in range(1, n_axles + 1):
-        variables += [
+        variables.append(
             FmuVariable(f"pressure_command_{k}", "input", "Pa",
                         f"commanded brake-cylinder pressure of axle {k} (the cylinder "
-                        "limits it to its maximum)", 0.0, 0.0),
-            FmuVariable(f"valve_{k}", "input", "1",
-                        f"WSP valve state of axle {k}: 0 apply, 1 hold, 2 vent (rounded)",
-                        0.0, 0.0, 2.0),
-        ]  # fmt: skip
+                        "limits it to its maximum)", 0.0, 0.0))  # fmt: skip
+        if not wsp:
+            variables.append(
+                FmuVariable(f"valve_{k}", "input", "1",
+                            f"WSP valve state of axle {k}: 0 apply, 1 hold, 2 vent (rounded)",
+                            0.0, 0.0, 2.0))  # fmt: skip
     variables += [
         FmuVariable("train_speed", "output", "m/s", "train speed"),
         FmuVariable("distance", "output", "m", "distance run since the start"),
@@ -55,6 +59,11 @@ def braking_fmu_variables(n_axles: int) -> list[FmuVariable]:
             FmuVariable(f"normal_load_{k}", "output", "N",
                         f"normal load of axle {k} (with pitch load transfer)"),
         ]  # fmt: skip
+        if wsp:
+            variables.append(
+                FmuVariable(f"valve_{k}", "output", "1",
+                            f"valve state of axle {k} chosen by the built-in WSP: 0 apply, "
+                            "1 hold, 2 vent"))  # fmt: skip
     return variables
 
 
