@@ -143,7 +143,7 @@ def test_cli_writes_a_validated_braking_fmu(tmp_path):
 
     out = tmp_path / "b.fmu"
     result = CliRunner().invoke(app, ["export", "braking-fmu", str(EXAMPLES / "brake_dry.toml"),
-                                      "--out", str(out)])  # fmt: skip
+                                      "--python", "--out", str(out)])  # fmt: skip
     assert result.exit_code == 0, result.output
     assert out.is_file() and "passes FMPy's validation" in result.output
     bad = CliRunner().invoke(app, ["export", "braking-fmu", str(tmp_path / "none.toml")])

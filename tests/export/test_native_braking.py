@@ -197,6 +197,23 @@ def test_cli_writes_a_native_braking_fmu(tmp_path):
     assert "sources/buildDescription.xml" in names
 
 
+def test_cli_default_is_native_and_wsp_needs_it(tmp_path):
+    from typer.testing import CliRunner
+
+    from railadhesion.cli import app
+
+    out = tmp_path / "w.fmu"
+    result = CliRunner().invoke(app, ["export", "braking-fmu", str(SCENARIO), "--out", str(out),
+                                      "--wsp"])  # fmt: skip
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    assert "valve_k are outputs" in text and "needs no Python on the host" in text
+    bad = CliRunner().invoke(app, ["export", "braking-fmu", str(SCENARIO), "--out", str(out),
+                                   "--wsp", "--python"])  # fmt: skip
+    assert bad.exit_code == 2
+    assert "runs in the native braking FMU only" in " ".join(bad.output.split())
+
+
 def test_two_instances_side_by_side_and_no_allocation_in_steps(fmu):
     v = fmu.vr
     speed, valve = v["train_speed"], v["valve_2"]

@@ -34,6 +34,7 @@ of the compiled model (``<id>.ll``), with ``buildDescription.xml`` (FMI 2.0.4) a
 Public entry points: :func:`build_step_fmu` (any step model: :class:`StepModel`,
 :class:`RecordVariable`), :func:`compile_functions` (the IR-to-object route),
 :func:`c_struct` and :func:`c_initializer` (records as C), :func:`find_c_compiler`,
+:func:`native_unavailable` (can this machine build one?),
 :func:`undefined_symbols` (ELF), :class:`NativeBuildError`.
 """
 
@@ -41,11 +42,13 @@ from __future__ import annotations
 
 import hashlib
 import os
+import platform
 import re
 import shlex
 import shutil
 import struct
 import subprocess
+import sys
 import tempfile
 import uuid
 import zipfile
@@ -75,6 +78,7 @@ __all__ = [
     "compile_functions",
     "find_c_compiler",
     "fmi2_header_dir",
+    "native_unavailable",
     "undefined_symbols",
     "variant_symbol",
 ]
@@ -689,6 +693,26 @@ def model_header(model: StepModel, guid: str, records: Mapping[str, np.ndarray])
     return "\n".join(out)
 
 
+def native_unavailable() -> str | None:
+    """Why a native FMU cannot be built on this machine (a message naming the remedy), or
+    None: a Linux x86-64 machine (the binary is linux64), a C compiler
+    (:func:`find_c_compiler`), the FMI 2.0 headers (:func:`fmi2_header_dir`)."""
+    if not (sys.platform.startswith("linux")
+            and platform.machine().lower() in ("x86_64", "amd64")):  # fmt: skip
+        return (f"native FMUs are built on Linux x86-64 (their binary is {PLATFORM}), this "
+                f"machine is {sys.platform} {platform.machine()}: the Python FMU remains "
+                "available (railadhesion export ... --python)")  # fmt: skip
+    if find_c_compiler() is None:
+        return ("no C compiler found (set CC, or install gcc or clang): a native FMU cannot be "
+                "built here; the Python FMU remains available (railadhesion export ... "
+                "--python)")  # fmt: skip
+    try:
+        fmi2_header_dir()
+    except NativeBuildError as exc:
+        return str(exc)
+    return None
+
+
 def _guid(*parts: str | bytes) -> str:
     digest = hashlib.sha256()
     for part in parts:
@@ -800,13 +824,10 @@ def build_step_fmu(
     if out.suffix != ".fmu":
         raise ValueError(f"out must be a file name ending in .fmu, got {str(out)!r}")
     model.check()
+    problem = native_unavailable()
+    if problem is not None:
+        raise NativeBuildError(problem)
     compiler = find_c_compiler()
-    if compiler is None:
-        raise NativeBuildError(
-            "no C compiler found (set CC, or install gcc or clang): a native FMU cannot be "
-            "built here; the Python FMU remains available (railadhesion export fmu without "
-            "--native)"
-        )
     headers = fmi2_header_dir()
     records = model.records()
     functions = {f"{model.identifier}_step": (model.step, STEP_SIGNATURE)}
