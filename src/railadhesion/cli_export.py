@@ -73,11 +73,18 @@ def export_fmu(
         build_native_creep_force_fmu,
         resolve_parameters,
     )
+    from railadhesion.export.native_creepforce import NATIVE_MODELS
 
     try:
         resolved = resolve_parameters(model, params, parameter_set)
     except ValueError as exc:
         _fail(exc)
+    if model not in NATIVE_MODELS and native is not False:
+        served = f"the native creep-force FMU offers {', '.join(NATIVE_MODELS)}"
+        if native:
+            _fail(f"--native: {served}; export the {model} model as the Python FMU (--python)")
+        console.print(f"{served}: writing the {model} model as the Python FMU")
+        native = False
     path, native = _write_either(native, build_native_creep_force_fmu, build_creep_force_fmu,
                                  out, model, params, parameter_set=parameter_set,
                                  shear_modulus=shear_modulus, poisson=poisson)  # fmt: skip

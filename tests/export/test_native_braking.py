@@ -235,3 +235,18 @@ def test_step_size_must_be_positive(fmu, h):
     lines, err = fmu.run(f"new 0\ninit 0\nstep 0 0 {h}\n")
     assert lines[-1] == "step 0 3"
     assert "fmi2DoStep: communicationStepSize must be > 0 and finite" in err
+
+
+def test_a_model_it_does_not_compile_is_a_native_unsupported_case():
+    """An adhesion model evaluated in Python (here WILAC with compiled=False) is not served by
+    the native FMU: NativeUnsupported (a NativeBuildError), which the CLI's default answers
+    with the Python FMU."""
+    from railadhesion.export import NativeBuildError, NativeUnsupported
+    from railadhesion.export.native_braking import braking_step_model
+
+    sc = load_scenario(SCENARIO)
+    sim = BrakingSimulator(sc.vehicle, sc.adhesion(), sc.initial_speed, cylinders=sc.cylinders,
+                           record=False, compiled=False)  # fmt: skip
+    with pytest.raises(NativeUnsupported, match="use the Python braking FMU"):
+        braking_step_model(sim)
+    assert issubclass(NativeUnsupported, NativeBuildError)

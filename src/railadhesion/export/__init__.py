@@ -31,7 +31,7 @@ from railadhesion.export.monitor_fmu import (
     monitor_fmu_variables,
     monitor_step_model,
 )
-from railadhesion.export.native import NativeBuildError
+from railadhesion.export.native import NativeBuildError, NativeUnsupported
 from railadhesion.export.native_braking import build_native_braking_fmu
 from railadhesion.export.native_creepforce import build_native_creep_force_fmu
 from railadhesion.export.tables import (
@@ -50,6 +50,7 @@ __all__ = [
     "FmuVariable",
     "InterpolationError",
     "NativeBuildError",
+    "NativeUnsupported",
     "braking_fmu_variables",
     "build_braking_fmu",
     "build_creep_force_fmu",

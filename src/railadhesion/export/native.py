@@ -35,7 +35,7 @@ Public entry points: :func:`build_step_fmu` (any step model: :class:`StepModel`,
 :class:`RecordVariable`), :func:`compile_functions` (the IR-to-object route),
 :func:`c_struct` and :func:`c_initializer` (records as C), :func:`find_c_compiler`,
 :func:`native_unavailable` (can this machine build one?),
-:func:`undefined_symbols` (ELF), :class:`NativeBuildError`.
+:func:`undefined_symbols` (ELF), :class:`NativeBuildError`, :class:`NativeUnsupported`.
 """
 
 from __future__ import annotations
@@ -70,6 +70,7 @@ __all__ = [
     "STEP_SIGNATURE",
     "CompiledCode",
     "NativeBuildError",
+    "NativeUnsupported",
     "RecordVariable",
     "StepModel",
     "build_step_fmu",
@@ -151,6 +152,11 @@ _INTEGER_LIMITS = {"i8": (-(2**53), 2**53), "i4": (-(2**31), 2**31 - 1), "u1": (
 class NativeBuildError(RuntimeError):
     """A native FMU cannot be built here (no C compiler, a model that needs more than libm,
     a failed compilation); the message says what to do. The Python FMU remains available."""
+
+
+class NativeUnsupported(NativeBuildError):
+    """The native FMU does not serve this case (e.g. an adhesion model it does not compile);
+    the Python FMU does (``railadhesion export`` falls back to it by default, saying so)."""
 
 
 # --------------------------------------------------------------------------------------------

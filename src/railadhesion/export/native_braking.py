@@ -30,7 +30,12 @@ from pathlib import Path
 import numpy as np
 
 from railadhesion.export.braking_fmu import braking_fmu_variables
-from railadhesion.export.native import RecordVariable, StepModel, build_step_fmu
+from railadhesion.export.native import (
+    NativeUnsupported,
+    RecordVariable,
+    StepModel,
+    build_step_fmu,
+)
 
 __all__ = ["braking_step_model", "build_native_braking_fmu"]
 
@@ -102,15 +107,17 @@ def braking_step_model(simulator, identifier: str = "railadhesion_braking") -> S
         raise ValueError("simulator: build it with record=False")
     buffer = simulator._buffer  # noqa: SLF001
     if buffer is None:
-        raise ValueError("simulator: the native braking FMU compiles the package's WSP "
-                         "controller and sensor model only (WheelSlideProtection, "
-                         "SensorModel); this simulator has another controller or sensor model")
+        raise NativeUnsupported(
+            "simulator: the native braking FMU compiles the package's WSP controller and "
+            "sensor model only (WheelSlideProtection, SensorModel); this simulator has another "
+            "controller or sensor model: use the Python braking FMU")
     machine, tables = split_buffer(buffer)
     n = int(machine[0]["settings"]["n_axles"])
     if int(machine[0]["settings"]["model"]) not in (POLACH, WILAC):
-        raise ValueError("simulator: the native braking FMU compiles the built-in adhesion "
-                         "models (Polach sets, WILAC) only; this simulator's model is a "
-                         "Python function or a user's law: use the Python braking FMU")
+        raise NativeUnsupported(
+            "simulator: the native braking FMU compiles the built-in adhesion models (Polach "
+            "sets, WILAC) only; this simulator's model is a Python function or a user's law: "
+            "use the Python braking FMU")
     wsp = int(machine[0]["settings"]["wsp_on"]) != 0
     state_t = np.dtype([("machine", MACHINE), ("stopped", "f8")], align=True)
     settings_t = np.dtype([("tables", "f8", (max(tables.size, 1),))], align=True)
@@ -208,6 +215,8 @@ def _build_in_generic_process(out, path: Path, wsp: bool) -> Path:
         last = (done.stderr.strip().splitlines() or ["(no message)"])[-1]
         from railadhesion.export.native import NativeBuildError
 
+        if "NativeUnsupported" in last:
+            raise NativeUnsupported(last.split(": ", 1)[-1])
         if "NativeBuildError" in last:
             raise NativeBuildError(last.split(": ", 1)[-1])
         if "ValueError" in last:
