@@ -101,7 +101,7 @@ def export_braking_fmu(
     wsp: bool = typer.Option(
         False, "--wsp",
         help="Run the package's WSP inside the FMU (the scenario's [wsp] settings, ideal "
-             "sensors): the valve states become outputs. Native FMU only.",
+             "sensors): the valve states become outputs.",
     ),  # fmt: skip
 ) -> None:
     """Write the braking vehicle of SCENARIO as an FMI 2.0 co-simulation FMU (inputs: commanded
@@ -109,15 +109,10 @@ def export_braking_fmu(
     Python on the host), --python for the Python FMU."""
     from railadhesion.export import build_braking_fmu, build_native_braking_fmu
 
+    path, native = _write_either(native, build_native_braking_fmu, build_braking_fmu, out,
+                                 scenario, wsp=wsp)  # fmt: skip
     if wsp:
-        if native is False:
-            _fail("--wsp: the built-in WSP runs in the native braking FMU only (drop --python)")
-        path = _write_fmu(build_native_braking_fmu, out, scenario, wsp=True)
         console.print("built-in WSP inside the FMU: valve_k are outputs")
-        native = True
-    else:
-        path, native = _write_either(native, build_native_braking_fmu, build_braking_fmu, out,
-                                     scenario)  # fmt: skip
     _say_kind(native)
     _check_fmu(path, required=True)
 

@@ -18,7 +18,7 @@ from xml.etree import ElementTree as ET
 
 from railadhesion.export.fmu import FmuVariable, build_fmu
 
-__all__ = ["braking_fmu_variables", "build_braking_fmu"]
+__all__ = ["braking_fmu_variables", "build_braking_fmu", "valve_control_text"]
 
 _CONFIG_FILE = "railadhesion_fmu.json"
 _SCENARIO_FILE = "scenario.toml"
@@ -67,7 +67,17 @@ def braking_fmu_variables(n_axles: int, wsp: bool = False) -> list[FmuVariable]:
     return variables
 
 
-def build_braking_fmu(out, scenario) -> Path:
+def valve_control_text(wsp: bool, own: bool) -> str:
+    """What commands the valves (the FMU description's words): the master (inputs), or the
+    built-in WSP with the scenario's settings (``own``) or the default ones."""
+    if not wsp:
+        return "inputs: commanded cylinder pressure and WSP valve per axle"
+    settings = "the scenario's [wsp] settings" if own else "the default WSP settings"
+    return ("input: commanded cylinder pressure per axle; the built-in WSP "
+            f"({settings}, ideal sensors) sets the valves (outputs)")
+
+
+def build_braking_fmu(out, scenario, *, wsp: bool = False) -> Path:
     """Write an FMI 2.0 co-simulation FMU of a braking vehicle (the stepping API).
 
     Parameters
@@ -81,6 +91,11 @@ def build_braking_fmu(out, scenario) -> Path:
         embedded verbatim as ``resources/scenario.toml``, so the files it names must be
         built-in names (``coach_default``, the ``default`` WILAC set) or absolute paths on
         the host.
+    wsp : bool
+        Run the package's WSP controller (the scenario's ``[wsp]`` settings, or the defaults
+        of :class:`~railadhesion.braking.wsp.WSPSettings` if it has none) with ideal sensors
+        inside the FMU: the valve states become outputs
+        (:func:`braking_fmu_variables` with ``wsp=True``), as in the native braking FMU.
 
     Returns
     -------
@@ -112,13 +127,13 @@ def build_braking_fmu(out, scenario) -> Path:
                 f"built-in names or absolute paths): {exc}"
             ) from exc
     vehicle = loaded.vehicle
-    variables = braking_fmu_variables(vehicle.n_axles)
+    variables = braking_fmu_variables(vehicle.n_axles, wsp=wsp)
     sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
     description = (
         f"railadhesion {railadhesion.__version__}: braking vehicle '{vehicle.name}' "
         f"({vehicle.n_axles} axles) from scenario '{loaded.name}', initial speed "
-        f"{loaded.initial_speed:g} m/s; inputs: commanded cylinder pressure and WSP valve per "
-        f"axle. Scenario embedded as resources/{_SCENARIO_FILE} (sha256 {sha[:12]}...)."
+        f"{loaded.initial_speed:g} m/s; {valve_control_text(wsp, loaded.wsp is not None)}. "
+        f"Scenario embedded as resources/{_SCENARIO_FILE} (sha256 {sha[:12]}...)."
     )
     config = {
         "scenario_file": _SCENARIO_FILE,
@@ -126,6 +141,7 @@ def build_braking_fmu(out, scenario) -> Path:
         "description": description,
         "fmu_version": f"railadhesion {railadhesion.__version__}, scenario {sha[:12]}",
         "variables": [v.to_config() for v in variables],
+        "wsp": bool(wsp),
     }
     meta = ET.Element("Scenario", {"name": loaded.name, "file": f"resources/{_SCENARIO_FILE}",
                                    "sha256": sha, "railadhesionVersion": railadhesion.__version__})

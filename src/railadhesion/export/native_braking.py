@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from railadhesion.export.braking_fmu import braking_fmu_variables
+from railadhesion.export.braking_fmu import braking_fmu_variables, valve_control_text
 from railadhesion.export.native import (
     NativeUnsupported,
     RecordVariable,
@@ -225,14 +225,6 @@ def _build_in_generic_process(out, path: Path, wsp: bool) -> Path:
     return Path(out)
 
 
-def _control_text(wsp: bool, own: bool) -> str:
-    if not wsp:
-        return "inputs: commanded cylinder pressure and WSP valve per axle"
-    settings = "the scenario's [wsp] settings" if own else "the default WSP settings"
-    return ("input: commanded cylinder pressure per axle; the built-in WSP "
-            f"({settings}, ideal sensors) sets the valves (outputs)")
-
-
 def _build(out, path, wsp: bool = False) -> Path:
     import railadhesion
     from railadhesion.braking import BrakingSimulator
@@ -262,7 +254,7 @@ def _build(out, path, wsp: bool = False) -> Path:
     description = (
         f"railadhesion {railadhesion.__version__}: braking vehicle '{vehicle.name}' "
         f"({vehicle.n_axles} axles) from scenario '{loaded.name}', initial speed "
-        f"{loaded.initial_speed:g} m/s; {_control_text(wsp, loaded.wsp is not None)}. "
+        f"{loaded.initial_speed:g} m/s; {valve_control_text(wsp, loaded.wsp is not None)}. "
         f"Native: no Python at run time. Scenario in documentation/{_SCENARIO_FILE} "
         f"(sha256 {sha[:12]}...)."
     )
