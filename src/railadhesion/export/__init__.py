@@ -4,7 +4,8 @@
 * :func:`build_native_creep_force_fmu`: the same law as a native FMU, compiled ahead of time
   (no Python at run time; :mod:`railadhesion.export.native` builds any step model so);
 * :func:`build_braking_fmu`: the braking simulator's stepping API as an FMU (inputs: commanded
-  pressure and WSP valve per axle);
+  pressure and WSP valve per axle, or with the built-in WSP the pressure only);
+  :func:`build_native_braking_fmu`: the same, native (no Python at run time);
 * :func:`build_monitor_fmu`: the on-board adhesion monitor as an FMU (inputs: speed
   reference, wheel speeds, pressures and/or torques; outputs: estimates, levels, reasons);
   :func:`build_native_monitor_fmu`: the same, native (no Python at run time);
