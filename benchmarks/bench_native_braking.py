@@ -10,7 +10,11 @@ changing), doStep, the train and wheel speeds read back; then doStep alone. The 
 moving throughout (2 x REPEAT x ROWS ms = 10 s; the script checks that it has not stopped).
 The Python braking FMU (pythonfmu) of the same scenario is timed under FMPy
 (``bench_export.bench_braking``), and the native WILAC creep-force FMU's doStep in the same
-C host. Medians of the host's runs; the machine is shared: compare the ratio.
+C host. The native braking FMU is timed twice, interleaved: with the binary's generic
+x86-64 code forced (``RAILADHESION_FMU_GENERIC=1``: what the binary ran before it carried an
+x86-64-v3 variant) and with its default (x86-64-v3 on processors that have it); and the FMU
+with the built-in WSP (pressure commands in, valves out). Medians of the host's runs; the
+machine is shared: compare the ratios.
 """
 
 from __future__ import annotations
@@ -37,20 +41,26 @@ RUNS = 5
 N = 4
 
 
-def bench_native_braking(host: Path, fmu: Path) -> tuple[float, ...]:
-    """(set + doStep + get, doStep alone) [µs per 1 ms step], wall and CPU, medians."""
+def bench_native_braking(host: Path, fmu: Path, generic: bool = False) -> tuple[float, ...]:
+    """(set + doStep + get, doStep alone) [µs per 1 ms step], wall and CPU, medians.
+    ``generic``: force the binary's generic x86-64 code (RAILADHESION_FMU_GENERIC=1), the
+    only code of the binaries before the x86-64-v3 variant."""
     from fmpy import read_model_description
 
     md = read_model_description(fmu)
     vr = {v.name: v.valueReference for v in md.modelVariables}
+    causality = {v.name: v.causality for v in md.modelVariables}
     inputs = [f"pressure_command_{k}" for k in range(1, N + 1)] + [
         f"valve_{k}" for k in range(1, N + 1)]
+    wsp = causality["valve_1"] == "output"  # the built-in WSP sets the valves
     outputs = ["train_speed"] + [f"wheel_speed_{k}" for k in range(1, N + 1)]
     rows = []
     for j in range(ROWS):
         valves = [2.0 if (j // 120 + i) % 6 == 0 else 1.0 if (j // 120 + i) % 6 == 1 else 0.0
                   for i in range(N)]  # fmt: skip
-        rows.append([5.5e5] * N + valves)
+        rows.append([5.5e5] * N + ([] if wsp else valves))
+    if wsp:
+        inputs = inputs[:N]
     where = Path(tempfile.mkdtemp(prefix="bench_nb_"))
     with zipfile.ZipFile(fmu) as z:
         z.extractall(where)
@@ -59,7 +69,10 @@ def bench_native_braking(host: Path, fmu: Path) -> tuple[float, ...]:
     commands = (f"new 0\ninit 0\nbench 0 {len(inputs)} {' '.join(str(vr[n]) for n in inputs)} "
                 f"{len(outputs)} {' '.join(str(vr[n]) for n in outputs)} {ROWS} {REPEAT}\n"
                 f"{table}\nget 0 {vr['train_speed']} {vr['stopped']}\nmaps\n")  # fmt: skip
-    env = {k: v for k, v in os.environ.items() if k not in ("LD_PRELOAD", "PYTHONPATH")}
+    env = {k: v for k, v in os.environ.items() if k not in ("LD_PRELOAD", "PYTHONPATH",
+                                                             "RAILADHESION_FMU_GENERIC")}
+    if generic:
+        env["RAILADHESION_FMU_GENERIC"] = "1"
     full, step, cpu_full, cpu_step = [], [], [], []
     for _ in range(RUNS):
         out = subprocess.run([str(host), "--script", str(binary), (where / "resources").as_uri(),
@@ -90,16 +103,24 @@ def main() -> None:
                        check=True)  # fmt: skip
         scenario = ROOT / "examples" / "brake_damp.toml"
         native = build_native_braking_fmu(tmp / "nb.fmu", scenario)
-        full, alone, cpu_full, cpu_alone = bench_native_braking(host, native)
+        wsp = build_native_braking_fmu(tmp / "nbw.fmu", scenario, wsp=True)
+        rows = []  # interleaved: the two codes of the binary side by side
+        for _ in range(2):
+            for fmu, generic in ((native, True), (native, False), (wsp, False)):
+                rows.append((fmu, generic, bench_native_braking(host, fmu, generic)))
         wilac = build_native_creep_force_fmu(tmp / "wilac.fmu", "wilac")
         cf = bench_c_host(host, wilac, "wilac", "dry", 20)
         py_us, direct_us = bench_braking(tmp)
         print("braking vehicle, 4 axles, WILAC damp example, 1 ms steps, train moving")
-        print(f"  native FMU, C host: set+doStep+get {full:.2f} µs (CPU {cpu_full:.2f}), "
-              f"doStep alone {alone:.2f} µs (CPU {cpu_alone:.2f}): "
-              f"{1e3 / full:.0f}x real time")
+        for fmu, generic, (full, alone, cpu_full, cpu_alone) in rows:
+            code = "generic x86-64 (forced)" if generic else "default (x86-64-v3 here)"
+            what = "built-in WSP" if fmu == wsp else "valves in"
+            print(f"  native FMU, C host, {what}, {code}: set+doStep+get {full:.2f} µs "
+                  f"(CPU {cpu_full:.2f}), doStep alone {alone:.2f} µs (CPU {cpu_alone:.2f}): "
+                  f"{1e3 / full:.0f}x real time")
         print(f"  Python FMU, FMPy:   set+doStep+get {py_us:.1f} µs "
-              f"({py_us / full:.0f}x the native FMU); stepping API directly {direct_us:.1f} µs")
+              f"({py_us / rows[1][2][0]:.0f}x the native FMU); stepping API directly "
+              f"{direct_us:.1f} µs")
         print(f"native WILAC creep-force FMU, C host: set+doStep+get {cf[0]:.3f} µs, "
               f"doStep alone {cf[1]:.3f} µs")
 

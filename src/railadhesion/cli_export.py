@@ -21,6 +21,12 @@ console = Console()
 _MODEL_HELP = "Creep-force model: wilac or polach."
 _PARAMS_HELP = "Parameter file (TOML, docs/parameter-files.md); embedded in the export."
 _SET_HELP = "Named parameter set: Polach, see 'railadhesion params list'; WILAC, 'default'."
+_NATIVE_HELP = (
+    "--native (the default): the model compiled into the FMU (linux64 binary and its C and "
+    "LLVM sources), no Python on the host; needs Linux x86-64 and a C compiler here, else "
+    "the Python FMU is written instead (said), or with an explicit --native an error. "
+    "--python: the Python FMU (pythonfmu; the host needs Python with railadhesion)."
+)
 
 
 def _fail(message) -> None:
@@ -58,31 +64,32 @@ def export_fmu(
     out: Path = typer.Option(Path("creepforce.fmu"), help="The FMU file to write (.fmu)."),
     shear_modulus: float = typer.Option(8.2e10, help="Start value of parameter G [Pa]."),
     poisson: float = typer.Option(0.28, help="Start value of Poisson's ratio [-]."),
-    native: bool = typer.Option(
-        False, "--native",
-        help="Compile the law into the FMU (linux64 binary and its sources): no Python on "
-             "the host. Needs a C compiler here. Default: the Python FMU (pythonfmu).",
-    ),  # fmt: skip
+    native: bool | None = typer.Option(None, "--native/--python", help=_NATIVE_HELP),
 ) -> None:
-    """Write an FMI 2.0 co-simulation FMU of a creep-force law (the Python FMU needs Python
-    on the host; --native does not)."""
+    """Write an FMI 2.0 co-simulation FMU of a creep-force law: native by default (no Python
+    on the host), --python for the Python FMU (pythonfmu)."""
     from railadhesion.export import (
         build_creep_force_fmu,
         build_native_creep_force_fmu,
         resolve_parameters,
     )
+    from railadhesion.export.native_creepforce import NATIVE_MODELS
 
-    build = build_native_creep_force_fmu if native else build_creep_force_fmu
     try:
         resolved = resolve_parameters(model, params, parameter_set)
     except ValueError as exc:
         _fail(exc)
-    path = _write_fmu(build, out, model, params, parameter_set=parameter_set,
-                      shear_modulus=shear_modulus, poisson=poisson)  # fmt: skip
+    if model not in NATIVE_MODELS and native is not False:
+        served = f"the native creep-force FMU offers {', '.join(NATIVE_MODELS)}"
+        if native:
+            _fail(f"--native: {served}; export the {model} model as the Python FMU (--python)")
+        console.print(f"{served}: writing the {model} model as the Python FMU")
+        native = False
+    path, native = _write_either(native, build_native_creep_force_fmu, build_creep_force_fmu,
+                                 out, model, params, parameter_set=parameter_set,
+                                 shear_modulus=shear_modulus, poisson=poisson)  # fmt: skip
     console.print(escape(f"{model}: {resolved.summary()}"))
-    if native:
-        console.print("native FMU: binaries/linux64 needs no Python on the host; sources in "
-                      "sources/ (docs/fmu.md)")  # fmt: skip
+    _say_kind(native)
     _check_fmu(path, required=False)
 
 
@@ -90,28 +97,69 @@ def export_fmu(
 def export_braking_fmu(
     scenario: Path = typer.Argument(..., help="Braking scenario TOML (docs/braking.md)."),
     out: Path = typer.Option(Path("braking.fmu"), help="The FMU file to write (.fmu)."),
-    native: bool = typer.Option(
-        False, "--native",
-        help="Compile the braking step into the FMU (linux64 binary and its sources): no "
-             "Python on the host. Needs a C compiler here. Default: the Python FMU.",
+    native: bool | None = typer.Option(None, "--native/--python", help=_NATIVE_HELP),
+    wsp: bool = typer.Option(
+        False, "--wsp",
+        help="Run the package's WSP inside the FMU (the scenario's [wsp] settings, ideal "
+             "sensors): the valve states become outputs.",
     ),  # fmt: skip
 ) -> None:
     """Write the braking vehicle of SCENARIO as an FMI 2.0 co-simulation FMU (inputs: commanded
-    pressure and WSP valve per axle; the Python FMU needs Python on the host, --native not)."""
+    pressure and WSP valve per axle, or with --wsp the pressure only): native by default (no
+    Python on the host), --python for the Python FMU."""
     from railadhesion.export import build_braking_fmu, build_native_braking_fmu
 
-    path = _write_fmu(build_native_braking_fmu if native else build_braking_fmu, out, scenario)
+    path, native = _write_either(native, build_native_braking_fmu, build_braking_fmu, out,
+                                 scenario, wsp=wsp)  # fmt: skip
+    if wsp:
+        console.print("built-in WSP inside the FMU: valve_k are outputs")
+    _say_kind(native)
     _check_fmu(path, required=True)
 
 
-def _write_fmu(build, out, *args, **kwargs):
+
+def _write_either(native, native_build, python_build, out, *args, **kwargs):
+    """The native FMU (``native`` True: an error if it cannot be built), the Python FMU
+    (False), or by default (None) the native FMU, falling back to the Python FMU, with a
+    message saying why, where this machine cannot build one. Returns (path, native?)."""
+    from railadhesion.export import NativeBuildError
+    from railadhesion.export.native import native_unavailable
+
+    if native is None:
+        problem = native_unavailable()
+        if problem is None:
+            try:
+                return _write_fmu(native_build, out, *args, fallback=True, **kwargs), True
+            except NativeBuildError as exc:
+                problem = str(exc)
+        console.print(f"[yellow]no native FMU:[/yellow] {escape(problem)}")
+        console.print("writing the Python FMU instead: the host needs Python with railadhesion "
+                      "(--python asks for it, --native makes this an error)")  # fmt: skip
+        native = False
+    build = native_build if native else python_build
+    return _write_fmu(build, out, *args, **kwargs), native
+
+
+def _say_kind(native: bool) -> None:
+    if native:
+        console.print("native FMU: binaries/linux64 needs no Python on the host; sources in "
+                      "sources/ (docs/fmu.md)")  # fmt: skip
+    else:
+        console.print("Python FMU: the host needs a Python with railadhesion installed "
+                      "(docs/fmu.md)")  # fmt: skip
+
+
+def _write_fmu(build, out, *args, fallback=False, **kwargs):
     """``build(out, *args, **kwargs)`` (an FMU builder); its errors become a red message and
-    exit code 1; says where the FMU was written and returns its path."""
+    exit code 2 (``fallback``: a NativeBuildError is raised for the caller to fall back);
+    says where the FMU was written and returns its path."""
     from railadhesion.export import NativeBuildError
 
     try:
         path = build(out, *args, **kwargs)
     except NativeBuildError as exc:
+        if fallback:
+            raise
         _fail(f"no native FMU: {exc}")
     except ValueError as exc:
         _fail(exc)

@@ -143,8 +143,44 @@ def test_cli_writes_a_validated_braking_fmu(tmp_path):
 
     out = tmp_path / "b.fmu"
     result = CliRunner().invoke(app, ["export", "braking-fmu", str(EXAMPLES / "brake_dry.toml"),
-                                      "--out", str(out)])  # fmt: skip
+                                      "--python", "--out", str(out)])  # fmt: skip
     assert result.exit_code == 0, result.output
     assert out.is_file() and "passes FMPy's validation" in result.output
     bad = CliRunner().invoke(app, ["export", "braking-fmu", str(tmp_path / "none.toml")])
     assert bad.exit_code == 2 and "scenario must be an existing TOML file" in bad.output
+
+
+def test_built_in_wsp_equals_the_stepping_api(tmp_path):
+    """wsp=True: the package's WSP inside the Python FMU, valve_k outputs, the same numbers as
+    the stepping API of a simulator built with the scenario's WSP (2 s of the damp stop: the
+    WSP holds from about 1.2 s, on the damp section)."""
+    from railadhesion.braking.wsp import WheelSlideProtection
+
+    path = EXAMPLES / "brake_damp.toml"
+    fmu = build_braking_fmu(tmp_path / "w.fmu", path, wsp=True)
+    assert validate_fmu(str(fmu)) == []
+    slave = _Slave(fmu)
+    causality = {v.name: v.causality for v in slave.md.modelVariables}
+    assert causality["valve_1"] == "output" and causality["pressure_command_1"] == "input"
+    sc = load_scenario(path)
+    sim = BrakingSimulator(sc.vehicle, sc.adhesion(), sc.initial_speed, cylinders=sc.cylinders,
+                           gradient=sc.gradient, refresh_period=sc.refresh_period,
+                           record=False, wsp=WheelSlideProtection(sc.wsp))  # fmt: skip
+    valve_refs = [slave.vr[f"valve_{k}"] for k in range(1, 5)]
+    acted = False
+    try:
+        for j in range(2000):
+            command = [5.5e5 if j < 1500 else 4e5] * 4
+            slave.s.setReal([slave.vr[f"pressure_command_{k}"] for k in range(1, 5)], command)
+            slave.s.doStep(currentCommunicationPoint=j * 1e-3, communicationStepSize=1e-3)
+            state = sim.step(1e-3, {"pressure_command": command})
+            np.testing.assert_allclose(slave.outputs(), _reference(state), rtol=1e-12,
+                                       atol=1e-12)  # fmt: skip
+            valves = slave.s.getReal(valve_refs)
+            assert valves == [float(v) for v in state.valves]
+            acted |= any(v != 0.0 for v in valves)
+    finally:
+        slave.s.terminate()
+        slave.s.freeInstance()
+        shutil.rmtree(slave.dir, ignore_errors=True)
+    assert acted  # the WSP held or vented

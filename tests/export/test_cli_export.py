@@ -19,10 +19,12 @@ runner = CliRunner()
 def test_export_fmu_writes_a_valid_fmu(tmp_path):
     out = tmp_path / "wet.fmu"
     result = runner.invoke(
-        app, ["export", "fmu", "--model", "polach", "--set", "polach2005_wet", "--out", str(out)]
-    )
+        app, ["export", "fmu", "--python", "--model", "polach", "--set", "polach2005_wet",
+              "--out", str(out)]
+    )  # fmt: skip
     assert result.exit_code == 0, result.output
     assert "passes FMPy's validation" in result.output
+    assert "Python FMU: the host needs a Python" in " ".join(result.output.split())
     assert "polach2005_wet" in result.output
     with zipfile.ZipFile(out) as z:
         assert "resources/parameters.toml" in z.namelist()
@@ -34,7 +36,7 @@ def test_export_fmu_default_wilac_embeds_the_package_file(tmp_path):
     from importlib import resources
 
     out = tmp_path / "w.fmu"
-    result = runner.invoke(app, ["export", "fmu", "--out", str(out)])
+    result = runner.invoke(app, ["export", "fmu", "--python", "--out", str(out)])
     assert result.exit_code == 0, result.output
     package_file = resources.files("railadhesion").joinpath("data", "wilac_default.toml")
     with zipfile.ZipFile(out) as z:
@@ -46,8 +48,9 @@ def test_export_fmu_embeds_a_parameter_file(tmp_path):
                                   tmp_path / "mine.toml")  # fmt: skip
     out = tmp_path / "mine.fmu"
     result = runner.invoke(
-        app, ["export", "fmu", "--model", "polach", "--params", str(path), "--out", str(out)]
-    )
+        app, ["export", "fmu", "--python", "--model", "polach", "--params", str(path),
+              "--out", str(out)]
+    )  # fmt: skip
     assert result.exit_code == 0, result.output
     with zipfile.ZipFile(out) as z:
         assert z.read("resources/parameters.toml") == path.read_bytes()
@@ -115,6 +118,29 @@ def test_export_fmu_native_writes_a_valid_native_fmu(tmp_path):
         names = z.namelist()
     assert "binaries/linux64/railadhesion_polach.so" in names
     assert "sources/railadhesion_polach.ll" in names and "sources/ra_fmi2.c" in names
+
+
+@pytest.mark.skipif(not _native_possible(), reason="native FMUs need Linux and a C compiler")
+def test_export_fmu_is_native_by_default(tmp_path):
+    out = tmp_path / "d.fmu"
+    result = runner.invoke(app, ["export", "fmu", "--model", "polach", "--set",
+                                 "polach2005_dry", "--out", str(out)])  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert "needs no Python on the host" in " ".join(result.output.split())
+    with zipfile.ZipFile(out) as z:
+        assert "binaries/linux64/railadhesion_polach.so" in z.namelist()
+
+
+def test_export_fmu_default_falls_back_to_the_python_fmu_and_says_why(tmp_path, monkeypatch):
+    monkeypatch.setenv("CC", "/nonexistent/cc")
+    out = tmp_path / "f.fmu"
+    result = runner.invoke(app, ["export", "fmu", "--model", "polach", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    assert "no native FMU:" in text and "writing the Python FMU instead" in text
+    assert "Python FMU: the host needs a Python" in text
+    with zipfile.ZipFile(out) as z:
+        assert "resources/parameters.toml" in z.namelist()
 
 
 def test_export_fmu_native_without_a_compiler_says_so(tmp_path, monkeypatch):

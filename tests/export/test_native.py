@@ -65,7 +65,7 @@ OUTPUTS = ["Fx", "Fy", "adhesion"]
 POLACH_SET = "polach2005_wet"
 # What the FMU binary may import: libm (via the compiled law and the layer's nearbyint) and
 # these C library functions of the FMI layer. Nothing allocates: no malloc, calloc, free.
-LAYER_LIBC = {"memcpy", "memset", "strcmp", "strlen", "vsnprintf"}
+LAYER_LIBC = {"getenv", "memcpy", "memset", "strcmp", "strlen", "vsnprintf"}
 
 
 # --------------------------------------------------------------------------------------------
@@ -105,11 +105,12 @@ class Unzipped:
         identifier = self.md.coSimulation.modelIdentifier
         self.binary = self.dir / "binaries" / "linux64" / f"{identifier}.so"
 
-    def run(self, commands: str, binary=None):
-        """Run the host in script mode with no Python in its environment; (stdout lines,
-        stderr)."""
+    def run(self, commands: str, binary=None, env=None):
+        """Run the host in script mode with no Python in its environment (plus ``env``);
+        (stdout lines, stderr)."""
         env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")
-               and k not in ("LD_PRELOAD", "LD_LIBRARY_PATH")}  # fmt: skip
+               and k not in ("LD_PRELOAD", "LD_LIBRARY_PATH", "RAILADHESION_FMU_GENERIC")
+               } | dict(env or {})  # fmt: skip
         args = [str(self.host), "--script", str(binary or self.binary),
                 (self.dir / "resources").as_uri(), self.md.guid]  # fmt: skip
         out = subprocess.run(args, input=commands, capture_output=True, text=True, env=env,
@@ -120,13 +121,14 @@ class Unzipped:
     def refs(self, names):
         return " ".join(str(self.vr[n]) for n in names)
 
-    def sweep(self, inputs: list[str], rows, outputs, instance=0, binary=None, setup=""):
+    def sweep(self, inputs: list[str], rows, outputs, instance=0, binary=None, setup="",
+              env=None):
         """setReal(inputs), doStep(1 ms), getReal(outputs) for each row; (status, values)."""
         table = "\n".join(" ".join(repr(float(x)) for x in row) for row in rows)
         commands = (f"new {instance}\n{setup}init {instance}\nsweep {instance} {len(inputs)} "
                     f"{self.refs(inputs)} {len(outputs)} {self.refs(outputs)} {len(rows)}\n"
                     f"{table}\nmaps\n")  # fmt: skip
-        lines, err = self.run(commands, binary)
+        lines, err = self.run(commands, binary, env)
         assert lines[0] == f"new {instance} ok", err[-2000:]
         assert lines[-1] == "maps 0"  # no Python, no numba in the host process
         body = [line.split() for line in lines[-1 - len(rows) : -1]]
@@ -829,3 +831,18 @@ def test_step_model_checks_its_variables():
                            model.inputs, [*model.variables, extra])  # fmt: skip
         with pytest.raises(ValueError, match=message):
             broken.check()
+
+
+def test_the_binary_carries_generic_and_x86_64_v3_code(unzipped):
+    """The linux64 binary links the model twice, generic x86-64 and x86-64-v3 (chosen at
+    instantiation); the sources hold the generic IR only (test_sources_rebuild_the_binary
+    holds the two to the same numbers)."""
+    nm = shutil.which("nm")
+    if nm is None:
+        pytest.skip("nm is not installed")
+    out = subprocess.run([nm, str(unzipped["wilac"].binary)], capture_output=True, text=True,
+                         check=True).stdout  # fmt: skip
+    names = {line.split()[-1] for line in out.splitlines() if line.strip()}
+    assert {"railadhesion_wilac_step", "railadhesion_wilac_step_x86_64_v3"} <= names
+    ir = (unzipped["wilac"].dir / "sources" / "railadhesion_wilac.ll").read_text()
+    assert "x86_64_v3" not in ir

@@ -83,6 +83,73 @@ def test_equals_the_stepping_api_over_a_damp_rail_stop(fmu):
     assert 50.0 < want[-1, 1]  # reached the damp section
 
 
+@pytest.fixture(scope="module")
+def wsp_fmu(host, tmp_path_factory):  # noqa: F811
+    tmp = tmp_path_factory.mktemp("native_braking_wsp")
+    path = build_native_braking_fmu(tmp / "braking_wsp.fmu", SCENARIO, wsp=True)
+    return Unzipped(path, host, tmp)
+
+
+WSP_INPUTS = INPUTS[:N]
+WSP_OUTPUTS = OUTPUTS + [f"valve_{k}" for k in range(1, N + 1)]
+
+
+def _wsp_reference(rows):
+    from railadhesion.braking.wsp import WheelSlideProtection
+
+    sc = load_scenario(SCENARIO)
+    sim = BrakingSimulator(sc.vehicle, sc.adhesion(), sc.initial_speed, cylinders=sc.cylinders,
+                           gradient=sc.gradient, refresh_period=sc.refresh_period,
+                           record=False, wsp=WheelSlideProtection(sc.wsp))  # fmt: skip
+    out = np.empty((len(rows), len(WSP_OUTPUTS)))
+    for j, row in enumerate(rows):
+        s = sim.step(0.001, {"pressure_command": row})
+        out[j, :4] = s.train_speed, s.distance, s.deceleration, float(s.stopped)
+        for i in range(N):
+            out[j, 4 + 5 * i: 9 + 5 * i] = (s.wheel_speeds[i], s.brake_pressures[i],
+                                            s.creep_forces[i], s.adhesion_used[i],
+                                            s.normal_loads[i])  # fmt: skip
+        out[j, 4 + 5 * N:] = s.valves
+    return out
+
+
+def test_built_in_wsp_equals_the_stepping_api_over_a_damp_rail_stop(wsp_fmu):
+    """The scenario's WSP inside the FMU: the valves are outputs, the pressure commands change
+    (a partial release on axles 3-4 for 2 s), the WSP holds and vents on the damp section."""
+    assert wsp_fmu.md.modelVariables[wsp_fmu.vr["valve_1"]].causality == "output"
+    n_steps = 45000
+    rows = np.full((n_steps, N), 5.5e5)
+    rows[8000:10000, 2:] = 2.5e5
+    status, got = wsp_fmu.sweep(WSP_INPUTS, rows, WSP_OUTPUTS)
+    assert (status == 0).all()
+    want = _wsp_reference(rows)
+    stop = int(np.argmax(want[:, 3] == 1.0))
+    assert stop > 0 and got[-1, 3] == 1.0  # the whole stop, to rest
+    np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9)
+    valves = want[:stop, 4 + 5 * N:]
+    assert (valves == 2.0).any() and (valves == 1.0).any()  # the WSP vented and held
+    assert 50.0 < want[-1, 1]  # reached the damp section
+    # the binary's generic x86-64 code (forced) gives the same numbers, bit for bit, as the
+    # x86-64-v3 code it runs on processors that have it
+    status_generic, generic = wsp_fmu.sweep(WSP_INPUTS, rows, WSP_OUTPUTS,
+                                            env={"RAILADHESION_FMU_GENERIC": "1"})
+    assert (status_generic == 0).all()
+    assert np.array_equal(generic, got)
+
+
+def test_built_in_wsp_rollback_and_no_valve_inputs(wsp_fmu):
+    v = wsp_fmu.vr
+    sets = "".join(f"set 0 {v[f'pressure_command_{k}']} 550000\n" for k in range(1, N + 1))
+    steps = "".join(f"step 0 {j * 1e-3!r} 0.001\n" for j in range(300))
+    lines, err = wsp_fmu.run(f"new 0\ninit 0\n{sets}{steps}save 0 0\n{steps}"
+                             f"get 0 {v['train_speed']}\nload 0 0\n{steps}"
+                             f"get 0 {v['train_speed']}\nset 0 {v['valve_1']} 2\n")  # fmt: skip
+    gets = [line for line in lines if line.startswith("get")]
+    assert gets[0] == gets[1]  # the WSP's state is rolled back with the vehicle
+    assert lines[-1] == "set 0 3"
+    assert "fmi2SetReal: valve_1 is an output" in err
+
+
 def test_state_rollback_gives_identical_results(fmu):
     v = fmu.vr
     speed, valve = v["train_speed"], v["valve_1"]
@@ -130,6 +197,24 @@ def test_cli_writes_a_native_braking_fmu(tmp_path):
     assert "sources/buildDescription.xml" in names
 
 
+def test_cli_default_is_native_with_or_without_the_built_in_wsp(tmp_path):
+    from typer.testing import CliRunner
+
+    from railadhesion.cli import app
+
+    out = tmp_path / "w.fmu"
+    result = CliRunner().invoke(app, ["export", "braking-fmu", str(SCENARIO), "--out", str(out),
+                                      "--wsp"])  # fmt: skip
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    assert "valve_k are outputs" in text and "needs no Python on the host" in text
+    py = CliRunner().invoke(app, ["export", "braking-fmu", str(SCENARIO), "--out",
+                                  str(tmp_path / "p.fmu"), "--wsp", "--python"])  # fmt: skip
+    assert py.exit_code == 0, py.output
+    text = " ".join(py.output.split())
+    assert "valve_k are outputs" in text and "Python FMU: the host needs a Python" in text
+
+
 def test_two_instances_side_by_side_and_no_allocation_in_steps(fmu):
     v = fmu.vr
     speed, valve = v["train_speed"], v["valve_2"]
@@ -151,3 +236,18 @@ def test_step_size_must_be_positive(fmu, h):
     lines, err = fmu.run(f"new 0\ninit 0\nstep 0 0 {h}\n")
     assert lines[-1] == "step 0 3"
     assert "fmi2DoStep: communicationStepSize must be > 0 and finite" in err
+
+
+def test_a_model_it_does_not_compile_is_a_native_unsupported_case():
+    """An adhesion model evaluated in Python (here WILAC with compiled=False) is not served by
+    the native FMU: NativeUnsupported (a NativeBuildError), which the CLI's default answers
+    with the Python FMU."""
+    from railadhesion.export import NativeBuildError, NativeUnsupported
+    from railadhesion.export.native_braking import braking_step_model
+
+    sc = load_scenario(SCENARIO)
+    sim = BrakingSimulator(sc.vehicle, sc.adhesion(), sc.initial_speed, cylinders=sc.cylinders,
+                           record=False, compiled=False)  # fmt: skip
+    with pytest.raises(NativeUnsupported, match="use the Python braking FMU"):
+        braking_step_model(sim)
+    assert issubclass(NativeUnsupported, NativeBuildError)

@@ -4,7 +4,8 @@
 * :func:`build_native_creep_force_fmu`: the same law as a native FMU, compiled ahead of time
   (no Python at run time; :mod:`railadhesion.export.native` builds any step model so);
 * :func:`build_braking_fmu`: the braking simulator's stepping API as an FMU (inputs: commanded
-  pressure and WSP valve per axle);
+  pressure and WSP valve per axle, or with the built-in WSP the pressure only);
+  :func:`build_native_braking_fmu`: the same, native (no Python at run time);
 * :func:`build_monitor_fmu`: the on-board adhesion monitor as an FMU (inputs: speed
   reference, wheel speeds, pressures and/or torques; outputs: estimates, levels, reasons);
   :func:`build_native_monitor_fmu`: the same, native (no Python at run time);
@@ -31,7 +32,7 @@ from railadhesion.export.monitor_fmu import (
     monitor_fmu_variables,
     monitor_step_model,
 )
-from railadhesion.export.native import NativeBuildError
+from railadhesion.export.native import NativeBuildError, NativeUnsupported
 from railadhesion.export.native_braking import build_native_braking_fmu
 from railadhesion.export.native_creepforce import build_native_creep_force_fmu
 from railadhesion.export.tables import (
@@ -50,6 +51,7 @@ __all__ = [
     "FmuVariable",
     "InterpolationError",
     "NativeBuildError",
+    "NativeUnsupported",
     "braking_fmu_variables",
     "build_braking_fmu",
     "build_creep_force_fmu",

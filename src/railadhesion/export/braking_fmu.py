@@ -18,24 +18,28 @@ from xml.etree import ElementTree as ET
 
 from railadhesion.export.fmu import FmuVariable, build_fmu
 
-__all__ = ["braking_fmu_variables", "build_braking_fmu"]
+__all__ = ["braking_fmu_variables", "build_braking_fmu", "valve_control_text"]
 
 _CONFIG_FILE = "railadhesion_fmu.json"
 _SCENARIO_FILE = "scenario.toml"
 
 
-def braking_fmu_variables(n_axles: int) -> list[FmuVariable]:
-    """The variables of a braking FMU with ``n_axles`` axles (axle 1 leading)."""
+def braking_fmu_variables(n_axles: int, wsp: bool = False) -> list[FmuVariable]:
+    """The variables of a braking FMU with ``n_axles`` axles (axle 1 leading).
+
+    ``wsp=True``: the FMU runs the package's built-in WSP, and ``valve_k`` is an output (the
+    valve state the WSP chose) instead of an input; the other variables are the same."""
     variables = []
     for k in range(1, n_axles + 1):
-        variables += [
+        variables.append(
             FmuVariable(f"pressure_command_{k}", "input", "Pa",
                         f"commanded brake-cylinder pressure of axle {k} (the cylinder "
-                        "limits it to its maximum)", 0.0, 0.0),
-            FmuVariable(f"valve_{k}", "input", "1",
-                        f"WSP valve state of axle {k}: 0 apply, 1 hold, 2 vent (rounded)",
-                        0.0, 0.0, 2.0),
-        ]  # fmt: skip
+                        "limits it to its maximum)", 0.0, 0.0))  # fmt: skip
+        if not wsp:
+            variables.append(
+                FmuVariable(f"valve_{k}", "input", "1",
+                            f"WSP valve state of axle {k}: 0 apply, 1 hold, 2 vent (rounded)",
+                            0.0, 0.0, 2.0))  # fmt: skip
     variables += [
         FmuVariable("train_speed", "output", "m/s", "train speed"),
         FmuVariable("distance", "output", "m", "distance run since the start"),
@@ -55,10 +59,25 @@ def braking_fmu_variables(n_axles: int) -> list[FmuVariable]:
             FmuVariable(f"normal_load_{k}", "output", "N",
                         f"normal load of axle {k} (with pitch load transfer)"),
         ]  # fmt: skip
+        if wsp:
+            variables.append(
+                FmuVariable(f"valve_{k}", "output", "1",
+                            f"valve state of axle {k} chosen by the built-in WSP: 0 apply, "
+                            "1 hold, 2 vent"))  # fmt: skip
     return variables
 
 
-def build_braking_fmu(out, scenario) -> Path:
+def valve_control_text(wsp: bool, own: bool) -> str:
+    """What commands the valves (the FMU description's words): the master (inputs), or the
+    built-in WSP with the scenario's settings (``own``) or the default ones."""
+    if not wsp:
+        return "inputs: commanded cylinder pressure and WSP valve per axle"
+    settings = "the scenario's [wsp] settings" if own else "the default WSP settings"
+    return ("input: commanded cylinder pressure per axle; the built-in WSP "
+            f"({settings}, ideal sensors) sets the valves (outputs)")
+
+
+def build_braking_fmu(out, scenario, *, wsp: bool = False) -> Path:
     """Write an FMI 2.0 co-simulation FMU of a braking vehicle (the stepping API).
 
     Parameters
@@ -72,6 +91,11 @@ def build_braking_fmu(out, scenario) -> Path:
         embedded verbatim as ``resources/scenario.toml``, so the files it names must be
         built-in names (``coach_default``, the ``default`` WILAC set) or absolute paths on
         the host.
+    wsp : bool
+        Run the package's WSP controller (the scenario's ``[wsp]`` settings, or the defaults
+        of :class:`~railadhesion.braking.wsp.WSPSettings` if it has none) with ideal sensors
+        inside the FMU: the valve states become outputs
+        (:func:`braking_fmu_variables` with ``wsp=True``), as in the native braking FMU.
 
     Returns
     -------
@@ -103,13 +127,13 @@ def build_braking_fmu(out, scenario) -> Path:
                 f"built-in names or absolute paths): {exc}"
             ) from exc
     vehicle = loaded.vehicle
-    variables = braking_fmu_variables(vehicle.n_axles)
+    variables = braking_fmu_variables(vehicle.n_axles, wsp=wsp)
     sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
     description = (
         f"railadhesion {railadhesion.__version__}: braking vehicle '{vehicle.name}' "
         f"({vehicle.n_axles} axles) from scenario '{loaded.name}', initial speed "
-        f"{loaded.initial_speed:g} m/s; inputs: commanded cylinder pressure and WSP valve per "
-        f"axle. Scenario embedded as resources/{_SCENARIO_FILE} (sha256 {sha[:12]}...)."
+        f"{loaded.initial_speed:g} m/s; {valve_control_text(wsp, loaded.wsp is not None)}. "
+        f"Scenario embedded as resources/{_SCENARIO_FILE} (sha256 {sha[:12]}...)."
     )
     config = {
         "scenario_file": _SCENARIO_FILE,
@@ -117,6 +141,7 @@ def build_braking_fmu(out, scenario) -> Path:
         "description": description,
         "fmu_version": f"railadhesion {railadhesion.__version__}, scenario {sha[:12]}",
         "variables": [v.to_config() for v in variables],
+        "wsp": bool(wsp),
     }
     meta = ET.Element("Scenario", {"name": loaded.name, "file": f"resources/{_SCENARIO_FILE}",
                                    "sha256": sha, "railadhesionVersion": railadhesion.__version__})

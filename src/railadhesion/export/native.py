@@ -20,7 +20,9 @@ The route, with no law written twice:
    Python error-reporting paths the step can never reach;
 3. the object code is emitted for a generic CPU of the target (``x86-64`` for linux64) and its
    undefined symbols are checked: only libm (and ``memcpy``/``memset``/``memmove``) may
-   remain: no numba runtime, no Python (:data:`ALLOWED_SYMBOLS`);
+   remain: no numba runtime, no Python (:data:`ALLOWED_SYMBOLS`); a second object holds the
+   same IR optimised for x86-64-v3 (:data:`FAST_CPUS`), which the C layer runs on
+   processors that have it (same numbers, about twice as fast);
 4. the records become C structs in a generated header (:func:`c_struct`, with
    ``_Static_assert`` on every offset), their start values C initializers, and a C compiler
    links ``ra_fmi2.c`` and the object into ``binaries/linux64/<id>.so``.
@@ -32,18 +34,21 @@ of the compiled model (``<id>.ll``), with ``buildDescription.xml`` (FMI 2.0.4) a
 Public entry points: :func:`build_step_fmu` (any step model: :class:`StepModel`,
 :class:`RecordVariable`), :func:`compile_functions` (the IR-to-object route),
 :func:`c_struct` and :func:`c_initializer` (records as C), :func:`find_c_compiler`,
-:func:`undefined_symbols` (ELF), :class:`NativeBuildError`.
+:func:`native_unavailable` (can this machine build one?),
+:func:`undefined_symbols` (ELF), :class:`NativeBuildError`, :class:`NativeUnsupported`.
 """
 
 from __future__ import annotations
 
 import hashlib
 import os
+import platform
 import re
 import shlex
 import shutil
 import struct
 import subprocess
+import sys
 import tempfile
 import uuid
 import zipfile
@@ -59,11 +64,13 @@ from railadhesion.export.fmu import FmuVariable, unit_definitions
 
 __all__ = [
     "ALLOWED_SYMBOLS",
+    "FAST_CPUS",
     "INIT_SIGNATURE",
     "PLATFORM",
     "STEP_SIGNATURE",
     "CompiledCode",
     "NativeBuildError",
+    "NativeUnsupported",
     "RecordVariable",
     "StepModel",
     "build_step_fmu",
@@ -72,7 +79,9 @@ __all__ = [
     "compile_functions",
     "find_c_compiler",
     "fmi2_header_dir",
+    "native_unavailable",
     "undefined_symbols",
+    "variant_symbol",
 ]
 
 #: numba signature of a step function: ``int step(void *state, const void *settings,
@@ -86,6 +95,11 @@ INIT_SIGNATURE = "intc(voidptr, voidptr, voidptr)"
 PLATFORM = "linux64"
 _TRIPLE = "x86_64-unknown-linux-gnu"
 _CPU = "x86-64"
+#: Further CPUs the linux64 binary carries code for: the same IR optimised and emitted for
+#: x86-64-v3 (AVX2, FMA, BMI2: Intel Haswell, AMD Zen and later), chosen at instantiation
+#: when the processor has it (``ra_fmi2.c``). The numbers are the same: the IR has no
+#: fast-math flags, so LLVM neither contracts to FMA nor reassociates.
+FAST_CPUS = ("x86-64-v3",)
 
 _LIBM = frozenset(
     "acos acosh asin asinh atan atan2 atanh cbrt ceil copysign cos cosh erf erfc exp exp2 "
@@ -138,6 +152,11 @@ _INTEGER_LIMITS = {"i8": (-(2**53), 2**53), "i4": (-(2**31), 2**31 - 1), "u1": (
 class NativeBuildError(RuntimeError):
     """A native FMU cannot be built here (no C compiler, a model that needs more than libm,
     a failed compilation); the message says what to do. The Python FMU remains available."""
+
+
+class NativeUnsupported(NativeBuildError):
+    """The native FMU does not serve this case (e.g. an adhesion model it does not compile);
+    the Python FMU does (``railadhesion export`` falls back to it by default, saying so)."""
 
 
 # --------------------------------------------------------------------------------------------
@@ -205,7 +224,10 @@ def undefined_symbols(data: bytes) -> list[str]:
 
 @dataclass(frozen=True)
 class CompiledCode:
-    """Object code of compiled entry points, with the LLVM IR it was emitted from."""
+    """Object code of compiled entry points, with the LLVM IR it was emitted from.
+
+    ``variants``: (cpu, object) pairs, the same IR optimised for a further CPU, its entry
+    points named ``<symbol>_<cpu>`` (:func:`variant_symbol`)."""
 
     ir: str
     obj: bytes
@@ -213,6 +235,13 @@ class CompiledCode:
     cpu: str
     symbols: tuple[str, ...]
     undefined: tuple[str, ...]
+    variants: tuple[tuple[str, bytes], ...] = ()
+
+
+def variant_symbol(symbol: str, cpu: str) -> str:
+    """The name of entry point ``symbol`` in the object of CPU variant ``cpu``
+    (``step`` -> ``step_x86_64_v3``)."""
+    return f"{symbol}_{re.sub(r'[^0-9A-Za-z]', '_', cpu)}"
 
 
 def _llvm():
@@ -225,7 +254,8 @@ def _llvm():
 
 
 def compile_functions(
-    functions: Mapping[str, tuple[Callable, str]], *, triple: str = _TRIPLE, cpu: str = _CPU
+    functions: Mapping[str, tuple[Callable, str]], *, triple: str = _TRIPLE, cpu: str = _CPU,
+    variants: Sequence[str] = (),
 ) -> CompiledCode:
     """Compile Python functions with ``numba.cfunc`` and emit one object file exporting them.
 
@@ -237,6 +267,10 @@ def compile_functions(
         raise, allocate or touch Python objects (``error_model="numpy"`` is used).
     triple, cpu : str
         LLVM target triple and CPU of the object (default: linux64, generic x86-64).
+    variants : sequence of str
+        Further CPUs (e.g. :data:`FAST_CPUS`): for each, the same IR optimised and emitted
+        for that CPU, entry points renamed by :func:`variant_symbol` (only ``ir``, the
+        generic code, is kept as text).
 
     Returns
     -------
@@ -284,29 +318,15 @@ def compile_functions(
     for var in module.global_variables:
         if not var.is_declaration:
             var.linkage = "internal"
+    linked = str(module)  # before optimisation: the variants start from here
     target = llvm.Target.from_triple(triple)
-    machine = target.create_target_machine(cpu=cpu, opt=3, reloc="pic", codemodel="default")
-    module.triple = triple
-    module.data_layout = str(machine.target_data)
-    builder = llvm.create_pass_builder(machine, llvm.create_pipeline_tuning_options(3))
-    builder.getModulePassManager().run(module, builder)
-    module.verify()
+    module, machine = _optimise(llvm, module, target, triple, cpu)
     declared = sorted(fn.name for fn in module.functions if fn.is_declaration)
     foreign = [n for n in declared if n.startswith("llvm.") and not n.startswith(
         _PORTABLE_INTRINSICS)]  # fmt: skip
     # the same counters in metadata strings (!"..."; never in constant data, c"...")
     ir = re.sub(r'!"[^"]*"', lambda m: re.sub(r"B\d+v\d+", "", m.group(0)), str(module))
-    obj = machine.emit_object(module)
-    if obj[:4] == b"\x7fELF":
-        undefined = undefined_symbols(obj)
-        pinned = sorted(set(undefined) & set(_GLIBC_BASELINE)) if triple == _TRIPLE else []
-        if pinned:  # bind libm to its first x86-64 version: the binary loads on old glibc
-            text = ir + "".join(
-                f'\nmodule asm ".symver {n},{n}@{_GLIBC_BASELINE[n]}"' for n in pinned)
-            module = llvm.parse_assembly(text + "\n")
-            obj = machine.emit_object(module)
-    else:
-        undefined = [n for n in declared if not n.startswith("llvm.")]
+    obj, undefined = _emit(llvm, machine, module, ir, triple, declared)
     forbidden = sorted(set(undefined) - ALLOWED_SYMBOLS) + foreign
     if forbidden:
         raise NativeBuildError(
@@ -314,7 +334,45 @@ def compile_functions(
             "libm may remain (numba runtime symbols come from an allocation or an exception "
             "path, Py* from Python objects; target intrinsics tie the IR to one processor)"
         )
-    return CompiledCode(ir, obj, triple, cpu, tuple(functions), tuple(undefined))
+    built = []
+    for variant in variants:  # target intrinsics allowed: this object runs on `variant` only
+        vmodule = llvm.parse_assembly(linked)
+        for symbol in functions:
+            vmodule.get_function(symbol).name = variant_symbol(symbol, variant)
+        vmodule, vmachine = _optimise(llvm, vmodule, target, triple, variant)
+        vdeclared = sorted(fn.name for fn in vmodule.functions if fn.is_declaration)
+        vobj, vundefined = _emit(llvm, vmachine, vmodule, str(vmodule), triple, vdeclared)
+        extra = sorted(set(vundefined) - ALLOWED_SYMBOLS)
+        if extra:  # pragma: no cover - the generic object would have failed first
+            raise NativeBuildError(f"the {variant} code needs {', '.join(extra)}")
+        built.append((variant, vobj))
+    return CompiledCode(ir, obj, triple, cpu, tuple(functions), tuple(undefined), tuple(built))
+
+
+def _optimise(llvm, module, target, triple: str, cpu: str):
+    """``module`` optimised (O3) for ``cpu``; (module, target machine)."""
+    machine = target.create_target_machine(cpu=cpu, opt=3, reloc="pic", codemodel="default")
+    module.triple = triple
+    module.data_layout = str(machine.target_data)
+    builder = llvm.create_pass_builder(machine, llvm.create_pipeline_tuning_options(3))
+    builder.getModulePassManager().run(module, builder)
+    module.verify()
+    return module, machine
+
+
+def _emit(llvm, machine, module, ir: str, triple: str, declared) -> tuple[bytes, list[str]]:
+    """The object of ``module`` (IR text ``ir``) and its undefined symbols; linux64: libm
+    bound to its first glibc versions."""
+    obj = machine.emit_object(module)
+    if obj[:4] != b"\x7fELF":
+        return obj, [n for n in declared if not n.startswith("llvm.")]
+    undefined = undefined_symbols(obj)
+    pinned = sorted(set(undefined) & set(_GLIBC_BASELINE)) if triple == _TRIPLE else []
+    if pinned:  # bind libm to its first x86-64 version: the binary loads on old glibc
+        text = ir + "".join(
+            f'\nmodule asm ".symver {n},{n}@{_GLIBC_BASELINE[n]}"' for n in pinned)
+        obj = machine.emit_object(llvm.parse_assembly(text + "\n"))
+    return obj, undefined
 
 
 # --------------------------------------------------------------------------------------------
@@ -641,6 +699,26 @@ def model_header(model: StepModel, guid: str, records: Mapping[str, np.ndarray])
     return "\n".join(out)
 
 
+def native_unavailable() -> str | None:
+    """Why a native FMU cannot be built on this machine (a message naming the remedy), or
+    None: a Linux x86-64 machine (the binary is linux64), a C compiler
+    (:func:`find_c_compiler`), the FMI 2.0 headers (:func:`fmi2_header_dir`)."""
+    if not (sys.platform.startswith("linux")
+            and platform.machine().lower() in ("x86_64", "amd64")):  # fmt: skip
+        return (f"native FMUs are built on Linux x86-64 (their binary is {PLATFORM}), this "
+                f"machine is {sys.platform} {platform.machine()}: the Python FMU remains "
+                "available (railadhesion export ... --python)")  # fmt: skip
+    if find_c_compiler() is None:
+        return ("no C compiler found (set CC, or install gcc or clang): a native FMU cannot be "
+                "built here; the Python FMU remains available (railadhesion export ... "
+                "--python)")  # fmt: skip
+    try:
+        fmi2_header_dir()
+    except NativeBuildError as exc:
+        return str(exc)
+    return None
+
+
 def _guid(*parts: str | bytes) -> str:
     digest = hashlib.sha256()
     for part in parts:
@@ -685,6 +763,13 @@ The binary in binaries/{PLATFORM}/ was built from exactly these files:
 
     clang -std=c11 -O2 -fPIC -shared -fvisibility=hidden -I<FMI 2.0 headers> -I. \\
         ra_fmi2.c {identifier}.ll -o {identifier}.so -lm
+
+and, beside it, the same IR optimised for x86-64-v3 (AVX2, FMA, BMI2), its step renamed
+{identifier}_step_x86_64_v3 and named to ra_fmi2.c by
+-DRA_STEP_X86_64_V3={identifier}_step_x86_64_v3: the binary uses that code on processors
+that have x86-64-v3 (same numbers; the environment variable RAILADHESION_FMU_GENERIC=1 forces
+the generic code). The command above builds the generic code only (with -O3 -march=native
+clang optimises the IR again for the building processor).
 
 (gcc cannot read .ll: compile it first with LLVM's llc, `llc -O3 -filetype=obj
 --relocation-model=pic {identifier}.ll`, and link the object.) For another 64-bit
@@ -745,19 +830,16 @@ def build_step_fmu(
     if out.suffix != ".fmu":
         raise ValueError(f"out must be a file name ending in .fmu, got {str(out)!r}")
     model.check()
+    problem = native_unavailable()
+    if problem is not None:
+        raise NativeBuildError(problem)
     compiler = find_c_compiler()
-    if compiler is None:
-        raise NativeBuildError(
-            "no C compiler found (set CC, or install gcc or clang): a native FMU cannot be "
-            "built here; the Python FMU remains available (railadhesion export fmu without "
-            "--native)"
-        )
     headers = fmi2_header_dir()
     records = model.records()
     functions = {f"{model.identifier}_step": (model.step, STEP_SIGNATURE)}
     if model.init is not None:
         functions[f"{model.identifier}_init"] = (model.init, INIT_SIGNATURE)
-    compiled = compile_functions(functions)
+    compiled = compile_functions(functions, variants=FAST_CPUS)
     variables = [rv.variable for rv in model.variables]
     guid = _guid(compiled.ir, model_header(model, "", records), description,
                  repr([(v, rv.field, rv.index) for v, rv in zip(variables, model.variables,
@@ -777,11 +859,18 @@ def build_step_fmu(
         }
         for name, text in texts.items():
             (src / name).write_text(text, encoding="utf-8")
-        (Path(tmp) / "model.o").write_bytes(compiled.obj)
+        objects = [Path(tmp) / "model.o"]
+        objects[0].write_bytes(compiled.obj)
+        defines = []
+        for cpu, obj in compiled.variants:  # x86-64-v3: ra_fmi2.c picks it if the CPU has it
+            objects.append(Path(tmp) / f"model_{variant_symbol('', cpu).strip('_')}.o")
+            objects[-1].write_bytes(obj)
+            name = variant_symbol(f"{model.identifier}_step", cpu)
+            defines.append(f"-D{variant_symbol('RA_STEP', cpu).upper()}={name}")
         library = Path(tmp) / f"{model.identifier}.so"
         command = [*compiler, "-std=c11", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
-                   "-Wall", "-Wextra", "-I", str(headers), "-I", str(src),
-                   str(src / "ra_fmi2.c"), str(Path(tmp) / "model.o"), "-o", str(library),
+                   "-Wall", "-Wextra", *defines, "-I", str(headers), "-I", str(src),
+                   str(src / "ra_fmi2.c"), *map(str, objects), "-o", str(library),
                    "-lm"]  # fmt: skip
         try:
             run = subprocess.run(command, capture_output=True, text=True, timeout=300)

@@ -2,19 +2,22 @@
 
 Same variables as the Python braking FMU (:func:`railadhesion.export.braking_fmu_variables`:
 commanded pressure and WSP valve per axle in; train speed, distance, deceleration, stopped,
-and per axle wheel speed, cylinder pressure, creep force, adhesion used, normal load out). The
-model is a step function on the three records of :mod:`railadhesion.export.native`:
+and per axle wheel speed, cylinder pressure, creep force, adhesion used, normal load out).
+With the built-in WSP (``wsp=True``) the package's WSP controller and sensor model run inside
+the step, as in the stepping API of a simulator built with ``wsp=``: the valve states are then
+outputs. The model is a step function on the three records of :mod:`railadhesion.export.native`:
 
 * ``state``: the braking simulator's machine (the record of
-  :data:`railadhesion.braking.step.MACHINE`), copied from a
-  :class:`~railadhesion.braking.BrakingSimulator` built from the scenario, and a ``stopped``
-  flag as a number;
+  :data:`railadhesion.braking.step.MACHINE`: vehicle state, WSP and sensor records), copied
+  from a :class:`~railadhesion.braking.BrakingSimulator` built from the scenario, and a
+  ``stopped`` flag as a number;
 * ``settings``: the simulator's constant tables (adhesion sets, track, water profile);
 * ``inputs``: the commanded pressure and the valve state of every axle.
 
-Each ``doStep`` copies the inputs into the machine (valves rounded, as the Python FMU does)
-and calls :func:`railadhesion.braking.step.advance_buffer_unrecorded`, the compiled step the
-stepping API calls: the physics is not retyped, and the outputs equal the stepping API's.
+Each ``doStep`` copies the inputs into the machine (valves rounded, as the Python FMU does;
+not the valves when the built-in WSP commands them) and calls
+:func:`railadhesion.braking.step.advance_unrecorded`, the compiled step the stepping API calls:
+the physics is not retyped, and the outputs equal the stepping API's.
 """
 
 from __future__ import annotations
@@ -26,15 +29,20 @@ from pathlib import Path
 
 import numpy as np
 
-from railadhesion.export.braking_fmu import braking_fmu_variables
-from railadhesion.export.native import RecordVariable, StepModel, build_step_fmu
+from railadhesion.export.braking_fmu import braking_fmu_variables, valve_control_text
+from railadhesion.export.native import (
+    NativeUnsupported,
+    RecordVariable,
+    StepModel,
+    build_step_fmu,
+)
 
 __all__ = ["braking_step_model", "build_native_braking_fmu"]
 
 _SCENARIO_FILE = "scenario.toml"
 # per-axle outputs: FMU variable prefix -> field of the braking state record
 _AXLE_OUTPUTS = {"wheel_speed": "omega", "brake_pressure": "pressure", "creep_force": "force",
-                 "adhesion_used": "mu", "normal_load": "load"}  # fmt: skip
+                 "adhesion_used": "mu", "normal_load": "load", "valve": "valve"}  # fmt: skip
 _SCALAR_OUTPUTS = {"train_speed": "machine.state.speed", "distance": "machine.state.distance",
                    "deceleration": "machine.state.deceleration", "stopped": "stopped"}  # fmt: skip
 
@@ -53,15 +61,16 @@ def _messages() -> dict[int, str]:
     }
 
 
-def _braking_step(state_t, settings_t, inputs_t, n_axles: int):
-    """The FMU's step on the records of one export: inputs into the machine, the compiled
-    braking step, the stop flag."""
+def _braking_step(state_t, settings_t, inputs_t, n_axles: int, wsp: bool):
+    """The FMU's step on the records of one export: inputs into the machine (the valves only
+    without the built-in WSP), the compiled braking step, the stop flag."""
     from numba import carray
 
     from railadhesion.braking.records import STOPPED
     from railadhesion.braking.step import MACHINE, advance_unrecorded
 
     n = n_axles
+    valves_in = not wsp
     n_tables = settings_t.fields["tables"][0].shape[0]
 
     def step(state, settings, inputs, dt):
@@ -71,7 +80,8 @@ def _braking_step(state_t, settings_t, inputs_t, n_axles: int):
         u = machine[0].inputs
         for i in range(n):
             u.pressure_command[i] = x.pressure_command[i]
-            u.valves[i] = np.round(x.valves[i])
+            if valves_in:
+                u.valves[i] = np.round(x.valves[i])
         status = advance_unrecorded(machine, tables, dt, 0)
         out = carray(state, 1, state_t)[0]
         out.stopped = 1.0 if machine[0].state.stopped != 0 else 0.0
@@ -85,22 +95,30 @@ def _braking_step(state_t, settings_t, inputs_t, n_axles: int):
 def braking_step_model(simulator, identifier: str = "railadhesion_braking") -> StepModel:
     """The braking vehicle of ``simulator`` (a :class:`~railadhesion.braking.BrakingSimulator`
     in its current state, not recording) as a :class:`StepModel` with the braking FMU's
-    variables."""
+    variables.
+
+    A simulator with the built-in WSP (``wsp=``, the package's controller and sensor model)
+    gives the FMU with the WSP inside: ``valve_k`` are then outputs
+    (:func:`railadhesion.export.braking_fmu_variables` with ``wsp=True``)."""
     from railadhesion.braking.records import INPUTS, POLACH, WILAC
     from railadhesion.braking.step import MACHINE, split_buffer
 
     if simulator._rows is not None:  # noqa: SLF001
         raise ValueError("simulator: build it with record=False")
     buffer = simulator._buffer  # noqa: SLF001
+    if buffer is None:
+        raise NativeUnsupported(
+            "simulator: the native braking FMU compiles the package's WSP controller and "
+            "sensor model only (WheelSlideProtection, SensorModel); this simulator has another "
+            "controller or sensor model: use the Python braking FMU")
     machine, tables = split_buffer(buffer)
     n = int(machine[0]["settings"]["n_axles"])
     if int(machine[0]["settings"]["model"]) not in (POLACH, WILAC):
-        raise ValueError("simulator: the native braking FMU compiles the built-in adhesion "
-                         "models (Polach sets, WILAC) only; this simulator's model is a "
-                         "Python function or a user's law: use the Python braking FMU")
-    if int(machine[0]["settings"]["wsp_on"]) != 0:
-        raise ValueError("simulator: build it without the built-in WSP (the FMU's master "
-                         "commands the valves)")
+        raise NativeUnsupported(
+            "simulator: the native braking FMU compiles the built-in adhesion models (Polach "
+            "sets, WILAC) only; this simulator's model is a Python function or a user's law: "
+            "use the Python braking FMU")
+    wsp = int(machine[0]["settings"]["wsp_on"]) != 0
     state_t = np.dtype([("machine", MACHINE), ("stopped", "f8")], align=True)
     settings_t = np.dtype([("tables", "f8", (max(tables.size, 1),))], align=True)
     state = np.zeros(1, state_t)
@@ -111,7 +129,7 @@ def braking_step_model(simulator, identifier: str = "railadhesion_braking") -> S
     inputs = np.zeros(1, INPUTS)
     inputs["pressure_command"][0] = machine[0]["inputs"]["pressure_command"]
     variables = []
-    for v in braking_fmu_variables(n):
+    for v in braking_fmu_variables(n, wsp=wsp):
         name = v.name
         if v.causality == "input":
             prefix, k = name.rsplit("_", 1)
@@ -125,7 +143,7 @@ def braking_step_model(simulator, identifier: str = "railadhesion_braking") -> S
                                             (int(k) - 1,)))  # fmt: skip
     return StepModel(
         identifier=identifier,
-        step=_braking_step(state_t, settings_t, INPUTS, n),
+        step=_braking_step(state_t, settings_t, INPUTS, n, wsp),
         state=state,
         settings=settings,
         inputs=inputs,
@@ -134,7 +152,7 @@ def braking_step_model(simulator, identifier: str = "railadhesion_braking") -> S
     )
 
 
-def build_native_braking_fmu(out, scenario) -> Path:
+def build_native_braking_fmu(out, scenario, *, wsp: bool = False) -> Path:
     """Write a native FMI 2.0 co-simulation FMU of a braking vehicle: no Python at run time.
 
     Same scenario file, variables and outputs as :func:`railadhesion.export.build_braking_fmu`;
@@ -148,6 +166,11 @@ def build_native_braking_fmu(out, scenario) -> Path:
         The ``.fmu`` file to write.
     scenario : str or os.PathLike
         A braking scenario TOML file (``docs/braking.md``), embedded as documentation.
+    wsp : bool
+        Run the package's WSP controller (the scenario's ``[wsp]`` settings, or the defaults
+        of :class:`~railadhesion.braking.wsp.WSPSettings` if it has none) and ideal sensors
+        inside the FMU: the valve states become outputs. Default: the master commands the
+        valves (inputs), as in the Python braking FMU.
 
     Returns
     -------
@@ -164,8 +187,8 @@ def build_native_braking_fmu(out, scenario) -> Path:
     if not path.is_file():
         raise ValueError(f"scenario must be an existing TOML file, got {str(path)!r}")
     if not _generic_cpu():
-        return _build_in_generic_process(out, path)
-    return _build(out, path)
+        return _build_in_generic_process(out, path, wsp)
+    return _build(out, path, wsp)
 
 
 def _generic_cpu() -> bool:
@@ -174,7 +197,7 @@ def _generic_cpu() -> bool:
     return numba.config.CPU_NAME == "generic"  # numba's public settings (NUMBA_CPU_NAME)
 
 
-def _build_in_generic_process(out, path: Path) -> Path:
+def _build_in_generic_process(out, path: Path, wsp: bool) -> Path:
     """Build in a Python process whose numba compiles for a generic x86-64: the braking
     step's IR then holds no vector intrinsics of this machine's processor (AVX masked loads),
     which the portable binary may not contain."""
@@ -184,13 +207,16 @@ def _build_in_generic_process(out, path: Path) -> Path:
 
     env = dict(os.environ, NUMBA_CPU_NAME="generic", NUMBA_CPU_FEATURES="")
     code = ("import sys; from railadhesion.export.native_braking import _build; "
-            "_build(sys.argv[1], sys.argv[2])")  # fmt: skip
-    done = subprocess.run([sys.executable, "-c", code, str(out), str(path)], env=env,
+            "_build(sys.argv[1], sys.argv[2], sys.argv[3] == '1')")  # fmt: skip
+    done = subprocess.run([sys.executable, "-c", code, str(out), str(path), str(int(wsp))],
+                          env=env,
                           capture_output=True, text=True)  # fmt: skip
     if done.returncode != 0:
         last = (done.stderr.strip().splitlines() or ["(no message)"])[-1]
         from railadhesion.export.native import NativeBuildError
 
+        if "NativeUnsupported" in last:
+            raise NativeUnsupported(last.split(": ", 1)[-1])
         if "NativeBuildError" in last:
             raise NativeBuildError(last.split(": ", 1)[-1])
         if "ValueError" in last:
@@ -199,10 +225,11 @@ def _build_in_generic_process(out, path: Path) -> Path:
     return Path(out)
 
 
-def _build(out, path) -> Path:
+def _build(out, path, wsp: bool = False) -> Path:
     import railadhesion
     from railadhesion.braking import BrakingSimulator
     from railadhesion.braking.scenario import load_scenario
+    from railadhesion.braking.wsp import WheelSlideProtection
 
     path = Path(path)
     text = path.read_text(encoding="utf-8")
@@ -219,6 +246,7 @@ def _build(out, path) -> Path:
     sim = BrakingSimulator(
         loaded.vehicle, loaded.adhesion(), loaded.initial_speed, cylinders=loaded.cylinders,
         gradient=loaded.gradient, refresh_period=loaded.refresh_period, record=False,
+        wsp=WheelSlideProtection(loaded.wsp) if wsp else None,
     )  # fmt: skip
     model = braking_step_model(sim)
     vehicle = loaded.vehicle
@@ -226,8 +254,8 @@ def _build(out, path) -> Path:
     description = (
         f"railadhesion {railadhesion.__version__}: braking vehicle '{vehicle.name}' "
         f"({vehicle.n_axles} axles) from scenario '{loaded.name}', initial speed "
-        f"{loaded.initial_speed:g} m/s; inputs: commanded cylinder pressure and WSP valve per "
-        f"axle. Native: no Python at run time. Scenario in documentation/{_SCENARIO_FILE} "
+        f"{loaded.initial_speed:g} m/s; {valve_control_text(wsp, loaded.wsp is not None)}. "
+        f"Native: no Python at run time. Scenario in documentation/{_SCENARIO_FILE} "
         f"(sha256 {sha[:12]}...)."
     )
     rows = "".join(

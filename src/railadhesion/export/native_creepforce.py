@@ -29,7 +29,11 @@ from railadhesion.export.fmu import (
 )
 from railadhesion.export.native import RecordVariable, StepModel, build_step_fmu
 
-__all__ = ["build_native_creep_force_fmu", "creep_force_step_model"]
+__all__ = ["NATIVE_MODELS", "build_native_creep_force_fmu", "creep_force_step_model"]
+
+#: The creep-force laws the native FMU compiles (``railadhesion export fmu`` writes any other
+#: as the Python FMU).
+NATIVE_MODELS = ("wilac", "polach")
 
 _PARAMETER_FILE = "parameters.toml"
 _STATE = np.dtype([("Fx", "f8"), ("Fy", "f8"), ("adhesion", "f8")], align=True)

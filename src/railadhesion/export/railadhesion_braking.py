@@ -6,9 +6,11 @@ not meant to be imported by users. At instantiation it loads the embedded scenar
 track) and builds a :class:`railadhesion.braking.BrakingSimulator` from it with the host's
 installed ``railadhesion``. Every ``doStep(t, h)`` calls ``simulator.step(h, inputs)`` with the
 current inputs (commanded pressure and valve state per axle), so the outputs equal those of
-the stepping API driven directly with the same inputs. The scenario's own WSP controller and
-brake demand are not used: the co-simulation master (a HIL rig's WSP unit, a train model)
-commands the pressures and the valves.
+the stepping API driven directly with the same inputs. The scenario's brake demand is not
+used: the co-simulation master (a HIL rig's WSP unit, a train model) commands the pressures
+and the valves; or, when the FMU was built with the built-in WSP (``"wsp": true`` in its
+configuration), the pressures only, and the package's WSP controller (the scenario's ``[wsp]``
+settings, ideal sensors) sets the valves, which are then outputs.
 """
 
 from __future__ import annotations
@@ -59,10 +61,16 @@ class RailadhesionBraking(Fmi2Slave):
         self._np = np
         scenario = load_scenario(resources / config["scenario_file"])
         self._n = scenario.vehicle.n_axles
+        self._wsp = bool(config.get("wsp", False))
+        wsp = None
+        if self._wsp:
+            from railadhesion.braking.wsp import WheelSlideProtection
+
+            wsp = WheelSlideProtection(scenario.wsp)
         self._sim = BrakingSimulator(
             scenario.vehicle, scenario.adhesion(), scenario.initial_speed,
             cylinders=scenario.cylinders, gradient=scenario.gradient,
-            refresh_period=scenario.refresh_period, record=False,
+            refresh_period=scenario.refresh_period, record=False, wsp=wsp,
         )  # fmt: skip
         self._failed = False
         for var in config["variables"]:
@@ -94,6 +102,8 @@ class RailadhesionBraking(Fmi2Slave):
             setattr(self, f"creep_force_{k}", float(state.creep_forces[i]))
             setattr(self, f"adhesion_used_{k}", float(state.adhesion_used[i]))
             setattr(self, f"normal_load_{k}", float(state.normal_loads[i]))
+            if self._wsp:  # the valve states the built-in WSP chose (outputs)
+                setattr(self, f"valve_{k}", float(state.valves[i]))
 
     def do_step(self, current_time, step_size):
         np = self._np
@@ -103,12 +113,13 @@ class RailadhesionBraking(Fmi2Slave):
             return True
         n = self._n
         command = np.array([getattr(self, f"pressure_command_{k}") for k in range(1, n + 1)])
-        valves = np.array(
-            [int(round(getattr(self, f"valve_{k}"))) for k in range(1, n + 1)], dtype=np.int64
-        )
+        inputs = {"pressure_command": command}
+        if not self._wsp:  # else the built-in WSP sets them
+            inputs["valves"] = np.array(
+                [int(round(getattr(self, f"valve_{k}"))) for k in range(1, n + 1)],
+                dtype=np.int64)  # fmt: skip
         try:
-            state = self._sim.step(float(step_size),
-                                   {"pressure_command": command, "valves": valves})
+            state = self._sim.step(float(step_size), inputs)
         except (ValueError, RuntimeError) as exc:  # bad input or a failed solve: say so
             self._failed = not isinstance(exc, ValueError)
             self.log(f"railadhesion: {exc}", Fmi2Status.error)

@@ -18,10 +18,15 @@
  * Build (what railadhesion.export.native does for linux64):
  *   cc -std=c11 -O2 -fPIC -fvisibility=hidden -shared -I<FMI 2.0 headers> -I. ra_fmi2.c
  *      <law object> -o <modelIdentifier>.so -lm
+ * The linux64 binary also links the same model optimised for x86-64-v3 (AVX2, FMA, BMI2),
+ * named by -DRA_STEP_X86_64_V3=<symbol>: fmi2Instantiate uses it when the processor has
+ * x86-64-v3, unless the environment variable RAILADHESION_FMU_GENERIC is set (non-empty).
+ * Both give the same numbers (the model's IR has no fast-math flags).
  */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "fmi2Functions.h"
@@ -63,6 +68,7 @@ typedef struct {
 typedef struct {
     uint32_t magic;
     Snapshot now;
+    ra_step_function step; /* RA_STEP, or its x86-64-v3 code */
     fmi2CallbackFunctions functions;
     char *name;
     int logging_on;
@@ -161,9 +167,41 @@ static void store(Snapshot *s, const ra_variable *v, double x) {
     }
 }
 
+#ifdef RA_STEP_X86_64_V3
+int RA_STEP_X86_64_V3(void *state, const void *settings, const void *inputs, double dt);
+
+static int has_x86_64_v3(void) {
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && __GNUC__ >= 12
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("x86-64-v3");
+#elif defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+    /* the feature names every GCC and clang know; processors with these have the rest of
+       x86-64-v3 (F16C, MOVBE, LZCNT: Intel since Haswell, AMD since Excavator) */
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+           __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2");
+#else
+    return 0;
+#endif
+}
+#endif
+
+/* The model's step for this processor (see the build notes above); *which names it. */
+static ra_step_function choose_step(const char **which) {
+#ifdef RA_STEP_X86_64_V3
+    const char *generic = getenv("RAILADHESION_FMU_GENERIC");
+    if ((generic == NULL || generic[0] == '\0') && has_x86_64_v3()) {
+        *which = "x86-64-v3";
+        return RA_STEP_X86_64_V3;
+    }
+#endif
+    *which = "x86-64";
+    return RA_STEP;
+}
+
 /* Runs the step; on failure logs the model's message and returns fmi2Error. */
 static fmi2Status run_step(Instance *c, const char *function, double dt) {
-    int code = RA_STEP(&c->now.state, &c->now.settings, &c->now.inputs, dt);
+    int code = c->step(&c->now.state, &c->now.settings, &c->now.inputs, dt);
     if (code == 0) {
         c->now.outputs_stale = 0;
         return fmi2OK;
@@ -215,6 +253,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     const char *name = instanceName != NULL ? instanceName : "";
     Instance *c;
     size_t length;
+    const char *code;
     (void)fmuResourceLocation; /* the model is compiled in: no resource is read */
     (void)visible;
     if (functions == NULL || functions->logger == NULL) return NULL; /* nowhere to say why */
@@ -251,7 +290,9 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     c->magic = RA_INSTANCE_MAGIC;
     c->functions = *functions;
     c->logging_on = loggingOn != fmi2False;
+    c->step = choose_step(&code);
     start(c);
+    log_status(c, fmi2OK, "fmi2Instantiate: %s code", code);
     return c;
 }
 
