@@ -83,6 +83,7 @@ from railadhesion.braking.records import (
     PYTHON,
     ROWS_FULL,
     STALE,
+    TABLE,
     USER,
     USER_GRID,
     WILAC,
@@ -313,7 +314,12 @@ def largest_stable_step(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed:
     """
     import warnings
 
-    from railadhesion.braking.adhesion import PolachAdhesion, WaterFlowProfile, WilacAdhesion
+    from railadhesion.braking.adhesion import (
+        ExactTableAdhesion,
+        PolachAdhesion,
+        WaterFlowProfile,
+        WilacAdhesion,
+    )
 
     radius, inertia = vehicle.wheel_radius, vehicle.wheelset_inertia
     loads = np.unique(np.concatenate([vehicle.axle_normal_loads(0.0),
@@ -328,6 +334,9 @@ def largest_stable_step(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed:
         probes = [(f"WILAC at {w:g} µl/s", WilacAdhesion(w, adhesion.parameters,
                                                          contact=adhesion.contact))
                   for w in sorted({0.0, *map(float, adhesion.water_flow.values)})]
+    elif type(adhesion) is ExactTableAdhesion:
+        probes = [("table model", ExactTableAdhesion(adhesion.mu, adhesion.friction_ratio,
+                                                     adhesion.friction_decay, adhesion.contact))]
     elif isinstance(adhesion, CallableAdhesion) and (
             type(adhesion).evaluate is CallableAdhesion.evaluate):
         probes = [(adhesion.label, CallableAdhesion(adhesion.function, adhesion.needs_load,
@@ -542,8 +551,12 @@ class BrakingSimulator:
         """The adhesion model's settings and constant tables, the model family and the
         step's entry points for it."""
         from railadhesion.braking import step
-        from railadhesion.braking.adhesion import PolachAdhesion, WilacAdhesion
-        from railadhesion.braking.curves import register_python_model
+        from railadhesion.braking.adhesion import (
+            ExactTableAdhesion,
+            PolachAdhesion,
+            WilacAdhesion,
+        )
+        from railadhesion.braking.curves import TABLE_AUX, register_python_model
 
         a = self.adhesion
         parts = []
@@ -585,6 +598,22 @@ class BrakingSimulator:
             packed = a.packed
             table("wilac", packed)
             st["wilac_count"] = packed.size
+        elif compiled and type(a) is ExactTableAdhesion:
+            model, aux = TABLE, TABLE_AUX
+            tab, dims, strides, origin, inv_step = a.arrays
+            table("table", tab)
+            st["table_count"] = tab.size
+            st["table_dims"], st["table_strides"] = dims, strides
+            st["table_origin"], st["table_inv_step"] = origin, inv_step
+            st["table_mu"], st["table_ratio"] = a.mu, a.friction_ratio
+            st["table_decay"] = a.friction_decay
+            st["table_a0"], st["table_b0"] = a.contact.a0, a.contact.b0
+            st["table_shear_modulus"] = a.contact.shear_modulus
+            st["table_poisson"] = a.contact.poisson
+            grid = np.geomspace(1e-4, 1.0, USER_GRID)
+            table("grid", grid)
+            st["grid_count"] = grid.size
+            entries = entries[:4] + (step.advance_table, step.advance_table_recorded)
         else:
             model, aux = PYTHON, None
             st["python_key"] = register_python_model(a, self)
@@ -609,14 +638,19 @@ class BrakingSimulator:
         """True if the adhesion model can be evaluated in compiled code (Polach, WILAC with a
         WaterFlowProfile, or a :class:`CallableAdhesion` of a numba ``@njit`` function);
         it then is unless ``compiled=False`` was asked."""
-        from railadhesion.braking.adhesion import PolachAdhesion, WaterFlowProfile, WilacAdhesion
+        from railadhesion.braking.adhesion import (
+            ExactTableAdhesion,
+            PolachAdhesion,
+            WaterFlowProfile,
+            WilacAdhesion,
+        )
 
         kind = type(self.adhesion)
         if kind is WilacAdhesion:
             return isinstance(self.adhesion.water_flow, WaterFlowProfile)
         if isinstance(self.adhesion, CallableAdhesion):
             return _is_jitted(self.adhesion)
-        return kind is PolachAdhesion
+        return kind is PolachAdhesion or kind is ExactTableAdhesion
 
     @property
     def runs_compiled(self) -> bool:
