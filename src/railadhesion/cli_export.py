@@ -18,7 +18,7 @@ export_app = typer.Typer(
 )
 console = Console()
 
-_MODEL_HELP = "Creep-force model: wilac or polach."
+_MODEL_HELP = "Creep-force model: wilac or polach (fmu: also table, Kalker's exact theory)."
 _PARAMS_HELP = "Parameter file (TOML, docs/parameter-files.md); embedded in the export."
 _SET_HELP = "Named parameter set: Polach, see 'railadhesion params list'; WILAC, 'default'."
 
@@ -63,6 +63,10 @@ def export_fmu(
         help="Compile the law into the FMU (linux64 binary and its sources): no Python on "
              "the host. Needs a C compiler here. Default: the Python FMU (pythonfmu).",
     ),  # fmt: skip
+    friction: str | None = typer.Option(
+        None, help="Table model: 'falling' (the set's mu0, A, B; default) or 'coulomb' (its "
+                   "mu0).",
+    ),  # fmt: skip
 ) -> None:
     """Write an FMI 2.0 co-simulation FMU of a creep-force law (the Python FMU needs Python
     on the host; --native does not)."""
@@ -77,8 +81,12 @@ def export_fmu(
         resolved = resolve_parameters(model, params, parameter_set)
     except ValueError as exc:
         _fail(exc)
+    if native and model == "table":
+        _fail("the native creep-force FMU offers wilac and polach; export the table model as "
+              "the Python FMU (without --native)")
+    extra = {} if friction is None else {"friction": friction}
     path = _write_fmu(build, out, model, params, parameter_set=parameter_set,
-                      shear_modulus=shear_modulus, poisson=poisson)  # fmt: skip
+                      shear_modulus=shear_modulus, poisson=poisson, **extra)  # fmt: skip
     console.print(escape(f"{model}: {resolved.summary()}"))
     if native:
         console.print("native FMU: binaries/linux64 needs no Python on the host; sources in "

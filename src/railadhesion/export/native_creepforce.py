@@ -171,6 +171,9 @@ def build_native_creep_force_fmu(
     fails the step (``fmi2Error``). After an error the instance needs ``fmi2Reset`` or
     ``fmi2SetFMUstate`` (FMI 2.0).
     """
+    if model == "table":
+        raise ValueError("model: the native creep-force FMU offers wilac and polach; the table "
+                         "model is exported as the Python FMU (without --native)")
     resolved = resolve_parameters(model, params, parameter_set)
     step_model = creep_force_step_model(model, resolved.params, shear_modulus=shear_modulus,
                                         poisson=poisson)  # fmt: skip
