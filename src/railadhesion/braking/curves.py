@@ -502,12 +502,14 @@ def table_slopes(creep, speed, loads, a, b, mu0, ratio, decay, g, nu, tab, dims,
 def table_peak(grid, speed, loads, a, b, mu0, ratio, decay, g, nu, tab, dims, strides,
                origin, inv_step, out):
     """The adhesion available per axle: the largest μ of :func:`table_axle_curve` over the
-    creepages ``grid`` (the log-spaced grid of user laws), into ``out``."""
+    creepages ``grid`` (the log-spaced grid of user laws; the law alone, without the
+    slopes), into ``out``."""
+    v = max(speed, 0.0)
     for i in range(loads.shape[0]):
         best = -math.inf
         for j in range(grid.shape[0]):
-            m = table_axle_curve(grid[j], speed, loads[i], a[i], b[i], mu0, ratio, decay, g,
-                                 nu, tab, dims, strides, origin, inv_step)[0]
+            m = _table_mu(grid[j], v, loads[i], a[i], b[i], mu0, ratio, decay, g, nu, tab, dims,
+                          strides, origin, inv_step) if loads[i] != 0.0 else 0.0
             best = max(best, m)
         out[i] = best
 
@@ -539,14 +541,15 @@ def _table_peak(s, st, tables, speed):
     c = s.curve
     tab = tables[st.table_at:st.table_at + st.table_count]
     grid = tables[st.grid_at:st.grid_at + st.grid_count]
+    v = max(speed, 0.0)
     for i in range(st.n_axles):
         best = -math.inf
+        q = s.wheel_load[i]
         for j in range(grid.size):
-            m = table_axle_curve(grid[j], speed, s.wheel_load[i], s.params[i, 0, 0],
-                                 s.params[i, 0, 1], st.table_mu, st.table_ratio,
-                                 st.table_decay, st.table_shear_modulus, st.table_poisson,
-                                 tab, st.table_dims, st.table_strides, st.table_origin,
-                                 st.table_inv_step)[0]
+            m = _table_mu(grid[j], v, q, s.params[i, 0, 0], s.params[i, 0, 1], st.table_mu,
+                          st.table_ratio, st.table_decay, st.table_shear_modulus,
+                          st.table_poisson, tab, st.table_dims, st.table_strides,
+                          st.table_origin, st.table_inv_step) if q != 0.0 else 0.0
             best = max(best, m)
         c.available[i] = best
 
