@@ -80,16 +80,19 @@ def stops():
     cyl = BrakeCylinders(max_pressure=6e5, fill_time_constant=0.3, vent_time_constant=0.15)
     print("\n### Emergency stops of the default coach from 30 m/s (5.5 bar, WSP, dt = 1 ms)\n")
     print("| set | model | stopping distance [m] | max slip [%] | vent actions "
-          "| mean adhesion used | run time [s] |")
+          "| mean adhesion used | run time [s], best of 3 |")
     print("|---|---|---|---|---|---|---|")
     for name in (*SETS, low_wet()):
         for label, m in models(name).items():
             simulate(coach, m, 30.0, 5.5e5, cylinders=cyl, wsp=WheelSlideProtection(),
                      dt=1e-3, max_time=1.0)  # compile outside the timing
-            t = time.perf_counter()
-            res = simulate(coach, models(name)[label], 30.0, 5.5e5, cylinders=cyl,
-                           wsp=WheelSlideProtection(), dt=1e-3)
-            dt = time.perf_counter() - t
+            times = []
+            for _ in range(3):  # best of 3
+                t = time.perf_counter()
+                res = simulate(coach, models(name)[label], 30.0, 5.5e5, cylinders=cyl,
+                               wsp=WheelSlideProtection(), dt=1e-3)
+                times.append(time.perf_counter() - t)
+            dt = min(times)
             s = res.summary
             set_name = name if isinstance(name, str) else name.name
             print(f"| {set_name} | {label} | {res.stopping_distance:.1f} | "
