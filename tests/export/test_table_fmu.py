@@ -157,3 +157,64 @@ def test_cli_export_fmu_model_table(tmp_path):
     res = CliRunner().invoke(app, ["export", "fmu", "--model", "table", "--native", "--out",
                                    str(tmp_path / "n.fmu")])
     assert res.exit_code != 0 and "native" in res.output
+
+
+BRAKE_SCENARIO = """
+format = "railadhesion-brake-scenario"
+version = 1
+name = "table"
+[vehicle]
+file = "coach_default"
+[run]
+initial_speed_m_s = 8.0
+time_step_s = 0.002
+[brake]
+pressure_Pa = 3e5
+[adhesion]
+model = "table"
+mu = 0.08
+friction_ratio = 0.4
+friction_decay_s_per_m = 0.6
+"""
+
+
+def test_braking_fmu_of_a_table_scenario_matches_the_stepping_api(tmp_path):
+    from railadhesion.braking import BrakingSimulator
+    from railadhesion.braking.scenario import load_scenario
+    from railadhesion.export import build_braking_fmu, build_native_braking_fmu
+
+    path = tmp_path / "t.toml"
+    path.write_text(BRAKE_SCENARIO)
+    fmu = build_braking_fmu(tmp_path / "b.fmu", path)
+    assert validate_fmu(str(fmu)) == []
+    sc = load_scenario(path)
+    sim = BrakingSimulator(sc.vehicle, sc.adhesion(), sc.initial_speed, cylinders=sc.cylinders,
+                           record=False)
+    md = read_model_description(fmu)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    dir_ = extract(fmu)
+    s = FMU2Slave(guid=md.guid, unzipDirectory=dir_,
+                  modelIdentifier=md.coSimulation.modelIdentifier, instanceName="b")
+    names = [f"wheel_speed_{k}" for k in range(1, 5)] + ["train_speed", "distance"]
+    try:
+        s.instantiate()
+        s.setupExperiment(startTime=0.0)
+        s.enterInitializationMode()
+        s.exitInitializationMode()
+        t, h = 0.0, 5e-3
+        for k in range(200):
+            command = [5e5] * 4 if k > 5 else [0.0] * 4  # hard enough to slide at mu 0.08
+            s.setReal([vr[f"pressure_command_{j}"] for j in range(1, 5)], command)
+            s.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+            t += h
+            state = sim.step(h, {"pressure_command": command, "valves": [0] * 4})
+        got = s.getReal([vr[n] for n in names])
+    finally:
+        s.terminate()
+        s.freeInstance()
+        shutil.rmtree(dir_, ignore_errors=True)
+    want = [*state.wheel_speeds, state.train_speed, state.distance]
+    np.testing.assert_allclose(got, want, rtol=1e-12)
+    assert max(state.creep) > 0.01  # the wheels slide: the table's falling branch is used
+    with pytest.raises(ValueError, match="table model"):
+        build_native_braking_fmu(tmp_path / "n.fmu", path)

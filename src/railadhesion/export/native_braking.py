@@ -97,7 +97,8 @@ def braking_step_model(simulator, identifier: str = "railadhesion_braking") -> S
     if int(machine[0]["settings"]["model"]) not in (POLACH, WILAC):
         raise ValueError("simulator: the native braking FMU compiles the built-in adhesion "
                          "models (Polach sets, WILAC) only; this simulator's model is a "
-                         "Python function or a user's law: use the Python braking FMU")
+                         "Python function, a user's law or the table model: use the Python "
+                         "braking FMU")
     if int(machine[0]["settings"]["wsp_on"]) != 0:
         raise ValueError("simulator: build it without the built-in WSP (the FMU's master "
                          "commands the valves)")
