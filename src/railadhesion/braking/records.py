@@ -20,7 +20,8 @@ which the first ``settings.n_axles`` are used.
     sensor_state     (1,) record of the sensor model
 
 Variable-length constant tables (Polach sets, track sections, the water-flow profile, the
-packed WILAC set, the search grid of user laws) live in one float64 array ``tables``; the
+packed WILAC set, the search grid of user laws, the table model's slice at the contact's
+a/b) live in one float64 array ``tables``; the
 settings name where each starts (``*_at``) and how many values it has (``*_count``).
 """
 

@@ -57,9 +57,10 @@ dissipation, O(dt)).
 
 One integrator performs these operations: :func:`railadhesion.braking.step.step`, compiled
 with numba, on the named records of :mod:`railadhesion.braking.records`. It evaluates the
-built-in models (Polach, WILAC with a :class:`~railadhesion.braking.adhesion.WaterFlowProfile`)
-and a user's numba law in compiled code, and any other adhesion model by calling its Python
-methods back (``compiled=False`` asks for that with every model).
+built-in models (Polach, WILAC with a :class:`~railadhesion.braking.adhesion.WaterFlowProfile`),
+the table model of Kalker's exact theory and a user's numba law in compiled code, and any
+other adhesion model by calling its Python methods back (``compiled=False`` asks for that
+with every model).
 """
 
 from __future__ import annotations
@@ -306,8 +307,8 @@ def largest_stable_step(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed:
     the smallest τ over the axle loads (static, and under a deceleration of 3 m/s²), speeds
     from ``initial_speed`` down to 1 m/s and creepages from 1e-4 to 1, for every adhesion
     condition the model holds (each Polach set; WILAC dry and at the water flows of its
-    profile; a :class:`CallableAdhesion` law). It is inf when no curve falls, and for models
-    defined in Python otherwise (not examined).
+    profile; the table model; a :class:`CallableAdhesion` law). It is inf when no curve
+    falls, and for models defined in Python otherwise (not examined).
 
     Returns ``(tau, where)``: the step [s] and a dict saying where it is reached (condition,
     speed, creepage, slope, axle load).
@@ -406,7 +407,8 @@ class BrakingSimulator:
         request (:meth:`adhesion_available`).
     compiled : bool
         Evaluate the adhesion model in compiled code when it allows it (Polach, WILAC with a
-        :class:`~railadhesion.braking.adhesion.WaterFlowProfile`, a
+        :class:`~railadhesion.braking.adhesion.WaterFlowProfile`, the table model
+        :class:`~railadhesion.braking.adhesion.ExactTableAdhesion`, a
         :class:`~railadhesion.braking.adhesion.CallableAdhesion` of a numba ``@njit`` law);
         with ``False`` (or any other model) the step calls the model's Python methods.
     wsp : WheelSlideProtection, optional
@@ -636,7 +638,8 @@ class BrakingSimulator:
     @property
     def compiled(self) -> bool:
         """True if the adhesion model can be evaluated in compiled code (Polach, WILAC with a
-        WaterFlowProfile, or a :class:`CallableAdhesion` of a numba ``@njit`` function);
+        WaterFlowProfile, the table model, or a :class:`CallableAdhesion` of a numba ``@njit``
+        function);
         it then is unless ``compiled=False`` was asked."""
         from railadhesion.braking.adhesion import (
             ExactTableAdhesion,
