@@ -18,7 +18,9 @@ export_app = typer.Typer(
 )
 console = Console()
 
-_MODEL_HELP = "Creep-force model: wilac or polach (fmu: also table, Kalker's exact theory)."
+_MODEL_HELP = "Creep-force model: wilac or polach."
+_FMU_MODEL_HELP = ("Creep-force model: wilac, polach, or table (the table model of Kalker's exact "
+                   "theory, with the friction of a Polach set; Python FMU only).")
 _PARAMS_HELP = "Parameter file (TOML, docs/parameter-files.md); embedded in the export."
 _SET_HELP = "Named parameter set: Polach, see 'railadhesion params list'; WILAC, 'default'."
 
@@ -52,7 +54,7 @@ def _creep_percent(text: str | None, name: str):
 
 @export_app.command("fmu")
 def export_fmu(
-    model: str = typer.Option("wilac", help=_MODEL_HELP),
+    model: str = typer.Option("wilac", help=_FMU_MODEL_HELP),
     params: Path | None = typer.Option(None, "--params", help=_PARAMS_HELP),
     parameter_set: str | None = typer.Option(None, "--set", help=_SET_HELP),
     out: Path = typer.Option(Path("creepforce.fmu"), help="The FMU file to write (.fmu)."),
