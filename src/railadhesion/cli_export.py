@@ -20,7 +20,7 @@ console = Console()
 
 _MODEL_HELP = "Creep-force model: wilac or polach."
 _FMU_MODEL_HELP = ("Creep-force model: wilac, polach, or table (the table model of Kalker's exact "
-                   "theory, with the friction of a Polach set; Python FMU only).")
+                   "theory, with the friction of a Polach set).")
 _PARAMS_HELP = "Parameter file (TOML, docs/parameter-files.md); embedded in the export."
 _SET_HELP = "Named parameter set: Polach, see 'railadhesion params list'; WILAC, 'default'."
 
@@ -83,9 +83,6 @@ def export_fmu(
         resolved = resolve_parameters(model, params, parameter_set)
     except ValueError as exc:
         _fail(exc)
-    if native and model == "table":
-        _fail("the native creep-force FMU offers wilac and polach; export the table model as "
-              "the Python FMU (without --native)")
     extra = {} if friction is None else {"friction": friction}
     path = _write_fmu(build, out, model, params, parameter_set=parameter_set,
                       shear_modulus=shear_modulus, poisson=poisson, **extra)  # fmt: skip

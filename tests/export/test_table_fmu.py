@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import shutil
+import sys
 import zipfile
 from xml.etree import ElementTree as ET
 
@@ -26,6 +27,7 @@ from railadhesion.export import (  # noqa: E402
     build_native_creep_force_fmu,
     creep_force_table,
     creep_force_variables,
+    native,
 )
 from railadhesion.models import polach_parameters  # noqa: E402
 
@@ -142,8 +144,8 @@ def test_table_fmu_bad_requests_name_the_argument(tmp_path):
         build_creep_force_fmu(tmp_path / "x.fmu", "table", friction="dry")
     with pytest.raises(ValueError, match="friction"):
         build_creep_force_fmu(tmp_path / "x.fmu", "polach", friction="coulomb")
-    with pytest.raises(ValueError, match="native"):
-        build_native_creep_force_fmu(tmp_path / "x.fmu", "table")
+    with pytest.raises(ValueError, match="friction"):
+        build_native_creep_force_fmu(tmp_path / "x.fmu", "table", friction="wet")
     with pytest.raises(ValueError, match="wilac or polach"):
         creep_force_table("table")
 
@@ -154,9 +156,49 @@ def test_cli_export_fmu_model_table(tmp_path):
                                    "polach2005_wet", "--friction", "coulomb", "--out", str(out)])
     assert res.exit_code == 0, res.output
     assert out.exists() and "table" in res.output
-    res = CliRunner().invoke(app, ["export", "fmu", "--model", "table", "--native", "--out",
-                                   str(tmp_path / "n.fmu")])
-    assert res.exit_code != 0 and "native" in res.output
+    res = CliRunner().invoke(app, ["export", "fmu", "--model", "polach", "--friction",
+                                   "coulomb", "--out", str(tmp_path / "p.fmu")])
+    assert res.exit_code != 0 and "friction" in res.output
+
+
+NATIVE = pytest.mark.skipif(
+    not sys.platform.startswith("linux") or native.find_c_compiler() is None,
+    reason="native FMUs are built for linux64 with a C compiler",
+)
+
+
+@NATIVE
+@pytest.mark.filterwarnings("ignore::railadhesion.plausibility.PlausibilityWarning")
+def test_native_table_fmu_matches_direct_calls(tmp_path):
+    # the 4-D table compiled into the binary's settings (one build, ~6 s on an idle core)
+    fmu = build_native_creep_force_fmu(tmp_path / "n.fmu", "table",
+                                       parameter_set="polach2005_wet")
+    assert validate_fmu(str(fmu)) == []
+    md = read_model_description(fmu)
+    assert [v.name for v in md.modelVariables] == [v.name for v in
+                                                   creep_force_variables("table")]
+    wet = polach_parameters("polach2005_wet")
+    rng = np.random.default_rng(5)
+    slave = _Slave(fmu)
+    try:
+        for _ in range(200):
+            b = rng.uniform(3e-3, 10e-3)
+            x = {"creep_long": rng.uniform(-0.05, 0.05),
+                 "creep_lat": rng.uniform(-0.01, 0.01), "spin": rng.uniform(-1.5, 1.5),
+                 "normal_force": rng.uniform(2e4, 1.2e5), "speed": rng.uniform(0.5, 40.0),
+                 "b": b, "a": b * rng.uniform(0.2, 5.0)}
+            slave.set(**x)
+            slave.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-3)
+            np.testing.assert_allclose(slave.get(*OUTPUTS), _direct(x, wet.mu0, wet.A, wet.B),
+                                       rtol=1e-12, atol=1e-9)
+        slave.set(normal_force=0.0)
+        slave.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-3)
+        assert slave.get(*OUTPUTS) == [0.0, 0.0, 0.0, 0.0]
+        slave.set(normal_force=5e4, a=10e-3, b=1e-3)  # a/b = 10: the step fails, named
+        with pytest.raises(Exception, match="fmi2DoStep failed"):
+            slave.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-3)
+    finally:
+        slave.close()
 
 
 BRAKE_SCENARIO = """

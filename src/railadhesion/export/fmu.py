@@ -41,9 +41,11 @@ __all__ = [
     "ResolvedParameters",
     "build_creep_force_fmu",
     "build_fmu",
+    "check_friction",
     "creep_force_documentation",
     "creep_force_variables",
     "resolve_parameters",
+    "table_friction_text",
     "unit_definitions",
 ]
 
@@ -362,6 +364,25 @@ def creep_force_variables(model: str, *, shear_modulus: float = 8.2e10,
     return inputs + parameters + outputs
 
 
+def check_friction(model: str, friction: str) -> None:
+    """Raise ValueError unless ``friction`` is one of :data:`TABLE_FRICTION`, and
+    ``"falling"`` (the default) for a model other than the table model."""
+    if friction not in TABLE_FRICTION:
+        raise ValueError(f"friction must be one of {', '.join(TABLE_FRICTION)}, got "
+                         f"{friction!r}")
+    if model != "table" and friction != "falling":
+        raise ValueError("friction: only for the table model (model='table')")
+
+
+def table_friction_text(params, friction: str) -> str:
+    """The sentence of a table-model FMU's description on its friction: the Polach set
+    ``params``' μ0 (and A, B with ``friction="falling"``), not its k_A, k_S."""
+    law = (f"Coulomb friction mu0 = {params.mu0:g}" if friction == "coulomb" else
+           f"falling friction mu0 = {params.mu0:g}, A = {params.A:g}, B = {params.B:g} s/m at "
+           "the global slip velocity")
+    return f"The table model uses the set's friction only ({law}; not k_A, k_S). "
+
+
 def _check_model(model: str) -> None:
     if model not in FMU_MODELS:
         raise ValueError(f"model must be one of {', '.join(FMU_MODELS)}, got {model!r}")
@@ -568,20 +589,11 @@ def build_creep_force_fmu(
     import railadhesion
 
     resolved = resolve_parameters(model, params, parameter_set)
-    if friction not in TABLE_FRICTION:
-        raise ValueError(f"friction must be one of {', '.join(TABLE_FRICTION)}, got "
-                         f"{friction!r}")
-    if model != "table" and friction != "falling":
-        raise ValueError("friction: only for the table model (model='table')")
+    check_friction(model, friction)
     variables = creep_force_variables(model, shear_modulus=shear_modulus, poisson=poisson)
     where = f"Embedded as resources/{_PARAMETER_FILE}."
     if model == "table":
-        p = resolved.params
-        law = (f"Coulomb friction mu0 = {p.mu0:g}" if friction == "coulomb" else
-               f"falling friction mu0 = {p.mu0:g}, A = {p.A:g}, B = {p.B:g} s/m at the global "
-               "slip velocity")
-        where = (f"The table model uses the set's friction only ({law}; not k_A, k_S). "
-                 f"{where}")
+        where = table_friction_text(resolved.params, friction) + where
     description = resolved.describe(where)
     config = {
         "model": model,
