@@ -110,7 +110,8 @@ def test_available_is_the_peak():
     grid = np.geomspace(1e-4, 1.0, 2000)
     best = np.max([falling.evaluate(np.full(4, x), 25.0)[0] for x in grid], axis=0)
     peak = falling.available(25.0)
-    assert np.all(peak <= best + 1e-12) and np.all(peak > best - 2e-3)
+    # the golden-section search finds the peak between the grid's points
+    assert np.all(peak >= best - 1e-9) and np.all(peak <= best + 1e-5)
 
 
 def test_full_stop_compiled_matches_python_path():

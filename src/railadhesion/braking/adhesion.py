@@ -531,14 +531,12 @@ class ExactTableAdhesion(AxleAdhesion):
         return np.array([self.slopes(np.full(self.loads.size, x), speed)[1] for x in creeps])
 
     def available(self, speed):
-        """The largest μ per axle over the log-spaced grid of user laws (64 creepages,
-        1e-4 … 1): :func:`railadhesion.braking.curves.table_peak`, as in the compiled step."""
+        """The largest μ per axle over creepages 1e-4 … 1 (a grid, then a golden-section
+        search): :func:`railadhesion.braking.curves.table_peak`, as in the compiled step."""
         from railadhesion.braking.curves import table_peak
-        from railadhesion.braking.records import USER_GRID
 
         out = np.empty(self.loads.size)
-        table_peak(np.geomspace(1e-4, 1.0, USER_GRID), float(speed), self.loads, self.a,
-                   self.b, *self._law(), out)
+        table_peak(float(speed), self.loads, self.a, self.b, *self._law(), out)
         return out
 
     def describe(self):

@@ -60,7 +60,8 @@ from railadhesion.models.kernels import (
 
 __all__ = ["new_workspace", "build_lanes", "evaluate_lanes", "peak_lanes", "water_flow_at",
            "wilac_axle_parameters", "family_slopes", "family_slope_table", "family_peak",
-           "register_python_model", "table_axle_curve", "table_slopes", "table_peak",
+           "register_python_model", "table_axle_curve", "table_slopes", "table_axle_peak",
+           "table_peak",
            "TABLE_AUX",
            "refresh_adhesion", "evaluate_adhesion", "peak_adhesion"]
 
@@ -499,19 +500,58 @@ def table_slopes(creep, speed, loads, a, b, mu0, ratio, decay, g, nu, tab, dims,
 
 
 @njit(cache=True, error_model="numpy")
-def table_peak(grid, speed, loads, a, b, mu0, ratio, decay, g, nu, tab, dims, strides,
-               origin, inv_step, out):
-    """The adhesion available per axle: the largest μ of :func:`table_axle_curve` over the
-    creepages ``grid`` (the log-spaced grid of user laws; the law alone, without the
-    slopes), into ``out``."""
+def table_axle_peak(speed, q, a, b, mu0, ratio, decay, g, nu, tab, dims, strides, origin,
+                    inv_step):
+    """The adhesion available to one wheel: the largest μ of the table model's curve
+    (:func:`table_axle_curve`'s law, without the slopes) over creepages 1e-4 … 1, searched as
+    :func:`peak_lanes` does in full: a 17-point log-spaced grid, then a golden-section search
+    (14 steps) in log creepage between the neighbours of the best grid point (33 lookups).
+    An unloaded wheel (q = 0) has none."""
+    if q == 0.0:
+        return 0.0
     v = max(speed, 0.0)
+    best = -math.inf
+    jb = 0
+    for j in range(17):
+        m = _table_mu(10.0 ** (-4.0 + 0.25 * j), v, q, a, b, mu0, ratio, decay, g, nu, tab,
+                      dims, strides, origin, inv_step)
+        if m > best:
+            best = m
+            jb = j
+    lo = -4.0 + 0.25 * max(jb - 1, 0)
+    hi = -4.0 + 0.25 * min(jb + 1, 16)
+    x1 = hi - _GOLDEN * (hi - lo)
+    x2 = lo + _GOLDEN * (hi - lo)
+    f1 = _table_mu(10.0 ** x1, v, q, a, b, mu0, ratio, decay, g, nu, tab, dims, strides,
+                   origin, inv_step)
+    f2 = _table_mu(10.0 ** x2, v, q, a, b, mu0, ratio, decay, g, nu, tab, dims, strides,
+                   origin, inv_step)
+    for _ in range(14):
+        if f1 > f2:
+            hi = x2
+            x2 = x1
+            f2 = f1
+            x1 = hi - _GOLDEN * (hi - lo)
+            f1 = _table_mu(10.0 ** x1, v, q, a, b, mu0, ratio, decay, g, nu, tab, dims,
+                           strides, origin, inv_step)
+        else:
+            lo = x1
+            x1 = x2
+            f1 = f2
+            x2 = lo + _GOLDEN * (hi - lo)
+            f2 = _table_mu(10.0 ** x2, v, q, a, b, mu0, ratio, decay, g, nu, tab, dims,
+                           strides, origin, inv_step)
+    return max(best, f1, f2)
+
+
+@njit(cache=True, error_model="numpy")
+def table_peak(speed, loads, a, b, mu0, ratio, decay, g, nu, tab, dims, strides, origin,
+               inv_step, out):
+    """:func:`table_axle_peak` of every axle (arrays over axles ``loads``, ``a``, ``b``)
+    into ``out``."""
     for i in range(loads.shape[0]):
-        best = -math.inf
-        for j in range(grid.shape[0]):
-            m = _table_mu(grid[j], v, loads[i], a[i], b[i], mu0, ratio, decay, g, nu, tab, dims,
-                          strides, origin, inv_step) if loads[i] != 0.0 else 0.0
-            best = max(best, m)
-        out[i] = best
+        out[i] = table_axle_peak(speed, loads[i], a[i], b[i], mu0, ratio, decay, g, nu, tab,
+                                 dims, strides, origin, inv_step)
 
 
 @njit(cache=True, error_model="numpy")
@@ -540,18 +580,11 @@ def _table_evaluate(s, st, tables, speed):
 def _table_peak(s, st, tables, speed):
     c = s.curve
     tab = tables[st.table_at:st.table_at + st.table_count]
-    grid = tables[st.grid_at:st.grid_at + st.grid_count]
-    v = max(speed, 0.0)
     for i in range(st.n_axles):
-        best = -math.inf
-        q = s.wheel_load[i]
-        for j in range(grid.size):
-            m = _table_mu(grid[j], v, q, s.params[i, 0, 0], s.params[i, 0, 1], st.table_mu,
-                          st.table_ratio, st.table_decay, st.table_shear_modulus,
-                          st.table_poisson, tab, st.table_dims, st.table_strides,
-                          st.table_origin, st.table_inv_step) if q != 0.0 else 0.0
-            best = max(best, m)
-        c.available[i] = best
+        c.available[i] = table_axle_peak(
+            speed, s.wheel_load[i], s.params[i, 0, 0], s.params[i, 0, 1], st.table_mu,
+            st.table_ratio, st.table_decay, st.table_shear_modulus, st.table_poisson, tab,
+            st.table_dims, st.table_strides, st.table_origin, st.table_inv_step)
 
 
 # ---------------------------------------------------------------------------------------------

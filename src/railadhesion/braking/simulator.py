@@ -612,9 +612,6 @@ class BrakingSimulator:
             st["table_a0"], st["table_b0"] = a.contact.a0, a.contact.b0
             st["table_shear_modulus"] = a.contact.shear_modulus
             st["table_poisson"] = a.contact.poisson
-            grid = np.geomspace(1e-4, 1.0, USER_GRID)
-            table("grid", grid)
-            st["grid_count"] = grid.size
             entries = entries[:4] + (step.advance_table, step.advance_table_recorded)
         else:
             model, aux = PYTHON, None
