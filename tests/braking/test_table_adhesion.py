@@ -255,3 +255,23 @@ def test_table_and_polach_agree_in_full_sliding():
     a = table.evaluate(np.ones(4), 20.0)[0]
     b = polach.evaluate(np.ones(4), 20.0)[0]
     np.testing.assert_allclose(a, b, rtol=0.02)
+
+
+def test_stepping_api_compiled_matches_python_path():
+    # the buffer entry points of the TABLE family (advance_table) against the Python path
+    def run(compiled):
+        sim = BrakingSimulator(VEHICLE, ExactTableAdhesion(0.1, 0.4, 0.6), 10.0,
+                               compiled=compiled, record=False)
+        for k in range(300):
+            valves = [0, 0, 0, 0] if (k // 100) % 2 == 0 else [2, 1, 0, 2]
+            state = sim.step(2e-3, {"pressure_command": [6e5, 6e5, 5e5, 5e5],
+                                    "valves": valves})
+        return sim, state
+
+    (fast, a), (slow, b) = run(True), run(False)
+    assert fast.runs_compiled and not slow.runs_compiled
+    np.testing.assert_allclose(a.wheel_speeds, b.wheel_speeds, rtol=1e-10)
+    assert a.distance == pytest.approx(b.distance, rel=1e-12)
+    assert max(a.creep) > 0.01  # the wheels slide
+    np.testing.assert_allclose(fast.adhesion_available(), slow.adhesion_available(),
+                               rtol=1e-12)
