@@ -457,7 +457,8 @@ def table_axle_curve(creep, speed, q, a, b, mu0, ratio, decay, g, nu, tab, dims,
     :func:`railadhesion.contact.table.exact_table_arrays` gives it.
 
     μ is the law at |ξ| with the sign of ξ (odd, 0 at ξ = 0); dμ/dξ a central difference
-    (step 1e-9 + 1e-5 |ξ|, across ξ = 0 where the law is odd and smooth), dμ/dV a forward
+    (step 1e-9 + 1e-5 |ξ|; across ξ = 0, where the law is odd, its slope is continuous and,
+    with falling friction, its curvature jumps: error below 1e-5 relative), dμ/dV a forward
     difference (step 1e-6 of the speed, at least 1e-6 m/s; 0 for Coulomb friction). An
     unloaded wheel (q = 0) has no adhesion: (0, 0, 0)."""
     if q == 0.0:
