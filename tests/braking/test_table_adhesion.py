@@ -275,3 +275,48 @@ def test_stepping_api_compiled_matches_python_path():
     assert max(a.creep) > 0.01  # the wheels slide
     np.testing.assert_allclose(fast.adhesion_available(), slow.adhesion_available(),
                                rtol=1e-12)
+
+
+PROGRAMME = """
+format = "railadhesion-wsp-programme"
+version = 1
+name = "table"
+[defaults]
+initial_speed_m_s = 8.0
+time_step_s = 0.001
+[[case]]
+name = "t"
+adhesion = {adhesion}
+"""
+
+
+def test_wsp_bench_case_with_the_table_model(tmp_path):
+    from railadhesion.braking import load_wsp_programme, run_wsp_programme
+
+    path = tmp_path / "p.toml"
+    path.write_text(PROGRAMME.format(adhesion='{ model = "table", mu0 = 0.05, A = 0.5, '
+                                              'B = 0.6 }'))
+    case = load_wsp_programme(path).cases[0]
+    assert case.adhesion.describe() == "table model mu0=0.05 A=0.5 B=0.6"
+    model = case.adhesion.build()
+    assert isinstance(model, ExactTableAdhesion)
+    assert (model.mu, model.friction_ratio, model.friction_decay) == (0.05, 0.5, 0.6)
+    res = run_wsp_programme(path)
+    assert res.cases[0]["status"] == "ok"
+    assert res.cases[0]["stopping_distance_m"] > res.cases[0]["dry_stopping_distance_m"]
+
+
+@pytest.mark.parametrize(("adhesion", "field"), [
+    ('{ model = "table", mu0 = 0.05, k_A = 0.5 }', "adhesion.k_A"),
+    ('{ model = "table", mu0 = 0.05, start_m = 1.0, end_m = 9.0 }', "adhesion.start_m"),
+    ('{ model = "table", parameters = "polach2005_wet", mu0 = 0.05 }', "adhesion.mu0"),
+    ('{ model = "table", A = 0.5 }', "adhesion.mu0"),
+    ('{ model = "table", mu0 = 0.05, A = 1.5 }', "adhesion.A"),
+])
+def test_wsp_bench_table_case_errors_name_the_field(tmp_path, adhesion, field):
+    from railadhesion.braking import BrakingFileError, load_wsp_programme
+
+    path = tmp_path / "p.toml"
+    path.write_text(PROGRAMME.format(adhesion=adhesion))
+    with pytest.raises(BrakingFileError, match=field):
+        load_wsp_programme(path)
