@@ -19,6 +19,8 @@ export_app = typer.Typer(
 console = Console()
 
 _MODEL_HELP = "Creep-force model: wilac or polach."
+_FMU_MODEL_HELP = ("Creep-force model: wilac, polach, or table (the table model of Kalker's exact "
+                   "theory, with the friction of a Polach set).")
 _PARAMS_HELP = "Parameter file (TOML, docs/parameter-files.md); embedded in the export."
 _SET_HELP = "Named parameter set: Polach, see 'railadhesion params list'; WILAC, 'default'."
 _NATIVE_HELP = (
@@ -58,13 +60,17 @@ def _creep_percent(text: str | None, name: str):
 
 @export_app.command("fmu")
 def export_fmu(
-    model: str = typer.Option("wilac", help=_MODEL_HELP),
+    model: str = typer.Option("wilac", help=_FMU_MODEL_HELP),
     params: Path | None = typer.Option(None, "--params", help=_PARAMS_HELP),
     parameter_set: str | None = typer.Option(None, "--set", help=_SET_HELP),
     out: Path = typer.Option(Path("creepforce.fmu"), help="The FMU file to write (.fmu)."),
     shear_modulus: float = typer.Option(8.2e10, help="Start value of parameter G [Pa]."),
     poisson: float = typer.Option(0.28, help="Start value of Poisson's ratio [-]."),
     native: bool | None = typer.Option(None, "--native/--python", help=_NATIVE_HELP),
+    friction: str | None = typer.Option(
+        None, help="Table model: 'falling' (the set's mu0, A, B; default) or 'coulomb' (its "
+                   "mu0).",
+    ),  # fmt: skip
 ) -> None:
     """Write an FMI 2.0 co-simulation FMU of a creep-force law: native by default (no Python
     on the host), --python for the Python FMU (pythonfmu)."""
@@ -85,9 +91,11 @@ def export_fmu(
             _fail(f"--native: {served}; export the {model} model as the Python FMU (--python)")
         console.print(f"{served}: writing the {model} model as the Python FMU")
         native = False
+    extra = {} if friction is None else {"friction": friction}
     path, native = _write_either(native, build_native_creep_force_fmu, build_creep_force_fmu,
                                  out, model, params, parameter_set=parameter_set,
-                                 shear_modulus=shear_modulus, poisson=poisson)  # fmt: skip
+                                 shear_modulus=shear_modulus, poisson=poisson,
+                                 **extra)  # fmt: skip
     console.print(escape(f"{model}: {resolved.summary()}"))
     _say_kind(native)
     _check_fmu(path, required=False)

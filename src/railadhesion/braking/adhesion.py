@@ -23,6 +23,9 @@ Shipped models:
 * :class:`WilacAdhesion` — WILAC (Trummer et al. 2017) with a water flow rate [µl/s] profile
   over distance or time (:class:`WaterFlowProfile`), optional adhesion recovery along the
   train.
+* :class:`ExactTableAdhesion` — the table model of Kalker's exact theory
+  (:func:`railadhesion.contact.exact_table_forces`) at each axle's Hertz contact, with
+  Coulomb or Polach-type falling friction (μ0, A, B); compiled in the braking step.
 * :class:`CallableAdhesion` — a user function ``mu(creep, speed)`` (e.g. a Fletcher-type
   2D curve or a measured table); a numba ``@njit`` one runs compiled.
 
@@ -55,6 +58,7 @@ __all__ = [
     "AxleAdhesion",
     "PolachAdhesion",
     "WilacAdhesion",
+    "ExactTableAdhesion",
     "CallableAdhesion",
     "WaterFlowProfile",
     "AdhesionRecovery",
@@ -400,6 +404,144 @@ class WilacAdhesion(_PolachFamily):
     def describe(self):
         return {"model": "wilac", "parameters": self.parameters.name,
                 "recovery": None if self.recovery is None else self.recovery.energy_scale}
+
+
+def _real(value, name, low, high, low_open=False):
+    """``value`` as a float in its range (ValueError naming ``name`` otherwise)."""
+    ok = isinstance(value, int | float) and not isinstance(value, bool)
+    v = float(value) if ok else math.nan
+    if not (ok and math.isfinite(v) and (v > low if low_open else v >= low) and v <= high):
+        lo = "(" if low_open else "["
+        raise ValueError(f"{name} must be a number in {lo}{low}, {high}], got {value!r}")
+    return v
+
+
+class ExactTableAdhesion(AxleAdhesion):
+    """The table model of Kalker's exact theory as each axle's creep-force law.
+
+    Each wheel's adhesion is ``μ(ξ) = −Fx/Q`` of :func:`railadhesion.contact.exact_table_forces`
+    (Kalker 1990, chapter 5, tabulated) at pure longitudinal creepage ξ, no lateral creepage
+    and no spin, at the wheel's Hertz contact (:class:`ContactGeometry`: semi-axes at its
+    reference load scaled with ``(Q/Q_ref)^(1/3)``, its G and ν), with Coulomb friction
+    μ0 or Polach's falling friction ``μ0 [(1 − A) exp(−B V|ξ|) + A]`` (the table's one
+    coefficient per contact at the global slip velocity V|ξ|). The law runs compiled in the
+    braking step (:func:`railadhesion.contact.exact_table_law` through
+    :func:`railadhesion.braking.curves.table_axle_curve`); dμ/dξ and dμ/dV are differences
+    of it. Unlike Polach's model there is no reduction of the initial slope (Polach's k_A,
+    k_S): the curve is the exact theory's; a lower stiffness can be given with the
+    contact's ``shear_modulus``.
+
+    Parameters
+    ----------
+    mu : float
+        Coefficient of friction μ0 [-] (Coulomb's, or the static one of the falling law),
+        in (0, 2].
+    friction_ratio : float
+        A = μ∞/μ0 of the falling friction, in [0, 1] (1: Coulomb friction).
+    friction_decay : float
+        B [s/m] of the falling friction, in [0, 100] (0: Coulomb friction).
+    contact : ContactGeometry, optional
+        Contact geometry (default: Hertz for the vehicle's wheel radius on a 0.3 m rail
+        crown); its a/b must be in [0.2, 5] and its Poisson's ratio in [0.25, 0.30], the
+        table's range.
+    """
+
+    name = "table"
+
+    def __init__(self, mu: float = 0.3, friction_ratio: float = 1.0,
+                 friction_decay: float = 0.0, contact: ContactGeometry | None = None):
+        self.mu = _real(mu, "mu", 0.0, 2.0, low_open=True)
+        self.friction_ratio = _real(friction_ratio, "friction_ratio", 0.0, 1.0)
+        self.friction_decay = _real(friction_decay, "friction_decay", 0.0, 100.0)
+        if contact is not None and not isinstance(contact, ContactGeometry):
+            raise ValueError(f"contact must be a ContactGeometry, got {type(contact).__name__}")
+        self.contact = contact
+        self.arrays = None
+        self.loads = self.a = self.b = None
+        if contact is not None:
+            self._check_contact()
+
+    @classmethod
+    def from_polach(cls, parameters="polach2005_dry", contact=None) -> ExactTableAdhesion:
+        """The table model with the friction of a Polach set (its μ0, A, B; its k_A, k_S,
+        which reduce Polach's initial slope, have no counterpart here)."""
+        p = _as_polach(parameters)
+        return cls(p.mu0, p.A, p.B, contact)
+
+    def _check_contact(self):
+        from railadhesion.contact.table import exact_table_arrays
+
+        c = self.contact
+        if not 0.25 <= c.poisson <= 0.30:
+            raise ValueError(f"contact.poisson must be in [0.25, 0.3] for the table model, got "
+                             f"{c.poisson!r}")
+        aob = c.a0 / c.b0
+        if not 0.2 <= aob <= 5.0:
+            raise ValueError(f"contact a/b must be in [0.2, 5] for the table model, got "
+                             f"{aob:.4g} (semi-axes {c.a0:.4g} m, {c.b0:.4g} m)")
+        self.arrays = exact_table_arrays(aob)
+
+    def bind(self, n_axles, wheel_radius):
+        from railadhesion.braking.records import MAX_AXLES
+
+        if n_axles > MAX_AXLES:
+            raise ValueError(f"n_axles must be at most {MAX_AXLES}, got {n_axles}")
+        super().bind(n_axles, wheel_radius)
+        if self.contact is None:
+            self.contact = ContactGeometry(wheel_radius=wheel_radius)
+            self._check_contact()
+
+    def prepare(self, speed, normal_loads, positions, time, dissipation=None):
+        loads = np.ascontiguousarray(np.broadcast_to(np.asarray(normal_loads, float),
+                                                     (self.n_axles,)))
+        a, b = self.contact.semi_axes(loads)
+        self.loads = loads
+        self.a = np.ascontiguousarray(a, dtype=float)
+        self.b = np.ascontiguousarray(b, dtype=float)
+
+    def _law(self):
+        c = self.contact
+        return (self.mu, self.friction_ratio, self.friction_decay, c.shear_modulus, c.poisson,
+                *self.arrays)
+
+    def slopes(self, creep, speed):
+        """μ, dμ/dξ and dμ/dV per axle at the creepages ``creep`` (one per axle):
+        :func:`railadhesion.braking.curves.table_slopes`, as in the compiled step."""
+        from railadhesion.braking.curves import table_slopes
+
+        creep = np.ascontiguousarray(creep, dtype=float)
+        if self.loads is None:
+            raise RuntimeError("prepare() must be called before slopes()")
+        if creep.shape != self.loads.shape:
+            raise ValueError(f"creep must have one value per axle ({self.loads.size}), got "
+                             f"shape {creep.shape}")
+        mu, dmu, dmv = np.empty(creep.size), np.empty(creep.size), np.empty(creep.size)
+        table_slopes(creep, float(speed), self.loads, self.a, self.b, *self._law(), mu, dmu,
+                     dmv)
+        return mu, dmu, dmv
+
+    def evaluate(self, creep, speed):
+        mu, dmu, _ = self.slopes(creep, speed)
+        return mu, dmu
+
+    def slope_table(self, creeps, speed):
+        """dμ/dξ of every axle (columns) at each of ``creeps`` (rows), at the prepared
+        conditions."""
+        creeps = np.asarray(creeps, float).ravel()
+        return np.array([self.slopes(np.full(self.loads.size, x), speed)[1] for x in creeps])
+
+    def available(self, speed):
+        """The largest μ per axle over creepages 1e-4 … 1 (a grid, then a golden-section
+        search): :func:`railadhesion.braking.curves.table_peak`, as in the compiled step."""
+        from railadhesion.braking.curves import table_peak
+
+        out = np.empty(self.loads.size)
+        table_peak(float(speed), self.loads, self.a, self.b, *self._law(), out)
+        return out
+
+    def describe(self):
+        return {"model": "table", "mu": self.mu, "friction_ratio": self.friction_ratio,
+                "friction_decay": self.friction_decay}
 
 
 class CallableAdhesion(AxleAdhesion):

@@ -48,6 +48,7 @@ from railadhesion.braking._fields import (
 )
 from railadhesion.braking.adhesion import (
     AxleAdhesion,
+    ExactTableAdhesion,
     PolachAdhesion,
     WaterFlowProfile,
     WilacAdhesion,
@@ -113,7 +114,10 @@ class WSPControllerError(ValueError):
 class AdhesionCase:
     """The rail of a case: Polach (a named set, or ``mu0``/``A``/``B``/``k_A``/``k_S``) or WILAC
     (a water flow), on the whole track or on a section ``[start, end)`` [m] with a dry rail
-    outside (``polach2005_dry`` for Polach, 0 µl/s for WILAC)."""
+    outside (``polach2005_dry`` for Polach, 0 µl/s for WILAC); or the table model of Kalker's
+    exact theory (:class:`~railadhesion.braking.adhesion.ExactTableAdhesion`) with the
+    friction μ0, A, B of ``parameters``, on the whole track (dry: the friction of
+    ``polach2005_dry``)."""
 
     model: str
     parameters: PolachParameters | None = None
@@ -121,6 +125,8 @@ class AdhesionCase:
     section: tuple[float, float] | None = None
 
     def build(self) -> AxleAdhesion:
+        if self.model == "table":
+            return ExactTableAdhesion.from_polach(self.parameters)
         if self.model == "polach":
             if self.section is None:
                 return PolachAdhesion(self.parameters)
@@ -130,6 +136,8 @@ class AdhesionCase:
         return WilacAdhesion(WaterFlowProfile.sections([(*self.section, self.water_flow)]))
 
     def build_dry(self) -> AxleAdhesion:
+        if self.model == "table":
+            return ExactTableAdhesion.from_polach("polach2005_dry")
         if self.model == "polach":
             return PolachAdhesion("polach2005_dry")
         return WilacAdhesion(WaterFlowProfile.constant(0.0))
@@ -139,6 +147,8 @@ class AdhesionCase:
         if self.model == "wilac":
             return f"WILAC {self.water_flow:g} µl/s{where}"
         p = self.parameters
+        if self.model == "table":
+            return f"table model mu0={p.mu0:g} A={p.A:g} B={p.B:g}"
         return (f"Polach mu0={p.mu0:g} A={p.A:g} B={p.B:g} k_A={p.k_A:g} k_S={p.k_S:g}"
                 f"{where}")
 
@@ -282,11 +292,34 @@ def _adhesion_case(tab, where) -> AdhesionCase:
             params = PolachParameters(k_A=k_a, k_S=k_s, mu0=mu0, A=a, B=b, name="case",
                                       source="WSP programme case")
         return AdhesionCase("polach", params, 0.0, section)
+    if model == "table":
+        keys(tab, where, ("model",), ("parameters", "mu0", "A", "B"))
+        if "parameters" in tab:
+            for k in ("mu0", "A", "B"):
+                if k in tab:
+                    raise FieldError(f"{where}.{k}", "give either parameters (a named Polach "
+                                     "set: its mu0, A, B) or the values mu0, A, B")
+            name = string(tab["parameters"], f"{where}.parameters")
+            if name not in POLACH_PARAMETER_SETS:
+                raise FieldError(f"{where}.parameters", f"unknown Polach set {name!r}; known: "
+                                 f"{', '.join(sorted(POLACH_PARAMETER_SETS))}")
+            params = POLACH_PARAMETER_SETS[name]
+        else:
+            if "mu0" not in tab:
+                raise FieldError(f"{where}.mu0", "required for model = 'table' (or give "
+                                 "parameters = a named Polach set)")
+            params = PolachParameters(  # k_A, k_S: not used by the table model
+                k_A=1.0, k_S=1.0,
+                mu0=number(tab["mu0"], f"{where}.mu0", 0.0, 1.5, low_open=True),
+                A=number(tab.get("A", 1.0), f"{where}.A", 0.0, 1.0),
+                B=number(tab.get("B", 0.0), f"{where}.B", 0.0, 100.0),
+                name="case", source="WSP programme case")  # fmt: skip
+        return AdhesionCase("table", params, 0.0, None)
     if model == "wilac":
         keys(tab, where, ("model", "water_flow_ul_s"), ("start_m", "end_m"))
         w = number(tab["water_flow_ul_s"], f"{where}.water_flow_ul_s", 0.0, 1e4)
         return AdhesionCase("wilac", None, w, section)
-    raise FieldError(f"{where}.model", f"must be 'polach' or 'wilac', got {model!r}")
+    raise FieldError(f"{where}.model", f"must be 'polach', 'wilac' or 'table', got {model!r}")
 
 
 def _programme_from_document(doc, base: Path) -> WSPProgramme:

@@ -23,9 +23,13 @@ three functions chosen when the step is compiled by the type of its ``aux`` argu
   compiled as a C callback): its slopes by the differences of
   :class:`~railadhesion.braking.adhesion.CallableAdhesion`;
 * ``None``: any :class:`~railadhesion.braking.adhesion.AxleAdhesion` in Python, called back
-  through numba's ``objmode`` (its ``prepare``, ``slopes`` and ``available`` methods).
+  through numba's ``objmode`` (its ``prepare``, ``slopes`` and ``available`` methods);
+* a float (:data:`TABLE_AUX`): the table model of Kalker's exact theory
+  (:class:`~railadhesion.braking.adhesion.ExactTableAdhesion`): each axle's curve is
+  :func:`railadhesion.contact.table.exact_table_law` at its Hertz contact
+  (:func:`table_axle_curve`), the table and the law's constants in the settings and tables.
 
-The first two compile to code with no Python in it (a C host can run them); only the
+The first two and the last compile to code with no Python in it (a C host can run them); only the
 third calls the interpreter.
 """
 
@@ -45,7 +49,9 @@ from railadhesion.braking.records import (
     PEAK_FULL_EVERY,
     PEAK_WINDOW,
     POLACH,
+    TABLE,
 )
+from railadhesion.contact.table import exact_table_law
 from railadhesion.models.kernels import (
     polach_longitudinal,
     wilac_condition_parameters,
@@ -54,7 +60,9 @@ from railadhesion.models.kernels import (
 
 __all__ = ["new_workspace", "build_lanes", "evaluate_lanes", "peak_lanes", "water_flow_at",
            "wilac_axle_parameters", "family_slopes", "family_slope_table", "family_peak",
-           "register_python_model",
+           "register_python_model", "table_axle_curve", "table_slopes", "table_axle_peak",
+           "table_peak",
+           "TABLE_AUX",
            "refresh_adhesion", "evaluate_adhesion", "peak_adhesion"]
 
 _GOLDEN = 0.6180339887498949
@@ -422,6 +430,165 @@ def _user_peak(s, st, tables, fn, speed):
 
 
 # ---------------------------------------------------------------------------------------------
+# the table model of Kalker's exact theory
+
+#: ``aux`` of the table model's family (its type, a float, selects it; the value is unused).
+TABLE_AUX = float(TABLE)
+
+
+@njit(cache=True, error_model="numpy")
+def _table_mu(s, speed, q, a, b, mu0, ratio, decay, g, nu, tab, dims, strides, origin,
+              inv_step):
+    """μ = −Fx/Q of :func:`railadhesion.contact.table.exact_table_law` at longitudinal
+    creepage ``s`` (no lateral creep, no spin): the braking adhesion of a wheel of load Q."""
+    fx = exact_table_law(s, 0.0, 0.0, q, a, b, mu0, g, nu, speed, ratio, decay, tab, dims,
+                         strides, origin, inv_step)[0]
+    return -fx / q
+
+
+@njit(cache=True, error_model="numpy")
+def table_axle_curve(creep, speed, q, a, b, mu0, ratio, decay, g, nu, tab, dims, strides,
+                     origin, inv_step):
+    """μ, dμ/dξ, dμ/dV of one wheel by the table model of Kalker's exact theory
+    (:func:`railadhesion.contact.table.exact_table_law`, Kalker 1990 ch. 5 tabulated):
+    pure longitudinal creepage ``creep`` (braking: ξ > 0 gives μ > 0), train speed [m/s]
+    (the falling friction's slip velocity is V|ξ|), wheel load ``q`` [N], Hertz semi-axes
+    ``a``, ``b`` [m], friction μ0, A, B [s/m], G [Pa], ν; the table as
+    :func:`railadhesion.contact.table.exact_table_arrays` gives it.
+
+    μ is the law at |ξ| with the sign of ξ (odd, 0 at ξ = 0); dμ/dξ a central difference
+    (step 1e-9 + 1e-5 |ξ|; across ξ = 0, where the law is odd, its slope is continuous and,
+    with falling friction, its curvature jumps: error below 1e-5 relative), dμ/dV a forward
+    difference (step 1e-6 of the speed, at least 1e-6 m/s; 0 for Coulomb friction). An
+    unloaded wheel (q = 0) has no adhesion: (0, 0, 0)."""
+    if q == 0.0:
+        return 0.0, 0.0, 0.0
+    v = max(speed, 0.0)
+    x = abs(creep)
+    m = _table_mu(x, v, q, a, b, mu0, ratio, decay, g, nu, tab, dims, strides, origin,
+                  inv_step)
+    h = 1e-9 + 1e-5 * x
+    hi = _table_mu(x + h, v, q, a, b, mu0, ratio, decay, g, nu, tab, dims, strides, origin,
+                   inv_step)
+    lo = _table_mu(x - h, v, q, a, b, mu0, ratio, decay, g, nu, tab, dims, strides, origin,
+                   inv_step)
+    dmu = (hi - lo) / (2.0 * h)
+    dmv = 0.0
+    if ratio != 1.0 and decay != 0.0:
+        hv = 1e-6 * max(v, 1.0)
+        dmv = (_table_mu(x, v + hv, q, a, b, mu0, ratio, decay, g, nu, tab, dims, strides,
+                         origin, inv_step) - m) / hv
+    if creep > 0.0:
+        sign = 1.0
+    elif creep < 0.0:
+        sign = -1.0
+    elif creep == 0.0:
+        sign = 0.0
+    else:
+        sign = math.nan
+    return sign * m, dmu, sign * dmv
+
+
+@njit(cache=True, error_model="numpy")
+def table_slopes(creep, speed, loads, a, b, mu0, ratio, decay, g, nu, tab, dims, strides,
+                 origin, inv_step, mu, dmu, dmv):
+    """:func:`table_axle_curve` of every axle (arrays over axles ``creep``, ``loads``, ``a``,
+    ``b``) into ``mu``, ``dmu``, ``dmv``."""
+    for i in range(creep.shape[0]):
+        mu[i], dmu[i], dmv[i] = table_axle_curve(creep[i], speed, loads[i], a[i], b[i], mu0,
+                                                 ratio, decay, g, nu, tab, dims, strides,
+                                                 origin, inv_step)
+
+
+@njit(cache=True, error_model="numpy")
+def table_axle_peak(speed, q, a, b, mu0, ratio, decay, g, nu, tab, dims, strides, origin,
+                    inv_step):
+    """The adhesion available to one wheel: the largest μ of the table model's curve
+    (:func:`table_axle_curve`'s law, without the slopes) over creepages 1e-4 … 1, searched as
+    :func:`peak_lanes` does in full: a 17-point log-spaced grid, then a golden-section search
+    (14 steps) in log creepage between the neighbours of the best grid point (33 lookups).
+    An unloaded wheel (q = 0) has none."""
+    if q == 0.0:
+        return 0.0
+    v = max(speed, 0.0)
+    best = -math.inf
+    jb = 0
+    for j in range(17):
+        m = _table_mu(10.0 ** (-4.0 + 0.25 * j), v, q, a, b, mu0, ratio, decay, g, nu, tab,
+                      dims, strides, origin, inv_step)
+        if m > best:
+            best = m
+            jb = j
+    lo = -4.0 + 0.25 * max(jb - 1, 0)
+    hi = -4.0 + 0.25 * min(jb + 1, 16)
+    x1 = hi - _GOLDEN * (hi - lo)
+    x2 = lo + _GOLDEN * (hi - lo)
+    f1 = _table_mu(10.0 ** x1, v, q, a, b, mu0, ratio, decay, g, nu, tab, dims, strides,
+                   origin, inv_step)
+    f2 = _table_mu(10.0 ** x2, v, q, a, b, mu0, ratio, decay, g, nu, tab, dims, strides,
+                   origin, inv_step)
+    for _ in range(14):
+        if f1 > f2:
+            hi = x2
+            x2 = x1
+            f2 = f1
+            x1 = hi - _GOLDEN * (hi - lo)
+            f1 = _table_mu(10.0 ** x1, v, q, a, b, mu0, ratio, decay, g, nu, tab, dims,
+                           strides, origin, inv_step)
+        else:
+            lo = x1
+            x1 = x2
+            f1 = f2
+            x2 = lo + _GOLDEN * (hi - lo)
+            f2 = _table_mu(10.0 ** x2, v, q, a, b, mu0, ratio, decay, g, nu, tab, dims,
+                           strides, origin, inv_step)
+    return max(best, f1, f2)
+
+
+@njit(cache=True, error_model="numpy")
+def table_peak(speed, loads, a, b, mu0, ratio, decay, g, nu, tab, dims, strides, origin,
+               inv_step, out):
+    """:func:`table_axle_peak` of every axle (arrays over axles ``loads``, ``a``, ``b``)
+    into ``out``."""
+    for i in range(loads.shape[0]):
+        out[i] = table_axle_peak(speed, loads[i], a[i], b[i], mu0, ratio, decay, g, nu, tab,
+                                 dims, strides, origin, inv_step)
+
+
+@njit(cache=True, error_model="numpy")
+def _table_refresh(s, st):
+    """Hertz semi-axes of every axle at its wheel load (a, b ∝ Q^(1/3)), into
+    ``s.params[i, 0, 0:2]``."""
+    for i in range(st.n_axles):
+        f = (s.wheel_load[i] / st.contact_reference_load) ** (1.0 / 3.0)
+        s.params[i, 0, 0] = st.table_a0 * f
+        s.params[i, 0, 1] = st.table_b0 * f
+
+
+@njit(cache=True, error_model="numpy")
+def _table_evaluate(s, st, tables, speed):
+    c = s.curve
+    tab = tables[st.table_at:st.table_at + st.table_count]
+    for i in range(st.n_axles):
+        c.mu[i], c.dmu[i], c.dmv[i] = table_axle_curve(
+            c.creep[i], speed, s.wheel_load[i], s.params[i, 0, 0], s.params[i, 0, 1],
+            st.table_mu, st.table_ratio, st.table_decay, st.table_shear_modulus,
+            st.table_poisson, tab, st.table_dims, st.table_strides, st.table_origin,
+            st.table_inv_step)
+
+
+@njit(cache=True, error_model="numpy")
+def _table_peak(s, st, tables, speed):
+    c = s.curve
+    tab = tables[st.table_at:st.table_at + st.table_count]
+    for i in range(st.n_axles):
+        c.available[i] = table_axle_peak(
+            speed, s.wheel_load[i], s.params[i, 0, 0], s.params[i, 0, 1], st.table_mu,
+            st.table_ratio, st.table_decay, st.table_shear_modulus, st.table_poisson, tab,
+            st.table_dims, st.table_strides, st.table_origin, st.table_inv_step)
+
+
+# ---------------------------------------------------------------------------------------------
 # any model in Python (objmode call-backs)
 
 _PYTHON_MODELS: dict[int, object] = {}
@@ -512,6 +679,8 @@ def peak_adhesion(s, st, tables, aux, speed):
 def _family(aux):
     if isinstance(aux, types.Integer):
         return "builtin"
+    if isinstance(aux, types.Float):
+        return "table"
     if isinstance(aux, types.NoneType):
         return "python"
     return "user"
@@ -524,6 +693,8 @@ def _refresh_adhesion(s, st, tables, aux):
         return lambda s, st, tables, aux: _builtin_refresh(s, st, tables)
     if family == "python":
         return lambda s, st, tables, aux: _python_refresh(s, st)
+    if family == "table":
+        return lambda s, st, tables, aux: _table_refresh(s, st)
     return lambda s, st, tables, aux: None  # a user law needs only the wheel loads
 
 
@@ -534,6 +705,8 @@ def _evaluate_adhesion(s, st, tables, aux, speed):
         return lambda s, st, tables, aux, speed: evaluate_lanes(s.curve, st.n_axles, speed)
     if family == "python":
         return lambda s, st, tables, aux, speed: _python_evaluate(s, st, speed)
+    if family == "table":
+        return lambda s, st, tables, aux, speed: _table_evaluate(s, st, tables, speed)
     return lambda s, st, tables, aux, speed: _user_evaluate(s, st, aux, speed)
 
 
@@ -544,6 +717,8 @@ def _peak_adhesion(s, st, tables, aux, speed):
         return lambda s, st, tables, aux, speed: peak_lanes(s.curve, st.n_axles, speed)
     if family == "python":
         return lambda s, st, tables, aux, speed: _python_peak(s, st, speed)
+    if family == "table":
+        return lambda s, st, tables, aux, speed: _table_peak(s, st, tables, speed)
     return lambda s, st, tables, aux, speed: _user_peak(s, st, tables, aux, speed)
 
 

@@ -20,7 +20,8 @@ which the first ``settings.n_axles`` are used.
     sensor_state     (1,) record of the sensor model
 
 Variable-length constant tables (Polach sets, track sections, the water-flow profile, the
-packed WILAC set, the search grid of user laws) live in one float64 array ``tables``; the
+packed WILAC set, the search grid of user laws, the table model's slice at the contact's
+a/b) live in one float64 array ``tables``; the
 settings name where each starts (``*_at``) and how many values it has (``*_count``).
 """
 
@@ -33,7 +34,7 @@ __all__ = [
     "INPUTS",
     "machine_dtype", "history_columns", "OK", "STOPPED", "NONFINITE", "BAD_DT",
     "BAD_COMMAND", "BAD_VALVE", "ROWS_FULL", "BAD_TORQUE", "STALE", "POLACH", "WILAC", "USER",
-    "PYTHON",
+    "PYTHON", "TABLE",
     "NEWTON_MAX", "USER_GRID", "PEAK_FULL_EVERY", "PEAK_WINDOW",
 ]
 
@@ -50,8 +51,9 @@ LANE_BLOCK = 8
 # status codes returned by the step (STALE: compiled for another layout, see machine_dtype)
 OK, STOPPED, NONFINITE, BAD_DT, BAD_COMMAND, BAD_VALVE, ROWS_FULL, BAD_TORQUE, STALE = range(9)
 # adhesion models the step evaluates: Polach sets on track sections, WILAC with a water-flow
-# profile, a user's compiled law mu(creep, speed, wheel load), or any model in Python
-POLACH, WILAC, USER, PYTHON = range(4)
+# profile, a user's compiled law mu(creep, speed, wheel load), any model in Python, or the
+# table model of Kalker's exact theory (railadhesion.contact.table)
+POLACH, WILAC, USER, PYTHON, TABLE = range(5)
 
 #: Newton iterations before the safeguarded solve takes over.
 NEWTON_MAX = 8
@@ -142,6 +144,13 @@ SETTINGS = _record([
     ("sections_at", "i8"), ("sections_count", "i8"), ("profile_at", "i8"),
     ("profile_count", "i8"), ("wilac_at", "i8"), ("wilac_count", "i8"), ("grid_at", "i8"),
     ("grid_count", "i8"), ("python_key", "i8"),
+    # the table model (TABLE): its friction law (mu0, A, B), the Hertz semi-axes at the
+    # contact's reference load, G, nu; the table as exact_table_law takes it (its values in
+    # the tables at table_at, table_count of them)
+    ("table_mu", "f8"), ("table_ratio", "f8"), ("table_decay", "f8"), ("table_a0", "f8"),
+    ("table_b0", "f8"), ("table_shear_modulus", "f8"), ("table_poisson", "f8"),
+    ("table_at", "i8"), ("table_count", "i8"), ("table_dims", "i8", (4,)),
+    ("table_strides", "i8", (4,)), ("table_origin", "f8", (4,)), ("table_inv_step", "f8", (4,)),
     # what to compute
     ("record", "i8"), ("track_available", "i8"),
     # the built-in WSP and the brake demand of simulate()

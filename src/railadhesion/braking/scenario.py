@@ -39,6 +39,7 @@ from railadhesion.braking.adhesion import (
     AxleAdhesion,
     CallableAdhesion,
     ContactGeometry,
+    ExactTableAdhesion,
     PolachAdhesion,
     WaterFlowProfile,
     WilacAdhesion,
@@ -117,11 +118,16 @@ def _adhesion(doc: Mapping, base: Path, wheel_radius: float):
     tab = table(doc, where)
     keys(tab, where, ("model",), ("parameters", "water_flow_ul_s", "over", "sections",
                                   "table", "recovery_energy_J_per_m", "rail_lateral_radius_m",
-                                  "dry_parameters", "file"))
+                                  "dry_parameters", "file", "mu", "friction_ratio",
+                                  "friction_decay_s_per_m"))
     model = string(tab["model"], "adhesion.model")
-    if model not in ("polach", "wilac", "law"):
+    if model not in ("polach", "wilac", "law", "table"):
         raise FieldError("adhesion.model", f"unknown model {model!r}; allowed: polach, wilac, "
-                         "law (user functions: use the Python API, CallableAdhesion)")
+                         "law, table (user functions: use the Python API, CallableAdhesion)")
+    if model != "table":
+        for k in ("mu", "friction_ratio", "friction_decay_s_per_m"):
+            if k in tab:
+                raise FieldError(f"adhesion.{k}", "only for model = 'table'")
     if model == "law":
         return _identified_law(tab, base, wheel_radius)
     if "file" in tab:
@@ -140,6 +146,8 @@ def _adhesion(doc: Mapping, base: Path, wheel_radius: float):
     def contact_copy():
         return contact
 
+    if model == "table":
+        return _table_model(tab, contact, sections)
     if model == "polach":
         for k in ("water_flow_ul_s", "table", "recovery_energy_J_per_m"):
             if k in tab:
@@ -202,6 +210,44 @@ def _adhesion(doc: Mapping, base: Path, wheel_radius: float):
     return (lambda: WilacAdhesion(profile, params, recovery, contact_copy()),
             lambda: WilacAdhesion(0.0, params, None, contact_copy()),
             {"model": "wilac", "water_flow_ul_s": w0, "over": over})
+
+
+def _table_model(tab: Mapping, contact: ContactGeometry, sections):
+    """``model = "table"``: the table model of Kalker's exact theory on every axle
+    (:class:`~railadhesion.braking.adhesion.ExactTableAdhesion`), its friction the μ0, A, B of
+    a Polach set (``parameters``) or given (``mu``, ``friction_ratio``,
+    ``friction_decay_s_per_m``; Coulomb friction by default); the dry reference is the table
+    model with the friction of a Polach set (``dry_parameters``, default ``polach2005_dry``)."""
+    for k in ("water_flow_ul_s", "table", "recovery_energy_J_per_m", "over"):
+        if k in tab:
+            raise FieldError(f"adhesion.{k}", "only for model = 'wilac'")
+    if sections:
+        raise FieldError("adhesion.sections", "not for model = 'table' (one friction law on "
+                         "the whole track)")
+    if "parameters" in tab:
+        for k in ("mu", "friction_ratio", "friction_decay_s_per_m"):
+            if k in tab:
+                raise FieldError(f"adhesion.{k}", "give either parameters (a Polach set's "
+                                 "mu0, A, B) or mu, friction_ratio, friction_decay_s_per_m")
+        name = _polach_name(tab["parameters"], "adhesion.parameters")
+        friction = {"parameters": name}
+        p = POLACH_PARAMETER_SETS[name]
+        law = (p.mu0, p.A, p.B)
+    else:
+        law = (number(tab.get("mu", 0.3), "adhesion.mu", 0.0, 2.0, low_open=True),
+               number(tab.get("friction_ratio", 1.0), "adhesion.friction_ratio", 0.0, 1.0),
+               number(tab.get("friction_decay_s_per_m", 0.0), "adhesion.friction_decay_s_per_m",
+                      0.0, 100.0))
+        friction = dict(zip(("mu", "friction_ratio", "friction_decay_s_per_m"), law,
+                            strict=True))
+    dry_set = _polach_name(tab.get("dry_parameters", "polach2005_dry"), "adhesion.dry_parameters")
+    try:  # the contact must be in the table's range: say so when loading
+        ExactTableAdhesion(*law, contact=contact)
+    except ValueError as exc:
+        raise FieldError("adhesion.rail_lateral_radius_m", str(exc)) from None
+    return (lambda: ExactTableAdhesion(*law, contact=contact),
+            lambda: ExactTableAdhesion.from_polach(dry_set, contact),
+            {"model": "table", **friction})
 
 
 def _identified_law(tab: Mapping, base: Path, wheel_radius: float):

@@ -57,9 +57,10 @@ dissipation, O(dt)).
 
 One integrator performs these operations: :func:`railadhesion.braking.step.step`, compiled
 with numba, on the named records of :mod:`railadhesion.braking.records`. It evaluates the
-built-in models (Polach, WILAC with a :class:`~railadhesion.braking.adhesion.WaterFlowProfile`)
-and a user's numba law in compiled code, and any other adhesion model by calling its Python
-methods back (``compiled=False`` asks for that with every model).
+built-in models (Polach, WILAC with a :class:`~railadhesion.braking.adhesion.WaterFlowProfile`),
+the table model of Kalker's exact theory and a user's numba law in compiled code, and any
+other adhesion model by calling its Python methods back (``compiled=False`` asks for that
+with every model).
 """
 
 from __future__ import annotations
@@ -83,6 +84,7 @@ from railadhesion.braking.records import (
     PYTHON,
     ROWS_FULL,
     STALE,
+    TABLE,
     USER,
     USER_GRID,
     WILAC,
@@ -305,15 +307,20 @@ def largest_stable_step(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed:
     the smallest τ over the axle loads (static, and under a deceleration of 3 m/s²), speeds
     from ``initial_speed`` down to 1 m/s and creepages from 1e-4 to 1, for every adhesion
     condition the model holds (each Polach set; WILAC dry and at the water flows of its
-    profile; a :class:`CallableAdhesion` law). It is inf when no curve falls, and for models
-    defined in Python otherwise (not examined).
+    profile; the table model; a :class:`CallableAdhesion` law). It is inf when no curve
+    falls, and for models defined in Python otherwise (not examined).
 
     Returns ``(tau, where)``: the step [s] and a dict saying where it is reached (condition,
     speed, creepage, slope, axle load).
     """
     import warnings
 
-    from railadhesion.braking.adhesion import PolachAdhesion, WaterFlowProfile, WilacAdhesion
+    from railadhesion.braking.adhesion import (
+        ExactTableAdhesion,
+        PolachAdhesion,
+        WaterFlowProfile,
+        WilacAdhesion,
+    )
 
     radius, inertia = vehicle.wheel_radius, vehicle.wheelset_inertia
     loads = np.unique(np.concatenate([vehicle.axle_normal_loads(0.0),
@@ -328,6 +335,9 @@ def largest_stable_step(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed:
         probes = [(f"WILAC at {w:g} µl/s", WilacAdhesion(w, adhesion.parameters,
                                                          contact=adhesion.contact))
                   for w in sorted({0.0, *map(float, adhesion.water_flow.values)})]
+    elif type(adhesion) is ExactTableAdhesion:
+        probes = [("table model", ExactTableAdhesion(adhesion.mu, adhesion.friction_ratio,
+                                                     adhesion.friction_decay, adhesion.contact))]
     elif isinstance(adhesion, CallableAdhesion) and (
             type(adhesion).evaluate is CallableAdhesion.evaluate):
         probes = [(adhesion.label, CallableAdhesion(adhesion.function, adhesion.needs_load,
@@ -397,7 +407,8 @@ class BrakingSimulator:
         request (:meth:`adhesion_available`).
     compiled : bool
         Evaluate the adhesion model in compiled code when it allows it (Polach, WILAC with a
-        :class:`~railadhesion.braking.adhesion.WaterFlowProfile`, a
+        :class:`~railadhesion.braking.adhesion.WaterFlowProfile`, the table model
+        :class:`~railadhesion.braking.adhesion.ExactTableAdhesion`, a
         :class:`~railadhesion.braking.adhesion.CallableAdhesion` of a numba ``@njit`` law);
         with ``False`` (or any other model) the step calls the model's Python methods.
     wsp : WheelSlideProtection, optional
@@ -542,8 +553,12 @@ class BrakingSimulator:
         """The adhesion model's settings and constant tables, the model family and the
         step's entry points for it."""
         from railadhesion.braking import step
-        from railadhesion.braking.adhesion import PolachAdhesion, WilacAdhesion
-        from railadhesion.braking.curves import register_python_model
+        from railadhesion.braking.adhesion import (
+            ExactTableAdhesion,
+            PolachAdhesion,
+            WilacAdhesion,
+        )
+        from railadhesion.braking.curves import TABLE_AUX, register_python_model
 
         a = self.adhesion
         parts = []
@@ -585,6 +600,19 @@ class BrakingSimulator:
             packed = a.packed
             table("wilac", packed)
             st["wilac_count"] = packed.size
+        elif compiled and type(a) is ExactTableAdhesion:
+            model, aux = TABLE, TABLE_AUX
+            tab, dims, strides, origin, inv_step = a.arrays
+            table("table", tab)
+            st["table_count"] = tab.size
+            st["table_dims"], st["table_strides"] = dims, strides
+            st["table_origin"], st["table_inv_step"] = origin, inv_step
+            st["table_mu"], st["table_ratio"] = a.mu, a.friction_ratio
+            st["table_decay"] = a.friction_decay
+            st["table_a0"], st["table_b0"] = a.contact.a0, a.contact.b0
+            st["table_shear_modulus"] = a.contact.shear_modulus
+            st["table_poisson"] = a.contact.poisson
+            entries = entries[:4] + (step.advance_table, step.advance_table_recorded)
         else:
             model, aux = PYTHON, None
             st["python_key"] = register_python_model(a, self)
@@ -607,16 +635,22 @@ class BrakingSimulator:
     @property
     def compiled(self) -> bool:
         """True if the adhesion model can be evaluated in compiled code (Polach, WILAC with a
-        WaterFlowProfile, or a :class:`CallableAdhesion` of a numba ``@njit`` function);
+        WaterFlowProfile, the table model, or a :class:`CallableAdhesion` of a numba ``@njit``
+        function);
         it then is unless ``compiled=False`` was asked."""
-        from railadhesion.braking.adhesion import PolachAdhesion, WaterFlowProfile, WilacAdhesion
+        from railadhesion.braking.adhesion import (
+            ExactTableAdhesion,
+            PolachAdhesion,
+            WaterFlowProfile,
+            WilacAdhesion,
+        )
 
         kind = type(self.adhesion)
         if kind is WilacAdhesion:
             return isinstance(self.adhesion.water_flow, WaterFlowProfile)
         if isinstance(self.adhesion, CallableAdhesion):
             return _is_jitted(self.adhesion)
-        return kind is PolachAdhesion
+        return kind is PolachAdhesion or kind is ExactTableAdhesion
 
     @property
     def runs_compiled(self) -> bool:

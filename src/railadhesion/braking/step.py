@@ -43,7 +43,12 @@ from numba import njit
 
 from railadhesion.braking import sensors as _sensors
 from railadhesion.braking import wsp as _wsp
-from railadhesion.braking.curves import evaluate_adhesion, peak_adhesion, refresh_adhesion
+from railadhesion.braking.curves import (
+    TABLE_AUX,
+    evaluate_adhesion,
+    peak_adhesion,
+    refresh_adhesion,
+)
 from railadhesion.braking.cylinders import cylinder_step, lag_factors, set_valves
 from railadhesion.braking.demand import demanded_pressure
 from railadhesion.braking.records import (
@@ -64,7 +69,8 @@ from railadhesion.braking.wsp import wsp_update
 
 __all__ = ["step", "advance", "advance_unrecorded", "split_buffer", "advance_buffer",
            "advance_buffer_unrecorded", "advance_builtin", "advance_builtin_recorded",
-           "advance_python", "advance_python_recorded", "run", "available", "MACHINE",
+           "advance_python", "advance_python_recorded", "advance_table",
+           "advance_table_recorded", "run", "available", "MACHINE",
            "FINGERPRINT", "SAFEGUARD_TOL", "SPEED_FLOOR"]
 
 #: The machine record of the built-in WSP and sensor model. The per-step entry points take
@@ -81,12 +87,15 @@ def _fingerprint() -> int:
     import zlib
     from pathlib import Path
 
+    from railadhesion import simd
     from railadhesion.braking import curves, cylinders, demand, records
+    from railadhesion.contact import friction, kalker, table
     from railadhesion.models import kernels
 
     crc = zlib.crc32(repr(MACHINE.descr).encode())
     for path in (records.__file__, curves.__file__, cylinders.__file__, demand.__file__,
-                 _sensors.__file__, _wsp.__file__, kernels.__file__, __file__):
+                 _sensors.__file__, _wsp.__file__, kernels.__file__, table.__file__,
+                 kalker.__file__, friction.__file__, simd.__file__, __file__):
         try:
             crc = zlib.crc32(Path(path).read_bytes(), crc)
         except OSError:  # no source (an installation without .py files): the name only
@@ -615,6 +624,18 @@ def advance_python(buffer, dt):
 def advance_python_recorded(buffer, rows, dt):
     """One call of the stepping API, an adhesion model in Python, recording into ``rows``."""
     return advance_buffer(buffer, rows, dt, None)
+
+
+@njit(cache=True, error_model="numpy")
+def advance_table(buffer, dt):
+    """One call of the stepping API, the table model (``TABLE_AUX``), no recording."""
+    return advance_buffer_unrecorded(buffer, dt, TABLE_AUX)
+
+
+@njit(cache=True, error_model="numpy")
+def advance_table_recorded(buffer, rows, dt):
+    """One call of the stepping API, the table model, recording into ``rows``."""
+    return advance_buffer(buffer, rows, dt, TABLE_AUX)
 
 
 @njit(cache=True, error_model="numpy")

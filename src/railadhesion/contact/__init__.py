@@ -28,6 +28,7 @@ _LAZY = {
     "solve_normal": "railadhesion.contact.exact",
     "solve_tangential": "railadhesion.contact.exact",
     "tangential_influence": "railadhesion.contact.exact",
+    "exact_table_arrays": "railadhesion.contact.table",
     "exact_table_forces": "railadhesion.contact.table",
     "exact_table_law": "railadhesion.contact.table",
 }
@@ -53,6 +54,7 @@ __all__ = [
     "exact_rolling",
     "contact_semi_axes",
 
+    "exact_table_arrays",
     "exact_table_forces",
     "exact_table_law",
     "fastsim",

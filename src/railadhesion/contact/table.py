@@ -75,7 +75,7 @@ from railadhesion.numerics import (
 from railadhesion.plausibility import input_checker
 from railadhesion.simd import NOUT, contract_rows
 
-__all__ = ["exact_table_forces", "exact_table_law", "table_axes"]
+__all__ = ["exact_table_arrays", "exact_table_forces", "exact_table_law", "table_axes"]
 
 #: Poisson's ratio of the table.
 TABLE_POISSON = 0.28
@@ -746,3 +746,24 @@ def _check_inputs(values):
     aob = a_ / b_
     if not np.all((aob >= AOB_MIN * (1 - 1e-12)) & (aob <= AOB_MAX * (1 + 1e-12))):
         raise ValueError(f"a/b must be in [{AOB_MIN}, {AOB_MAX}] for the table model")
+
+
+def exact_table_arrays(aob=None):
+    """The table as :func:`exact_table_law` takes it: ``(tab, dims, strides, origin,
+    inv_step)``, its last five arguments (read-only arrays), for compiled code elsewhere in
+    the package (the braking step, FMUs).
+
+    ``aob=None``: the 4-D table (a/b looked up per contact). A float a/b in [0.2, 5]: the
+    table interpolated to that a/b as :func:`exact_table_forces` does when every contact
+    shares it (3-D lookup, ``strides[0] = 0``); the law then ignores the a/b of a contact
+    in the interpolation (Kalker's coefficients still use it), so give it contacts of that
+    a/b only."""
+    d = _load()
+    if aob is None:
+        return d["padded_flat"], d["dims"], d["strides"], d["origin"], d["inv_step"]
+    aob = float(aob)
+    if not AOB_MIN * (1 - 1e-12) <= aob <= AOB_MAX * (1 + 1e-12):
+        raise ValueError(f"aob (a/b) must be in [{AOB_MIN}, {AOB_MAX}] for the table model, "
+                         f"got {aob!r}")
+    return (_slice_at(math.log(aob)), d["dims"], _slice_strides(d["strides"]), d["origin"],
+            d["inv_step"])

@@ -41,14 +41,19 @@ __all__ = [
     "ResolvedParameters",
     "build_creep_force_fmu",
     "build_fmu",
+    "check_friction",
     "creep_force_documentation",
     "creep_force_variables",
     "resolve_parameters",
+    "table_friction_text",
     "unit_definitions",
 ]
 
-#: Models the creep-force FMU can wrap.
-FMU_MODELS = ("wilac", "polach")
+#: Models the creep-force FMU can wrap (``"table"``: the table model of Kalker's exact theory
+#: with the friction of a Polach set; Python FMU only).
+FMU_MODELS = ("wilac", "polach", "table")
+#: Friction laws of the table model's FMU: the set's falling friction or Coulomb's (its mu0).
+TABLE_FRICTION = ("falling", "coulomb")
 
 #: FMI 2.0 unit definitions used by the FMUs: unit name -> BaseUnit attributes (SI exponents,
 #: optional factor). Water flow is in µl/s as everywhere in the package (spelt ``ul/s``).
@@ -304,18 +309,21 @@ def _add_initial_unknowns(root: ET.Element) -> None:
 
 def creep_force_variables(model: str, *, shear_modulus: float = 8.2e10,
                           poisson: float = 0.28) -> list[FmuVariable]:  # fmt: skip
-    """The variables of the creep-force FMU of ``model`` (``"wilac"`` or ``"polach"``).
+    """The variables of the creep-force FMU of ``model`` (``"wilac"``, ``"polach"`` or
+    ``"table"``).
 
     Inputs: creepages, spin, normal force, speed, semi-axes and (WILAC) water flow; fixed
     parameters: elastic constants, with start values ``shear_modulus`` [Pa] in (0, inf) and
-    ``poisson`` [-] in [0, 0.5]; outputs: Fx, Fy, adhesion. Signs: ``docs/CONVENTIONS.md``.
+    ``poisson`` [-] in [0, 0.5] (the table model: [0.25, 0.30]); outputs: Fx, Fy, adhesion
+    (the table model also Mz). Signs: ``docs/CONVENTIONS.md``.
     """
     _check_model(model)
     g, nu = float(shear_modulus), float(poisson)
+    nu_lo, nu_hi = (0.25, 0.30) if model == "table" else (0.0, 0.5)
     if not (0.0 < g < math.inf):
         raise ValueError(f"shear_modulus must be in (0, inf), got {shear_modulus!r}")
-    if not (0.0 <= nu <= 0.5):
-        raise ValueError(f"poisson must be in [0, 0.5], got {poisson!r}")
+    if not (nu_lo <= nu <= nu_hi):
+        raise ValueError(f"poisson must be in [{nu_lo:g}, {nu_hi:g}], got {poisson!r}")
     for name, value in (("shear_modulus", g), ("poisson", nu)):  # G = 82000 (N/mm^2): a warning
         check_plausible(value, name, where=f"{name} (start value)")
     inputs = [
@@ -341,7 +349,7 @@ def creep_force_variables(model: str, *, shear_modulus: float = 8.2e10,
         FmuVariable("shear_modulus", "parameter", "Pa", "Combined shear modulus G", g,
                     min=0.0),
         FmuVariable("poisson", "parameter", "1", "Combined Poisson's ratio nu", nu,
-                    min=0.0, max=0.5),
+                    min=nu_lo, max=nu_hi),
     ]  # fmt: skip
     outputs = [
         FmuVariable("Fx", "output", "N",
@@ -350,7 +358,29 @@ def creep_force_variables(model: str, *, shear_modulus: float = 8.2e10,
                     "Lateral force of the rail on the wheel (opposes creep_lat)"),
         FmuVariable("adhesion", "output", "1", "Adhesion coefficient sqrt(Fx^2 + Fy^2)/Q"),
     ]  # fmt: skip
+    if model == "table":
+        outputs.append(FmuVariable("Mz", "output", "N.m",
+                                   "Spin moment of the rail on the wheel (Kalker's signs)"))
     return inputs + parameters + outputs
+
+
+def check_friction(model: str, friction: str) -> None:
+    """Raise ValueError unless ``friction`` is one of :data:`TABLE_FRICTION`, and
+    ``"falling"`` (the default) for a model other than the table model."""
+    if friction not in TABLE_FRICTION:
+        raise ValueError(f"friction must be one of {', '.join(TABLE_FRICTION)}, got "
+                         f"{friction!r}")
+    if model != "table" and friction != "falling":
+        raise ValueError("friction: only for the table model (model='table')")
+
+
+def table_friction_text(params, friction: str) -> str:
+    """The sentence of a table-model FMU's description on its friction: the Polach set
+    ``params``' μ0 (and A, B with ``friction="falling"``), not its k_A, k_S."""
+    law = (f"Coulomb friction mu0 = {params.mu0:g}" if friction == "coulomb" else
+           f"falling friction mu0 = {params.mu0:g}, A = {params.A:g}, B = {params.B:g} s/m at "
+           "the global slip velocity")
+    return f"The table model uses the set's friction only ({law}; not k_A, k_S). "
 
 
 def _check_model(model: str) -> None:
@@ -378,8 +408,9 @@ class ResolvedParameters:
 
     @property
     def label(self) -> str:
-        """The law's name as printed: WILAC or Polach."""
-        return "WILAC" if self.model == "wilac" else "Polach"
+        """The law's name as printed: WILAC, Polach, or the table model."""
+        return {"wilac": "WILAC", "table": "Kalker exact-theory table"}.get(self.model,
+                                                                           "Polach")
 
     def describe(self, where: str) -> str:
         """The ``description`` of a creep-force FMU of this set: the law, the set, its
@@ -424,11 +455,13 @@ def resolve_parameters(model: str, params=None, parameter_set: str | None = None
 
     Parameters
     ----------
-    model : {"wilac", "polach"}
+    model : {"wilac", "polach", "table"}
     params : path-like, WilacParameters or PolachParameters, optional
-        A parameter file (copied verbatim, after validation) or a parameter object.
+        A parameter file (copied verbatim, after validation) or a parameter object (the
+        table model takes a Polach set, of which it uses the friction μ0, A, B).
     parameter_set : str, optional
-        A named set: Polach, a key of ``POLACH_PARAMETER_SETS``; WILAC, ``"default"``.
+        A named set: Polach and table, a key of ``POLACH_PARAMETER_SETS``; WILAC,
+        ``"default"``.
         Default when neither is given: ``"default"`` (WILAC) or ``"polach2005_dry"``.
 
     Returns
@@ -511,8 +544,10 @@ def build_creep_force_fmu(
     parameter_set: str | None = None,
     shear_modulus: float = 8.2e10,
     poisson: float = 0.28,
+    friction: str = "falling",
 ) -> Path:
-    """Write an FMI 2.0 co-simulation FMU of a creep-force law (WILAC or Polach).
+    """Write an FMI 2.0 co-simulation FMU of a creep-force law (WILAC, Polach or the table
+    model of Kalker's exact theory).
 
     Inputs: ``creep_long``, ``creep_lat`` [-], ``spin`` [rad/m], ``normal_force`` [N],
     ``speed`` [m/s], ``a``, ``b`` [m] and, for WILAC, ``water_flow`` [µl/s]; fixed parameters
@@ -526,11 +561,14 @@ def build_creep_force_fmu(
     ----------
     out : str or os.PathLike
         The ``.fmu`` file to write.
-    model : {"wilac", "polach"}
+    model : {"wilac", "polach", "table"}
     params, parameter_set :
         The parameter set, see :func:`resolve_parameters`.
     shear_modulus, poisson : float
         Start values of the FMU's elastic-constant parameters [Pa], [-].
+    friction : {"falling", "coulomb"}
+        The table model's friction: the set's falling friction μ0 [(1 − A) exp(−B w) + A]
+        at the global slip velocity (default), or Coulomb's μ0. Only for ``model="table"``.
 
     Returns
     -------
@@ -539,18 +577,27 @@ def build_creep_force_fmu(
 
     Notes
     -----
-    The FMU runs Python: the host needs a Python interpreter with ``railadhesion`` installed
+    The table model (:func:`railadhesion.contact.exact_table_forces`) has one more output,
+    ``Mz`` [N m]; its inputs must be in the table's range (a/b in [0.2, 5]; Poisson's ratio
+    in [0.25, 0.30]), otherwise the outputs are NaN and the step fails, as for any invalid
+    input. The FMU runs Python: the host needs a Python interpreter with ``railadhesion`` installed
     (pythonfmu's binary runs the slave in the interpreter of the process that loads it, e.g.
-    FMPy's). The slave calls :func:`railadhesion.wilac_forces` or
-    :func:`railadhesion.polach_forces` with scalars, so its outputs equal direct calls.
+    FMPy's). The slave calls :func:`railadhesion.wilac_forces`,
+    :func:`railadhesion.polach_forces` or :func:`railadhesion.contact.exact_table_forces`
+    with scalars, so its outputs equal direct calls.
     """
     import railadhesion
 
     resolved = resolve_parameters(model, params, parameter_set)
+    check_friction(model, friction)
     variables = creep_force_variables(model, shear_modulus=shear_modulus, poisson=poisson)
-    description = resolved.describe(f"Embedded as resources/{_PARAMETER_FILE}.")
+    where = f"Embedded as resources/{_PARAMETER_FILE}."
+    if model == "table":
+        where = table_friction_text(resolved.params, friction) + where
+    description = resolved.describe(where)
     config = {
         "model": model,
+        "friction": friction,
         "parameter_file": _PARAMETER_FILE,
         "railadhesion_version": railadhesion.__version__,
         "description": description,

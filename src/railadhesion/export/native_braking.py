@@ -116,8 +116,8 @@ def braking_step_model(simulator, identifier: str = "railadhesion_braking") -> S
     if int(machine[0]["settings"]["model"]) not in (POLACH, WILAC):
         raise NativeUnsupported(
             "simulator: the native braking FMU compiles the built-in adhesion models (Polach "
-            "sets, WILAC) only; this simulator's model is a Python function or a user's law: "
-            "use the Python braking FMU")
+            "sets, WILAC) only; this simulator's model is a Python function, a user's law or "
+            "the table model: use the Python braking FMU")
     wsp = int(machine[0]["settings"]["wsp_on"]) != 0
     state_t = np.dtype([("machine", MACHINE), ("stopped", "f8")], align=True)
     settings_t = np.dtype([("tables", "f8", (max(tables.size, 1),))], align=True)

@@ -1,4 +1,5 @@
-"""The native creep-force FMU: Polach or WILAC compiled ahead of time, no Python at run time.
+"""The native creep-force FMU: Polach, WILAC or the table model of Kalker's exact theory
+compiled ahead of time, no Python at run time.
 
 The model is a step function on three records (:mod:`railadhesion.export.native`):
 
@@ -13,6 +14,12 @@ The step calls the package's validating scalar kernels, those ``polach_forces`` 
 ``wilac_checked``), with the Kalker coefficients looked up from a/b and nu on every call as
 they do: the FMU gives the library's numbers (tested to 1e-12 on 10^4 random inputs). A normal
 force <= 0 (wheel lift-off) gives zero forces and zero adhesion, as the Python FMU.
+
+The table model's step calls :func:`railadhesion.contact.exact_table_law` on the package's 4-D
+table, held in the settings record (2.6 MB, compiled into the binary's start values), with
+the friction of a Polach set; an a/b outside the table's range [0.2, 5] fails the step (its
+other inputs' ranges are the variables' bounds, checked by ``fmi2SetReal``), and it has a
+fourth output, ``Mz``.
 """
 
 from __future__ import annotations
@@ -23,9 +30,11 @@ from pathlib import Path
 import numpy as np
 
 from railadhesion.export.fmu import (
+    check_friction,
     creep_force_documentation,
     creep_force_variables,
     resolve_parameters,
+    table_friction_text,
 )
 from railadhesion.export.native import RecordVariable, StepModel, build_step_fmu
 
@@ -33,10 +42,12 @@ __all__ = ["NATIVE_MODELS", "build_native_creep_force_fmu", "creep_force_step_mo
 
 #: The creep-force laws the native FMU compiles (``railadhesion export fmu`` writes any other
 #: as the Python FMU).
-NATIVE_MODELS = ("wilac", "polach")
+NATIVE_MODELS = ("wilac", "polach", "table")
 
 _PARAMETER_FILE = "parameters.toml"
 _STATE = np.dtype([("Fx", "f8"), ("Fy", "f8"), ("adhesion", "f8")], align=True)
+_TABLE_STATE = np.dtype([("Fx", "f8"), ("Fy", "f8"), ("adhesion", "f8"), ("Mz", "f8")],
+                        align=True)
 _POLACH = ("mu0", "k_A", "k_S", "A", "B")
 # Arguments of polach_checked in order, by the position its ``bad`` result reports.
 _POLACH_ARGS = ("creep_long", "creep_lat", "spin", "normal_force", "speed", "a", "b",
@@ -90,16 +101,90 @@ def _creep_force_step(model, settings_t, inputs_t):
     return step
 
 
+def _table_step(settings_t, inputs_t):
+    """The step function of the table model's FMU: :func:`railadhesion.contact.exact_table_law`
+    on the 4-D table held in the settings, after the check of a/b (the one input whose range
+    the variables' bounds cannot state); lift-off and the adhesion as the other laws."""
+    from numba import carray
+
+    from railadhesion.contact.table import AOB_MAX, AOB_MIN, exact_table_law
+
+    state_t = _TABLE_STATE
+    lo, hi = AOB_MIN * (1 - 1e-12), AOB_MAX * (1 + 1e-12)  # exact_table_forces' bounds
+
+    def step(state, settings, inputs, dt):
+        out = carray(state, 1, state_t)
+        p = carray(settings, 1, settings_t)[0]
+        x = carray(inputs, 1, inputs_t)[0]
+        q = x.normal_force
+        code = 0
+        if q <= 0.0:  # wheel lift-off: no contact, no force
+            fx, fy, mz, adhesion = 0.0, 0.0, 0.0, 0.0
+        elif not lo <= x.a / x.b <= hi:
+            fx, fy, mz, adhesion = math.nan, math.nan, math.nan, math.nan
+            code = 1
+        else:
+            fx, fy, mz = exact_table_law(x.creep_long, x.creep_lat, x.spin, q, x.a, x.b, p.mu0,
+                                         p.shear_modulus, p.poisson, x.speed, p.A, p.B, p.tab,
+                                         p.dims, p.strides, p.origin, p.inv_step)  # fmt: skip
+            adhesion = math.hypot(fx, fy) / q  # railadhesion.adhesion
+        out[0].Fx = fx
+        out[0].Fy = fy
+        out[0].adhesion = adhesion
+        out[0].Mz = mz
+        return code
+
+    return step
+
+
+def _table_step_model(params, variables, inputs_t, friction):
+    """The table model (friction μ0, A, B of the Polach set ``params``, or Coulomb's μ0) as a
+    :class:`StepModel`: the package's 4-D table (2.6 MB) compiled into the settings."""
+    from railadhesion.contact.table import exact_table_arrays
+
+    tab, dims, strides, origin, inv_step = exact_table_arrays()
+    settings_t = np.dtype([("shear_modulus", "f8"), ("poisson", "f8"), ("mu0", "f8"),
+                           ("A", "f8"), ("B", "f8"), ("dims", "i8", (4,)),
+                           ("strides", "i8", (4,)), ("origin", "f8", (4,)),
+                           ("inv_step", "f8", (4,)), ("tab", "f8", (tab.size,))],
+                          align=True)  # fmt: skip
+    settings = np.zeros(1, settings_t)
+    coulomb = friction == "coulomb"
+    settings["mu0"] = params.mu0
+    settings["A"], settings["B"] = (1.0, 0.0) if coulomb else (params.A, params.B)
+    for name, value in (("dims", dims), ("strides", strides), ("origin", origin),
+                        ("inv_step", inv_step), ("tab", tab)):  # fmt: skip
+        settings[name][0] = value
+    for v in variables:
+        if v.causality == "parameter":
+            settings[v.name] = v.start
+    return StepModel(
+        identifier="railadhesion_table",
+        step=_table_step(settings_t, inputs_t),
+        state=np.zeros(1, _TABLE_STATE),
+        settings=settings,
+        inputs=np.zeros(1, inputs_t),
+        variables=[RecordVariable(v, v.name, min_open=v.name in _OPEN_BELOW) for v in variables],
+        errors={1: "a/b outside the table model's range [0.2, 5]"},
+        feedthrough=True,
+    )
+
+
 def creep_force_step_model(model: str, params, *, shear_modulus: float = 8.2e10,
-                           poisson: float = 0.28) -> StepModel:  # fmt: skip
+                           poisson: float = 0.28,
+                           friction: str = "falling") -> StepModel:  # fmt: skip
     """The creep-force law of ``model`` with parameter set ``params`` (a
     :class:`~railadhesion.models.parameters.PolachParameters` or
-    :class:`~railadhesion.models.wilac.WilacParameters`) as a :class:`StepModel`."""
+    :class:`~railadhesion.models.wilac.WilacParameters`) as a :class:`StepModel`; the table
+    model takes the friction of a Polach set (``friction="falling"``: μ0, A, B; or
+    ``"coulomb"``: μ0)."""
     from railadhesion.models.kernels import pack_wilac
 
     variables = creep_force_variables(model, shear_modulus=shear_modulus, poisson=poisson)
     names = [v.name for v in variables if v.causality == "input"]
     inputs_t = np.dtype([(n, "f8") for n in names], align=True)
+    if model == "table":
+        return _table_step_model(params, variables, inputs_t, friction)
     if model == "wilac":
         packed = pack_wilac(params)
         settings_t = np.dtype([("shear_modulus", "f8"), ("poisson", "f8"),
@@ -139,6 +224,7 @@ def build_native_creep_force_fmu(
     parameter_set: str | None = None,
     shear_modulus: float = 8.2e10,
     poisson: float = 0.28,
+    friction: str = "falling",
 ) -> Path:
     """Write a native FMI 2.0 co-simulation FMU of a creep-force law: no Python at run time.
 
@@ -151,11 +237,13 @@ def build_native_creep_force_fmu(
     ----------
     out : str or os.PathLike
         The ``.fmu`` file to write.
-    model : {"wilac", "polach"}
+    model : {"wilac", "polach", "table"}
     params, parameter_set :
         The parameter set, see :func:`railadhesion.export.resolve_parameters`.
     shear_modulus, poisson : float
         Start values of the FMU's elastic-constant parameters [Pa], [-].
+    friction : {"falling", "coulomb"}
+        The table model's friction, as in :func:`railadhesion.export.build_creep_force_fmu`.
 
     Returns
     -------
@@ -176,11 +264,13 @@ def build_native_creep_force_fmu(
     ``fmi2SetFMUstate`` (FMI 2.0).
     """
     resolved = resolve_parameters(model, params, parameter_set)
+    check_friction(model, friction)
     step_model = creep_force_step_model(model, resolved.params, shear_modulus=shear_modulus,
-                                        poisson=poisson)  # fmt: skip
+                                        poisson=poisson, friction=friction)  # fmt: skip
     file = f"documentation/{_PARAMETER_FILE}"
+    friction_text = table_friction_text(resolved.params, friction) if model == "table" else ""
     description = resolved.describe(
-        "Compiled into the binary (sources/ra_model.h); the set's file is "
+        f"{friction_text}Compiled into the binary (sources/ra_model.h); the set's file is "
         f"{file}. Native: no Python at run time."
     )
     variables = [rv.variable for rv in step_model.variables]

@@ -49,7 +49,8 @@ def _import_railadhesion():
 
 
 class RailadhesionCreepForce(Fmi2Slave):
-    """Creep forces Fx, Fy [N] and adhesion [-] of a wheel-rail contact (Polach or WILAC)."""
+    """Creep forces Fx, Fy [N] and adhesion [-] of a wheel-rail contact (Polach, WILAC or the
+    table model of Kalker's exact theory, which also gives the spin moment Mz [N m])."""
 
     author = "railadhesion"
 
@@ -70,7 +71,14 @@ class RailadhesionCreepForce(Fmi2Slave):
         params = load_parameter_file(resources / config["parameter_file"])
         self._params = params
         self._adhesion = ra.adhesion
-        self._forces_fn = ra.wilac_forces if self._model == "wilac" else ra.polach_forces
+        if self._model == "table":
+            from railadhesion.contact import exact_table_forces
+
+            self._forces_fn = exact_table_forces
+            coulomb = config.get("friction", "falling") == "coulomb"
+            self._friction = (1.0, 0.0) if coulomb else (params.A, params.B)
+        else:
+            self._forces_fn = ra.wilac_forces if self._model == "wilac" else ra.polach_forces
         if ra.__version__ != config["railadhesion_version"]:
             self.log(
                 f"the FMU was built with railadhesion {config['railadhesion_version']}, the "
@@ -81,6 +89,7 @@ class RailadhesionCreepForce(Fmi2Slave):
         self.Fx = 0.0
         self.Fy = 0.0
         self.adhesion = 0.0
+        self.Mz = 0.0
         for var in config["variables"]:
             name = var["name"]
             causality = Fmi2Causality[var["causality"]]
@@ -119,10 +128,18 @@ class RailadhesionCreepForce(Fmi2Slave):
     def _evaluate(self) -> None:
         q = self.normal_force
         if q <= 0.0 and math.isfinite(q):  # wheel lift-off: no contact, no force
-            self.Fx = self.Fy = self.adhesion = 0.0
+            self.Fx = self.Fy = self.adhesion = self.Mz = 0.0
             self._dirty = False
             return
-        if self._model == "wilac":
+        if self._model == "table":
+            ratio, decay = self._friction
+            fx, fy, mz = self._forces_fn(
+                self.creep_long, self.creep_lat, self.spin, q, self.a, self.b,
+                self._params.mu0, shear_modulus=self.shear_modulus, poisson=self.poisson,
+                speed=self.speed, friction_ratio=ratio, friction_decay=decay,
+            )  # fmt: skip
+            self.Mz = float(mz)
+        elif self._model == "wilac":
             fx, fy = self._forces_fn(
                 self.creep_long, self.creep_lat, self.spin, q, self.speed, self.a, self.b,
                 self.water_flow, self._params,
@@ -152,7 +169,7 @@ class RailadhesionCreepForce(Fmi2Slave):
         except ValueError as exc:
             # Invalid inputs: NaN outputs (a number would be a wrong force), the message in
             # the log, and a failed step (pythonfmu reports it as fmi2Discard).
-            self.Fx = self.Fy = self.adhesion = math.nan
+            self.Fx = self.Fy = self.adhesion = self.Mz = math.nan
             self._dirty = False
             self.log(f"railadhesion: {exc}", Fmi2Status.error)
             return False

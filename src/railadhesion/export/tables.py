@@ -224,6 +224,9 @@ def creep_force_table(
     """
     import railadhesion
 
+    if model == "table":  # an FMU model, not a table model: say so rather than fall to Polach
+        raise ValueError("model must be wilac or polach for a creep-force table, got 'table' "
+                         "(the table model is itself a table: exact_table_forces)")
     resolved = resolve_parameters(model, params, parameter_set)
     grid = {
         "creep_long": _axis(creep_long, "creep_long"),

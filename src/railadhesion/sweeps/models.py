@@ -29,6 +29,7 @@ __all__ = [
     "ContactSweep",
     "WilacSweep",
     "PolachSweep",
+    "ExactTableSweep",
     "TwoDSweep",
     "FunctionSweep",
     "SWEEP_MODELS",
@@ -265,6 +266,99 @@ class PolachSweep(ContactSweep):
                 "shear_modulus": self.shear_modulus, "poisson": self.poisson}  # fmt: skip
 
 
+#: Friction laws of :class:`ExactTableSweep`.
+TABLE_FRICTION = ("falling", "coulomb")
+
+
+@dataclass(frozen=True)
+class ExactTableSweep(PolachSweep):
+    """The table model of Kalker's exact theory
+    (:func:`railadhesion.contact.exact_table_forces`, Kalker 1990 ch. 5 tabulated) on a
+    grid, with the inputs of :class:`PolachSweep`.
+
+    Parameters
+    ----------
+    parameters : str or PolachParameters, optional
+        A Polach set (named, a parameter-file path, or a set), of which the table model
+        takes the friction only: μ0, and A, B with ``friction="falling"`` (its k_A, k_S,
+        which reduce Polach's initial slope, have no counterpart in the exact theory). Also
+        the default label of a ``parameter_set`` dimension.
+    geometry : str or (float, float), optional
+        Named Hertz geometry or fixed semi-axes ``(a, b)`` [m]; a/b in [0.2, 5].
+    shear_modulus, poisson : float, optional
+        Elastic constants [Pa, -]; ν in [0.25, 0.30] (the table's range).
+    friction : str, optional
+        ``"falling"`` (default): the set's falling friction μ0 [(1 − A) exp(−B w) + A] at the
+        global slip velocity w = V sqrt(ξ² + η²) (where that is accurate:
+        :func:`~railadhesion.contact.exact_table_forces`); ``"coulomb"``: μ0 throughout.
+    mu, friction_ratio, friction_decay : float, optional
+        μ0, A, B [s/m] instead of the set's (A, B only with ``friction="falling"``).
+
+    Inputs: creep_long, creep_lat (0), spin (0), normal_force, speed; labels: parameter_set.
+    """
+
+    geometry: object = "locomotive"
+    friction: str = "falling"
+    mu: float | None = None
+    friction_ratio: float | None = None
+    friction_decay: float | None = None
+    name = "table"
+
+    def __post_init__(self):
+        if self.friction not in TABLE_FRICTION:
+            raise ValueError(f"friction: expected one of {list(TABLE_FRICTION)}, got "
+                             f"{self.friction!r}")
+        if self.friction == "coulomb" and (self.friction_ratio is not None
+                                           or self.friction_decay is not None):
+            raise ValueError("friction_ratio: friction_ratio and friction_decay only with "
+                             "friction='falling'")
+        for key, lo, hi in (("mu", 0.0, 2.0), ("friction_ratio", 0.0, 1.0),
+                            ("friction_decay", 0.0, 100.0)):
+            v = getattr(self, key)
+            if v is not None and not (isinstance(v, int | float) and not isinstance(v, bool)
+                                      and lo <= v <= hi and (key != "mu" or v > 0.0)):
+                what = "(0, 2]" if key == "mu" else f"[{lo:g}, {hi:g}]"
+                raise ValueError(f"{key}: must be a number in {what}, got {v!r}")
+        if not 0.25 <= self.poisson <= 0.30:
+            raise ValueError(f"poisson: must be in [0.25, 0.3] for the table model, got "
+                             f"{self.poisson!r}")
+        super().__post_init__()
+        a, b = contact_semi_axes(self.geometry, 1e5)  # a/b does not change with the load
+        if not 0.2 <= float(a) / float(b) <= 5.0:
+            raise ValueError(f"geometry: a/b must be in [0.2, 5] for the table model, got "
+                             f"{float(a) / float(b):.4g}")
+
+    def law(self, params) -> tuple[float, float, float]:
+        """(μ0, A, B) of the table model with the set ``params``."""
+        mu = params.mu0 if self.mu is None else self.mu
+        if self.friction == "coulomb":
+            return mu, 1.0, 0.0
+        ratio = params.A if self.friction_ratio is None else self.friction_ratio
+        decay = params.B if self.friction_decay is None else self.friction_decay
+        return mu, ratio, decay
+
+    def forces(self, values, a, b, params):
+        from railadhesion.contact.table import exact_table_forces
+
+        mu, ratio, decay = self.law(params)
+        fx, fy, _ = exact_table_forces(
+            values["creep_long"], values["creep_lat"], values["spin"], values["normal_force"],
+            a, b, mu, shear_modulus=self.shear_modulus, poisson=self.poisson,
+            speed=values["speed"], friction_ratio=ratio, friction_decay=decay,
+        )  # fmt: skip
+        return fx, fy
+
+    def describe(self):
+        label = self.labels["parameter_set"]
+        mu, ratio, decay = self.law(self.resolve("parameter_set", label))
+        return {"model": "table model of Kalker's exact theory (Kalker 1990, ch. 5; "
+                         "railadhesion.contact.exact_table_forces)",
+                "geometry": _geometry_text(self.geometry), "parameter_set": label,
+                "friction": self.friction, "mu": mu, "friction_ratio": ratio,
+                "friction_decay": decay, "shear_modulus": self.shear_modulus,
+                "poisson": self.poisson}  # fmt: skip
+
+
 #: The 2D twin-disc models :class:`TwoDSweep` can evaluate.
 TWOD_VARIANTS = ("fletcher", "elastic_foundation", "carter")
 
@@ -437,6 +531,7 @@ def _geometry_text(geometry) -> str:
 SWEEP_MODELS = {
     "wilac": WilacSweep,
     "polach": PolachSweep,
+    "table": ExactTableSweep,
     "fletcher": lambda **kw: TwoDSweep(variant="fletcher", **kw),
     "elastic_foundation": lambda **kw: TwoDSweep(variant="elastic_foundation", **kw),
     "carter": lambda **kw: TwoDSweep(variant="carter", **kw),

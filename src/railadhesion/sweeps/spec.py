@@ -6,9 +6,12 @@ Format (``format = "railadhesion-sweep"``, ``format_version = 1``)::
     chunk_points = 262144                   # optional, target points per chunk
 
     [model]
-    name = "wilac"            # wilac | polach | fletcher | elastic_foundation | carter
-    parameters = "default"    # wilac: "default" or a parameter file; polach: a named set or file
-    geometry = "tram"         # wilac/polach: "tram", "locomotive" or [a, b] in m
+    name = "wilac"            # wilac | polach | table | fletcher | elastic_foundation | carter
+    parameters = "default"    # wilac: "default" or a parameter file; polach, table: a named
+                              # Polach set or file (table: its mu0, A, B only)
+    geometry = "tram"         # wilac/polach/table: "tram", "locomotive" or [a, b] in m
+    # friction = "falling"    # table: "falling" or "coulomb"; mu, friction_ratio,
+                              # friction_decay (numbers) instead of the set's
     # condition = "W1"        # 2D models: Fletcher's test code
 
     [grid]                    # dimension order = order of the keys
@@ -53,6 +56,8 @@ FORMAT_VERSION = 1
 _MODEL_OPTIONS = {
     "wilac": ("parameters", "geometry", "shear_modulus", "poisson"),
     "polach": ("parameters", "geometry", "shear_modulus", "poisson"),
+    "table": ("parameters", "geometry", "shear_modulus", "poisson", "friction", "mu",
+              "friction_ratio", "friction_decay"),
     "fletcher": ("condition",),
     "elastic_foundation": ("condition",),
     "carter": ("condition",),
@@ -217,7 +222,7 @@ def parse_sweep_spec(doc: dict, *, base: Path = Path("."), source: str = "") -> 
         if key not in _MODEL_OPTIONS[name]:
             fail_field(f"model.{key}", f"not an option of the {name!r} model; options: "
                                   f"{', '.join(_MODEL_OPTIONS[name])}")  # fmt: skip
-        if key in ("shear_modulus", "poisson"):
+        if key in ("shear_modulus", "poisson", "mu", "friction_ratio", "friction_decay"):
             value = number_field(value, f"model.{key}")
         elif key == "geometry" and isinstance(value, list):
             value = tuple(number_field(v, f"model.geometry[{i}]") for i, v in enumerate(value))
@@ -232,6 +237,9 @@ def parse_sweep_spec(doc: dict, *, base: Path = Path("."), source: str = "") -> 
         text = str(exc)
         if text.startswith("geometry:"):
             fail_field("model.geometry", text.split(":", 1)[1].strip())
+        head = text.split(":", 1)[0]
+        if head in options and head != "parameters":
+            fail_field(f"model.{head}", text.split(":", 1)[1].strip())
         culprit = next((k for k in ("parameters", "condition") if k in options), None)
         fail_field(f"model.{culprit}" if culprit else "model", text)
 
