@@ -262,3 +262,20 @@ def test_braking_fmu_of_a_table_scenario_matches_the_stepping_api(tmp_path):
 
     with pytest.raises(NativeUnsupported, match="table model"):  # the CLI falls back on it
         build_native_braking_fmu(tmp_path / "n.fmu", path)
+
+
+def test_cli_braking_fmu_of_a_table_scenario_falls_back_to_the_python_fmu(tmp_path):
+    """The native braking FMU does not compile the table model: by default the export writes
+    the Python FMU and says why; asked for --native, it is an error (exit 2)."""
+    path = tmp_path / "t.toml"
+    path.write_text(BRAKE_SCENARIO)
+    out = tmp_path / "b.fmu"
+    result = CliRunner().invoke(app, ["export", "braking-fmu", str(path), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    assert "table model" in text and "Python FMU: the host needs a Python" in text
+    assert out.exists()
+    result = CliRunner().invoke(app, ["export", "braking-fmu", str(path), "--native", "--out",
+                                      str(tmp_path / "n.fmu")])  # fmt: skip
+    assert result.exit_code == 2
+    assert "table model" in " ".join(result.output.split())
