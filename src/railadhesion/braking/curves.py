@@ -16,9 +16,11 @@ three functions chosen when the step is compiled by the type of its ``aux`` argu
 
 * an integer (0): the built-in models, Polach sets on track sections or WILAC with a
   water-flow profile (``settings.model``). Each axle's curve is a weighted sum of Polach
-  curves, evaluated by :func:`railadhesion.models.kernels.polach_longitudinal` (the law and
+  curves, evaluated by :func:`railadhesion.models.polach.polach_longitudinal` (the law and
   its analytic slopes) in one loop over *lanes*, one per axle and set of non-zero weight,
-  which the compiler vectorises;
+  which the compiler vectorises: the law is the plain function, inlined into the loop with
+  the curve it calls (a call of its compiled dispatcher in the loop body would keep the
+  loop scalar);
 * a first-class function ``mu(creep >= 0, speed, wheel load) -> float`` (a user's numba law
   compiled as a C callback): its slopes by the differences of
   :class:`~railadhesion.braking.adhesion.CallableAdhesion`;
@@ -47,10 +49,10 @@ from railadhesion.braking.records import (
     POLACH,
 )
 from railadhesion.models.kernels import (
-    polach_longitudinal,
     wilac_condition_parameters,
     wilac_weights_scalar,
 )
+from railadhesion.models.polach import polach_longitudinal
 
 __all__ = ["new_workspace", "build_lanes", "evaluate_lanes", "peak_lanes", "water_flow_at",
            "wilac_axle_parameters", "family_slopes", "family_slope_table", "family_peak",

@@ -152,7 +152,7 @@ def polach_law(creep_x, creep_y, spin, normal_force, speed, a, b, G, nu, c11, c2
                         t[5], t[6], k_A, k_S, mu0, A, B)  # fmt: skip
 
 
-@jitable
+@jitable(inline="always")
 def polach_curve(creep, slope, inverse_mu, ratio):
     """Polach's (2005) adhesion-creep curve without falling friction, and two derivatives.
 
