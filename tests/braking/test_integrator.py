@@ -91,6 +91,29 @@ def test_advance_equals_step_and_its_live_state_is_a_read_only_view():
     np.testing.assert_array_equal(a.vent_actions, b.vent_actions)
 
 
+def test_advance_binds_the_compiled_entry_point_on_its_first_call():
+    """advance() calls the step's compiled entry point (railadhesion._jit.kernel_entry), found
+    on the first call by a call with dt = NaN that the step refuses: that first call must
+    advance exactly once, recorded or not."""
+    from railadhesion._jit import compiled_entry
+    from railadhesion.braking import step
+
+    for record, name, dispatcher in ((False, "_advance", step.advance_builtin),
+                                     (True, "_advance_recorded",
+                                      step.advance_builtin_recorded)):
+        sim = BrakingSimulator(VEHICLE, PolachAdhesion("polach2005_dry"), 10.0,
+                               record=record)
+        stand_in = sim.__dict__[name]
+        sim.advance(1e-3)
+        assert sim.time == pytest.approx(1e-3) and sim.solver_counts["steps"] == 1
+        bound = sim.__dict__[name]
+        assert bound is not stand_in
+        args = (sim._buffer, sim._rows, 1e-3) if record else (sim._buffer, 1e-3)
+        assert bound is compiled_entry(dispatcher, args)
+        sim.advance(1e-3)
+        assert sim.time == pytest.approx(2e-3) and sim.__dict__[name] is bound
+
+
 def test_advance_checks_its_inputs_and_names_the_axle():
     sim = BrakingSimulator(VEHICLE, PolachAdhesion("polach2005_dry"), 10.0)
     sim.advance(1e-3)
