@@ -319,10 +319,11 @@ def wilac_axle_parameters(packed, wheel_loads, speed, water, weights, params, sc
     of each axle and its regression factors (``wilac_normalise``, ``wilac_factors``) into
     the columns of ``scratch`` (8 rows, at least n rounded up to a multiple of
     ``WILAC_AXLE_BLOCK`` columns: the six factors, the factor 1, the sums), then each
-    regression term by term for blocks of axles at once (``wilac_terms``, ``wilac_term``,
-    ``wilac_clip``): the loop differs from ``wilac_regression``'s (over the axles inside,
-    which the compiler vectorises, where the table of factors would otherwise be looked up
-    term by term through a jump table), the terms, their order and the clip do not.
+    regression term by term for four axles at once (``wilac_terms``, ``wilac_term``,
+    ``wilac_clip``; four sums in registers, the factors read from the rows of ``scratch`` by
+    their packed indices, where ``wilac_regression`` picks each factor of each term out of a
+    tuple through a jump table): the loop differs from ``wilac_regression``'s, the terms,
+    their order and the clip do not, and neither do the numbers.
     """
     n = wheel_loads.shape[0]
     for a in range(n):

@@ -46,7 +46,8 @@ MAX_LANES = MAX_AXLES * MAX_CONDITIONS
 #: The lanes are padded to a multiple of this (the SIMD width in doubles with AVX-512): the
 #: vectorised loop over lanes then has no scalar remainder, which costs more than the padding.
 LANE_BLOCK = 8
-#: WILAC's regressions are evaluated for this many axles at once (MAX_AXLES is a multiple).
+#: WILAC's regressions are evaluated for this many axles at once (four sums in
+#: :func:`railadhesion.braking.curves.wilac_axle_parameters`; MAX_AXLES is a multiple).
 WILAC_AXLE_BLOCK = 4
 
 # status codes returned by the step (STALE: compiled for another layout, see machine_dtype)

@@ -170,6 +170,8 @@ def polach_curve(creep, slope, inverse_mu, ratio):
     ``slope F'(x)/(1 + ratio)`` and d/d slope = ``creep F'(x)/(1 + ratio)`` with
     ``F'(x) = (1 - x**2)/(1 + x**2)**2 + ratio/(1 + (ratio x)**2)``. Written for the on-board
     monitor's estimator; compiled: :func:`railadhesion.models.kernels.polach_curve_scalar`.
+    Inlined where compiled code calls it (:func:`polach_longitudinal`, whose loops over
+    braking axles then vectorise).
     """
     z = math.pi * slope * creep / (2.0 * (1.0 + ratio))
     x = z * inverse_mu
