@@ -11,7 +11,7 @@
    driver writing into those arrays would. Real-time factor = simulated time / wall time.
    The same loop is also timed with all 8 inputs copied in every call, and with recording.
 2. The per-call cost broken into components: the Python loop, the Python side of the call
-   (the method and numba's dispatcher, measured on a stopped simulator, which returns at
+   (the method and the compiled entry point, measured on a stopped simulator, which returns at
    once), the compiled step itself (the same steps run inside one compiled loop), its
    refresh share, and the rest (the cost of entering compiled code from the interpreter:
    cold caches and branch predictors).
@@ -118,7 +118,7 @@ def empty_loop(steps):
 
 
 def python_side(steps):
-    """advance() on a stopped simulator: the method and numba's dispatcher, no step."""
+    """advance() on a stopped simulator: the method and the compiled entry point, no step."""
     sim = new_sim()
     sim._machine[0]["state"]["stopped"] = 1
     advance = sim.advance
@@ -226,7 +226,7 @@ def main() -> None:
     rest = headline - empty - side - compiled
     print("  components of one advance() call:")
     print(f"    Python loop (for, if)                     {empty * 1e9:6.0f} ns")
-    print(f"    Python side of the call (method + numba dispatcher, one buffer + dt) "
+    print(f"    Python side of the call (method + compiled entry point, one buffer + dt) "
           f"{side * 1e9:6.0f} ns")
     print(f"    compiled step (same steps in one compiled loop) {compiled * 1e9:6.0f} ns, of "
           f"which the 10 ms refresh {refresh * 1e9 / 10:.0f} ns "

@@ -1,6 +1,7 @@
 """The package's only uses of numba's private internals, isolated here on purpose.
 
-Two remain, both for ``monitor.kernel`` and ``monitor.estimator`` (every other kernel is built
+Two remain, for ``monitor.kernel`` and ``monitor.estimator``, and the second also for the
+braking simulator's stepping call ``BrakingSimulator.advance`` (every other kernel is built
 with :func:`railadhesion.numerics.jit`, whose cache directory is keyed by the kernel sources and
 needs no guard, and called through numba's public dispatcher):
 
@@ -10,7 +11,8 @@ needs no guard, and called through numba's public dispatcher):
   monitor's kernels to :func:`railadhesion.numerics.jit` makes the guard unnecessary.
 * :func:`kernel_entry` reads ``Dispatcher.overloads[types].entry_point``: calling the compiled
   entry point skips the dispatcher's type resolution of every argument on every call (numba
-  has no public equivalent short of a ``cfunc`` with a C signature for the monitor's records).
+  has no public equivalent short of a ``cfunc`` with a C signature for the monitor's records,
+  or for the buffer of ``advance``).
 
 ``tests/test_jit.py`` reads both internals from the installed numba directly and fails when
 numba changes them (the declared upper bounds on numba and llvmlite, checked by

@@ -91,6 +91,29 @@ def test_advance_equals_step_and_its_live_state_is_a_read_only_view():
     np.testing.assert_array_equal(a.vent_actions, b.vent_actions)
 
 
+def test_advance_binds_the_compiled_entry_point_on_its_first_call():
+    """advance() calls the step's compiled entry point (railadhesion._jit.kernel_entry), found
+    on the first call by a call with dt = NaN that the step refuses: that first call must
+    advance exactly once, recorded or not."""
+    from railadhesion._jit import compiled_entry
+    from railadhesion.braking import step
+
+    for record, name, dispatcher in ((False, "_advance", step.advance_builtin),
+                                     (True, "_advance_recorded",
+                                      step.advance_builtin_recorded)):
+        sim = BrakingSimulator(VEHICLE, PolachAdhesion("polach2005_dry"), 10.0,
+                               record=record)
+        stand_in = sim.__dict__[name]
+        sim.advance(1e-3)
+        assert sim.time == pytest.approx(1e-3) and sim.solver_counts["steps"] == 1
+        bound = sim.__dict__[name]
+        assert bound is not stand_in
+        args = (sim._buffer, sim._rows, 1e-3) if record else (sim._buffer, 1e-3)
+        assert bound is compiled_entry(dispatcher, args)
+        sim.advance(1e-3)
+        assert sim.time == pytest.approx(2e-3) and sim.__dict__[name] is bound
+
+
 def test_advance_checks_its_inputs_and_names_the_axle():
     sim = BrakingSimulator(VEHICLE, PolachAdhesion("polach2005_dry"), 10.0)
     sim.advance(1e-3)
@@ -150,9 +173,11 @@ def test_adhesion_available_tracking_matches_a_full_search(polach_curve):
 
 
 def test_wilac_axle_parameters_equal_the_library_regressions():
-    """Per axle, the WILAC kernel's weights and regressions; a bogie pair (same load) and
-    equal water flows reuse the axle before, and must give the same numbers."""
+    """Per axle, exactly the WILAC kernel's weights and regressions: axles evaluated four at
+    once (a vehicle of 1, 4, 5 or 12 axles: the padding of the last block must not leak), a
+    bogie pair (same load) and equal water flows (the weights reused from the axle before)."""
     from railadhesion.braking.curves import wilac_axle_parameters
+    from railadhesion.braking.records import MAX_AXLES
     from railadhesion.models.kernels import (
         pack_wilac,
         wilac_condition_parameters,
@@ -161,16 +186,22 @@ def test_wilac_axle_parameters_equal_the_library_regressions():
     from railadhesion.models.wilac import default_wilac_parameters
 
     packed = pack_wilac(default_wilac_parameters())
-    loads = np.array([36e3, 36e3, 21e3, 52e3])  # a bogie pair (reused), then distinct
-    water = np.array([12.0, 12.0, 25.0, 60.0])
-    weights, params = np.empty((4, 4)), np.empty((4, 4, 5))
-    wilac_axle_parameters(packed, loads, 31.0, water, weights, params, np.empty(7),
-                          np.empty(20))
-    ref = np.empty(20)
-    for a in range(4):
-        wilac_condition_parameters(loads[a], 31.0, packed, np.empty(7), ref)
-        np.testing.assert_array_equal(params[a].ravel(), ref)
-        np.testing.assert_array_equal(weights[a], wilac_weights_scalar(water[a], packed))
+    rng = np.random.default_rng(7)
+    cases = [(np.array([36e3, 36e3, 21e3, 52e3]), np.array([12.0, 12.0, 25.0, 60.0]), 31.0),
+             (np.array([2e3]), np.array([0.0]), 0.0),  # below the calibrated ranges
+             (np.array([36e3, 36e3, 21e3, 21e3, 3e5]), np.array([12.0, 30.0, 30.0, 50.0, 80.0]),
+              70.0),  # above them; five axles: one in a padded block
+             (rng.uniform(1e4, 8e4, MAX_AXLES), rng.uniform(0.0, 80.0, MAX_AXLES), 17.0)]
+    for loads, water, speed in cases:
+        n = loads.size
+        weights, params = np.empty((n, 4)), np.empty((n, 4, 5))
+        scratch = np.full((8, MAX_AXLES), np.nan)
+        wilac_axle_parameters(packed, loads, speed, water, weights, params, scratch)
+        ref = np.empty(20)
+        for a in range(n):
+            wilac_condition_parameters(loads[a], speed, packed, np.empty(7), ref)
+            np.testing.assert_array_equal(params[a].ravel(), ref)
+            np.testing.assert_array_equal(weights[a], wilac_weights_scalar(water[a], packed))
 
 
 def test_new_parameters_before_the_first_step_rebuild_the_simulator():

@@ -386,6 +386,7 @@ class WilacAdhesion(_PolachFamily):
 
     def prepare(self, speed, normal_loads, positions, time, dissipation=None):
         from railadhesion.braking.curves import wilac_axle_parameters
+        from railadhesion.braking.records import MAX_AXLES
 
         w = np.broadcast_to(np.asarray(self.water_flow(positions, time), float),
                             (self.n_axles,)).copy()
@@ -398,7 +399,7 @@ class WilacAdhesion(_PolachFamily):
             self.params = np.empty((n, len(WILAC_CONDITIONS), 5))
         q = np.ascontiguousarray(normal_loads, dtype=float)
         wilac_axle_parameters(self.packed, q, max(float(speed), 0.0), w, self.weights,
-                              self.params, np.empty(7), np.empty(20))
+                              self.params, np.empty((8, MAX_AXLES)))
         self.stiffness = self.contact.stiffness_over_load(q)
 
     def describe(self):

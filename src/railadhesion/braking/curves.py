@@ -16,9 +16,11 @@ three functions chosen when the step is compiled by the type of its ``aux`` argu
 
 * an integer (0): the built-in models, Polach sets on track sections or WILAC with a
   water-flow profile (``settings.model``). Each axle's curve is a weighted sum of Polach
-  curves, evaluated by :func:`railadhesion.models.kernels.polach_longitudinal` (the law and
+  curves, evaluated by :func:`railadhesion.models.polach.polach_longitudinal` (the law and
   its analytic slopes) in one loop over *lanes*, one per axle and set of non-zero weight,
-  which the compiler vectorises;
+  which the compiler vectorises: the law is the plain function, inlined into the loop with
+  the curve it calls (a call of its compiled dispatcher in the loop body would keep the
+  loop scalar);
 * a first-class function ``mu(creep >= 0, speed, wheel load) -> float`` (a user's numba law
   compiled as a C callback): its slopes by the differences of
   :class:`~railadhesion.braking.adhesion.CallableAdhesion`;
@@ -50,12 +52,17 @@ from railadhesion.braking.records import (
     PEAK_WINDOW,
     POLACH,
     TABLE,
+    WILAC_AXLE_BLOCK,
 )
 from railadhesion.contact.table import exact_table_law
-from railadhesion.models.kernels import (
-    polach_longitudinal,
-    wilac_condition_parameters,
-    wilac_weights_scalar,
+from railadhesion.models.kernels import wilac_weights_scalar
+from railadhesion.models.polach import polach_longitudinal
+from railadhesion.models.wilac_parameters import (
+    wilac_clip,
+    wilac_factors,
+    wilac_normalise,
+    wilac_term,
+    wilac_terms,
 )
 
 __all__ = ["new_workspace", "build_lanes", "evaluate_lanes", "peak_lanes", "water_flow_at",
@@ -311,11 +318,21 @@ def water_flow_at(x, values, linear, where):
 
 
 @njit(cache=True, error_model="numpy")
-def wilac_axle_parameters(packed, wheel_loads, speed, water, weights, params, factors, out):
-    """WILAC's weights (n, 4) and Polach parameters (n, 4, 5) of every axle, through the WILAC
-    kernel's functions. An axle with the same water flow (or load) as the axle before it
-    reuses that axle's weights (parameters): the two axles of a bogie share a load.
-    ``factors`` (7) and ``out`` (20): scratch."""
+def wilac_axle_parameters(packed, wheel_loads, speed, water, weights, params, scratch):
+    """WILAC's weights (n, 4) and Polach parameters (n, 4, 5) of every axle, through the
+    WILAC laws of :mod:`railadhesion.models.wilac_parameters`.
+
+    The weights: :func:`~railadhesion.models.kernels.wilac_weights_scalar` per axle (an axle
+    with the same water flow as the axle before it reuses them). The parameters: Q' and v'
+    of each axle and its regression factors (``wilac_normalise``, ``wilac_factors``) into
+    the columns of ``scratch`` (8 rows, at least n rounded up to a multiple of
+    ``WILAC_AXLE_BLOCK`` columns: the six factors, the factor 1, the sums), then each
+    regression term by term for four axles at once (``wilac_terms``, ``wilac_term``,
+    ``wilac_clip``; four sums in registers, the factors read from the rows of ``scratch`` by
+    their packed indices, where ``wilac_regression`` picks each factor of each term out of a
+    tuple through a jump table): the loop differs from ``wilac_regression``'s, the terms,
+    their order and the clip do not, and neither do the numbers.
+    """
     n = wheel_loads.shape[0]
     for a in range(n):
         if a > 0 and water[a] == water[a - 1]:
@@ -325,15 +342,31 @@ def wilac_axle_parameters(packed, wheel_loads, speed, water, weights, params, fa
             w = wilac_weights_scalar(water[a], packed)
             for i in range(4):
                 weights[a, i] = w[i]
-        if a > 0 and wheel_loads[a] == wheel_loads[a - 1]:
-            for i in range(4):
-                for j in range(5):
-                    params[a, i, j] = params[a - 1, i, j]
-            continue
-        wilac_condition_parameters(wheel_loads[a], speed, packed, factors, out)
-        for i in range(4):
-            for j in range(5):
-                params[a, i, j] = out[5 * i + j]
+    padded = (n + WILAC_AXLE_BLOCK - 1) // WILAC_AXLE_BLOCK * WILAC_AXLE_BLOCK
+    for a in range(padded):  # padding columns: the last axle's factors (finite)
+        qn, vn = wilac_normalise(wheel_loads[min(a, n - 1)], speed, packed)
+        (scratch[0, a], scratch[1, a], scratch[2, a], scratch[3, a], scratch[4, a],
+         scratch[5, a]) = wilac_factors(qn, vn)
+        scratch[6, a] = 1.0
+    for i in range(4):
+        for j in range(5):
+            first, count = wilac_terms(packed, i, j)
+            for b in range(0, padded, WILAC_AXLE_BLOCK):  # four sums in registers
+                s0 = s1 = s2 = s3 = 0.0
+                for t in range(count):
+                    p = first + 4 * t
+                    c = packed[p]
+                    fa = scratch[int(packed[p + 1])]
+                    fb = scratch[int(packed[p + 2])]
+                    fc = scratch[int(packed[p + 3])]
+                    s0 = s0 + wilac_term(c, fa[b], fb[b], fc[b])
+                    s1 = s1 + wilac_term(c, fa[b + 1], fb[b + 1], fc[b + 1])
+                    s2 = s2 + wilac_term(c, fa[b + 2], fb[b + 2], fc[b + 2])
+                    s3 = s3 + wilac_term(c, fa[b + 3], fb[b + 3], fc[b + 3])
+                scratch[7, b], scratch[7, b + 1], scratch[7, b + 2], scratch[7, b + 3] = (
+                    s0, s1, s2, s3)
+            for a in range(n):
+                params[a, i, j] = wilac_clip(scratch[7, a], packed, j)
 
 
 @njit(cache=True, error_model="numpy")
@@ -380,7 +413,7 @@ def _builtin_refresh(s, st, tables):
     c = s.curve
     wilac_axle_parameters(tables[st.wilac_at:st.wilac_at + st.wilac_count], s.wheel_load[:n],
                           max(s.speed, 0.0), s.water[:n], s.weights[:n], s.params[:n],
-                          c.wilac_factors, c.wilac_parameters)
+                          c.wilac_scratch)
     build_lanes(c, n, MAX_CONDITIONS, s.weights, s.params, s.stiffness)
 
 

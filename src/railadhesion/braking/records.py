@@ -30,8 +30,8 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = [
-    "MAX_AXLES", "MAX_CONDITIONS", "MAX_LANES", "LANE_BLOCK", "CURVE", "STATE", "SETTINGS",
-    "INPUTS",
+    "MAX_AXLES", "MAX_CONDITIONS", "MAX_LANES", "LANE_BLOCK", "WILAC_AXLE_BLOCK", "CURVE",
+    "STATE", "SETTINGS", "INPUTS",
     "machine_dtype", "history_columns", "OK", "STOPPED", "NONFINITE", "BAD_DT",
     "BAD_COMMAND", "BAD_VALVE", "ROWS_FULL", "BAD_TORQUE", "STALE", "POLACH", "WILAC", "USER",
     "PYTHON", "TABLE",
@@ -47,6 +47,9 @@ MAX_LANES = MAX_AXLES * MAX_CONDITIONS
 #: The lanes are padded to a multiple of this (the SIMD width in doubles with AVX-512): the
 #: vectorised loop over lanes then has no scalar remainder, which costs more than the padding.
 LANE_BLOCK = 8
+#: WILAC's regressions are evaluated for this many axles at once (four sums in
+#: :func:`railadhesion.braking.curves.wilac_axle_parameters`; MAX_AXLES is a multiple).
+WILAC_AXLE_BLOCK = 4
 
 # status codes returned by the step (STALE: compiled for another layout, see machine_dtype)
 OK, STOPPED, NONFINITE, BAD_DT, BAD_COMMAND, BAD_VALVE, ROWS_FULL, BAD_TORQUE, STALE = range(9)
@@ -82,7 +85,7 @@ CURVE = _record([
     ("peak_t", "f8", _A), ("peak_lo", "f8", _A), ("peak_hi", "f8", _A), ("peak_x1", "f8", _A),
     ("peak_x2", "f8", _A), ("peak_f1", "f8", _A), ("peak_f2", "f8", _A),
     ("peak_best", "f8", _A), ("peak_side", "i8", _A),
-    ("wilac_factors", "f8", (7,)), ("wilac_parameters", "f8", (20,)),
+    ("wilac_scratch", "f8", (8, MAX_AXLES)),
     ("lane_axle", "i8", _L), ("lane_weight", "f8", _L), ("lane_stiffness", "f8", _L),
     ("lane_k_a", "f8", _L), ("lane_k_s", "f8", _L), ("lane_mu0", "f8", _L),
     ("lane_a", "f8", _L), ("lane_b", "f8", _L), ("lane_creep", "f8", _L),

@@ -294,6 +294,24 @@ def _user_entries(adhesion):
     return entries
 
 
+def _entry_on_first_call(attributes: dict, name: str, dispatcher):
+    """A stand-in for the step entry ``dispatcher`` (arguments: the simulator's buffer, [its
+    rows,] dt) that, on its first call, puts the dispatcher's compiled entry point into
+    ``attributes[name]`` (:func:`railadhesion._jit.kernel_entry`; found by a call with
+    dt = NaN, which the step refuses before doing anything) and calls it: every later call
+    of ``advance()`` then skips numba's type resolution of the arguments. The arguments
+    keep their types (the simulator's own buffer and rows, dt a float)."""
+
+    def first_call(*args):
+        from railadhesion._jit import kernel_entry
+
+        entry = kernel_entry(dispatcher, (*args[:-1], math.nan))
+        attributes[name] = entry
+        return entry(*args)
+
+    return first_call
+
+
 def largest_stable_step(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float):
     """The longest step [s] the integrator accepts for this vehicle and adhesion model.
 
@@ -539,6 +557,10 @@ class BrakingSimulator:
                 lambda _, rows, dt, f=entries[1]: f(machine, tables, rows, dt, aux))
         d["_machine"], d["_tables"], d["_n"], d["_aux"] = machine, tables, n, aux
         d["_buffer"] = buffer
+        if buffer is not None:  # the compiled entry points, bound on the first call
+            step_entries = tuple(_entry_on_first_call(d, name, f) for name, f in
+                                 zip(("_advance", "_advance_recorded"), step_entries,
+                                     strict=True))
         d["_advance"], d["_advance_recorded"] = step_entries
         d["_run"], d["_available"] = entries[2:4]
         d["_model"] = model

@@ -83,19 +83,22 @@ MACHINE = machine_dtype(_wsp.SETTINGS_DTYPE, _wsp.STATE_DTYPE, _sensors.SETTINGS
 
 def _fingerprint() -> int:
     """CRC-32 of the sources the compiled step is built from (this module, the records,
-    curves, cylinders, demand, sensors and WSP modules, the model kernels) and of MACHINE."""
+    curves, cylinders, demand, sensors and WSP modules, the model kernels and the laws the
+    step inlines: Polach's, WILAC's, the falling friction, the numeric primitives) and of
+    MACHINE."""
     import zlib
     from pathlib import Path
 
-    from railadhesion import simd
+    from railadhesion import numerics, simd
     from railadhesion.braking import curves, cylinders, demand, records
     from railadhesion.contact import friction, kalker, table
-    from railadhesion.models import kernels
+    from railadhesion.models import kernels, polach, wilac_parameters
 
     crc = zlib.crc32(repr(MACHINE.descr).encode())
     for path in (records.__file__, curves.__file__, cylinders.__file__, demand.__file__,
-                 _sensors.__file__, _wsp.__file__, kernels.__file__, table.__file__,
-                 kalker.__file__, friction.__file__, simd.__file__, __file__):
+                 _sensors.__file__, _wsp.__file__, kernels.__file__, polach.__file__,
+                 wilac_parameters.__file__, table.__file__, kalker.__file__, friction.__file__,
+                 simd.__file__, numerics.__file__, __file__):
         try:
             crc = zlib.crc32(Path(path).read_bytes(), crc)
         except OSError:  # no source (an installation without .py files): the name only

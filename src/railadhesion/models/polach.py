@@ -152,7 +152,7 @@ def polach_law(creep_x, creep_y, spin, normal_force, speed, a, b, G, nu, c11, c2
                         t[5], t[6], k_A, k_S, mu0, A, B)  # fmt: skip
 
 
-@jitable
+@jitable(inline="always")
 def polach_curve(creep, slope, inverse_mu, ratio):
     """Polach's (2005) adhesion-creep curve without falling friction, and two derivatives.
 
@@ -170,6 +170,8 @@ def polach_curve(creep, slope, inverse_mu, ratio):
     ``slope F'(x)/(1 + ratio)`` and d/d slope = ``creep F'(x)/(1 + ratio)`` with
     ``F'(x) = (1 - x**2)/(1 + x**2)**2 + ratio/(1 + (ratio x)**2)``. Written for the on-board
     monitor's estimator; compiled: :func:`railadhesion.models.kernels.polach_curve_scalar`.
+    Inlined where compiled code calls it (:func:`polach_longitudinal`, whose loops over
+    braking axles then vectorise).
     """
     z = math.pi * slope * creep / (2.0 * (1.0 + ratio))
     x = z * inverse_mu
