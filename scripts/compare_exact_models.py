@@ -187,6 +187,12 @@ def main(out: Path = DEFAULT_OUT) -> None:
     ]
     lines += falling_friction_section(figdir)
     lines += poisson_section()
+    # keep the section that scripts/table_accuracy.py writes (between its markers)
+    begin = "<!-- scripts/table_accuracy.py: begin -->"
+    end = "<!-- scripts/table_accuracy.py: end -->"
+    old = out.read_text(encoding="utf-8") if out.exists() else ""
+    if begin in old and end in old:
+        lines += [begin + old.split(begin, 1)[1].split(end, 1)[0] + end, ""]
     out.write_text("\n".join(lines), encoding="utf-8")
     print("\n".join(lines))
 

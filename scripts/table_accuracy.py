@@ -2,7 +2,7 @@
 
 Usage::
 
-    PYTHONPATH=src MPLBACKEND=Agg python3 scripts/table_accuracy.py [--jobs 2] [--figure]
+    PYTHONPATH=src MPLBACKEND=Agg python3 scripts/table_accuracy.py [--jobs 2] [--write-docs]
 
 Cases: a/b x creep direction x creep magnitude x spin (normalised by tau = mu p0/G and
 c = sqrt(ab): xi' = xi/tau, eta' = eta/tau, phi' = phi c/tau), at nu = 0.25, 0.28 and 0.30.
@@ -16,9 +16,11 @@ Error: |(dFx, dFy)|/(mu Fz). It is split into
 * **nu scaling** (nu != the table's only): the latter against the solver at nu on 60 x 60.
 
 The 60 x 60 reference is cached (``--cache``, default in the temporary directory), so that a
-rebuilt table is measured again in seconds. ``--figure`` writes the map
-``docs/figures/exact_table_error_map.png`` and prints the Markdown tables of the validation
-page. Runtime: about 4 minutes on one core without the cache.
+rebuilt table is measured again in seconds. ``--write-docs`` writes the map
+``docs/figures/exact_table_error_map.png`` and the section of
+``docs/validation/exact_models.md`` between its markers. Runtime without the cache: about
+6 minutes with ``--jobs 2`` on the shared project machine (about 5 CPU minutes); with it,
+about 30 s.
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ import numpy as np
 
 from railadhesion.contact.exact import exact_rolling
 from railadhesion.contact.kalker import kalker_coefficients
-from railadhesion.contact.table import TABLE_POISSON, _load, exact_table_forces
+from railadhesion.contact.table import TABLE_POISSON, _load, build_grid, exact_table_forces
 from railadhesion.plausibility import PlausibilityWarning
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -82,16 +84,13 @@ def solve(xi, eta, phi, a, b, nu, grid, jobs=1):
     return np.concatenate(out, axis=1)
 
 
-def grid_coefficients(aob, nu, grid):
-    """The solver's own linear coefficients (C11, C22, C23) on ``grid`` at each a/b: (3, n)."""
-    out = np.empty((3, len(aob)))
-    for i, q in enumerate(aob):
-        a, b = C * math.sqrt(q), C / math.sqrt(q)
-        lin = exact_rolling([1e-6, 0, 0], [0, 1e-6, 0], [0, 0, 1e-4], FZ, a, b, 1e3,
-                            shear_modulus=G, poisson=nu, nx=grid, ny=grid)  # fmt: skip
-        out[:, i] = (-lin.fx[0] / (G * C * C * 1e-6), -lin.fy[1] / (G * C * C * 1e-6),
-                     -lin.fy[2] / (G * C**3 * 1e-4))  # fmt: skip
-    return out
+def grid_coefficients(aob, nu, nx, ny):
+    """The solver's own linear coefficients (C11, C22, C23) on nx x ny at a/b."""
+    a, b = C * math.sqrt(aob), C / math.sqrt(aob)
+    lin = exact_rolling([1e-6, 0, 0], [0, 1e-6, 0], [0, 0, 1e-4], FZ, a, b, 1e3,
+                        shear_modulus=G, poisson=nu, nx=nx, ny=ny)  # fmt: skip
+    return np.array([-lin.fx[0] / (G * C * C * 1e-6), -lin.fy[1] / (G * C * C * 1e-6),
+                     -lin.fy[2] / (G * C**3 * 1e-4)])  # fmt: skip
 
 
 def reference(cs, nu, cache: Path, jobs):
@@ -116,14 +115,22 @@ def reference(cs, nu, cache: Path, jobs):
 
 def build_grid_solution(cs, nu, d):
     """The solver on the table's build grid at the table's nu, at the creepages the table
-    interpolates: creepages scaled by Kalker's coefficient at nu over the build grid's own."""
+    interpolates: creepages scaled by Kalker's coefficient at nu over the build grid's own
+    (the build grid of each case's a/b, :func:`railadhesion.contact.table.build_grid`)."""
     aob, _, _, _, a, b, xi, eta, phi = cs.T
-    n = int(d["grid"][0])
-    uq = np.unique(aob)
-    cg = grid_coefficients(uq, float(d["poisson"]), n)
-    kn = kalker_coefficients(uq, nu)
-    s = [np.interp(aob, uq, k / cg[j]) for j, k in enumerate((kn.c11, kn.c22, kn.c23))]
-    return _solve((xi * s[0], eta * s[1], phi * s[2], a, b, float(d["poisson"]), n))
+    n, nu0 = int(d["grid"][0]), float(d["poisson"])
+    out = np.empty((2, aob.size))
+    for q in np.unique(aob):
+        i = aob == q
+        nx, ny = build_grid(q, n) if "grids" in d else (n, n)
+        k = kalker_coefficients(q, nu)
+        s = np.array([k.c11, k.c22, k.c23]) / grid_coefficients(q, nu0, nx, ny)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", PlausibilityWarning)
+            r = exact_rolling(xi[i] * s[0], eta[i] * s[1], phi[i] * s[2], FZ, a[i], b[i], MU,
+                              shear_modulus=G, poisson=nu0, nx=nx, ny=ny)  # fmt: skip
+        out[:, i] = r.fx, r.fy
+    return out
 
 
 def error(f, g):
@@ -143,7 +150,7 @@ def measure(jobs=1, cache=None, split=True):
             warnings.simplefilter("ignore", PlausibilityWarning)
             tab = np.stack(exact_table_forces(xi, eta, phi, FZ, a, b, MU, shear_modulus=G,
                                               poisson=nu)[:2])  # fmt: skip
-        e = {"total": error(tab, ref)}
+        e = {"total": error(tab, ref), "ref": ref}
         if split:
             bg = build_grid_solution(cs, nu, d)
             e["interp"] = error(tab, bg)
@@ -163,6 +170,8 @@ def report(cs, errs):
     for nu, e in errs.items():
         print(f"nu = {nu}:")
         for k, v in e.items():
+            if k == "ref":
+                continue
             i = int(np.argmax(v))
             print(f"  {k:8s} {_stats(v)}   worst: a/b {aob[i]}, dir {th[i]:.0f}, "
                   f"|creep'| {r[i]}, spin' {ph[i]}")
@@ -178,16 +187,115 @@ def report(cs, errs):
             print(f"  {q:5.2f} " + " ".join(f"{v:7.4f}" for v in row))
 
 
+BEGIN = "<!-- scripts/table_accuracy.py: begin -->"
+END = "<!-- scripts/table_accuracy.py: end -->"
+PAGE = ROOT / "docs" / "validation" / "exact_models.md"
+FIGURE = ROOT / "docs" / "figures" / "exact_table_error_map.png"
+
+
+def write_docs(cs, errs, seconds):
+    """The error map (figure) and the section of the validation page between BEGIN and END."""
+    import matplotlib.pyplot as plt
+
+    aob, th, r, ph = cs.T[:4]
+    worst = np.max([e["total"] for e in errs.values()], axis=0)  # over nu
+    fig, axes = plt.subplots(1, len(DIRECTIONS), figsize=(13, 3.6), sharey=True)
+    vmax = max(0.02, float(worst.max()))
+    for ax, d in zip(axes, DIRECTIONS, strict=True):
+        grid = np.array([[worst[(aob == q) & (th == d) & (ph == sp)].max() for sp in SPINS]
+                         for q in AOB])  # fmt: skip
+        im = ax.imshow(grid, origin="lower", cmap="viridis", vmin=0.0, vmax=vmax, aspect="auto")
+        for i in range(len(AOB)):
+            for j in range(len(SPINS)):
+                ax.text(j, i, f"{1e3 * grid[i, j]:.0f}", ha="center", va="center", fontsize=7,
+                        color="w" if grid[i, j] < 0.6 * vmax else "k")  # fmt: skip
+        ax.set_xticks(range(len(SPINS)), [f"{v:g}" for v in SPINS])
+        ax.set_yticks(range(len(AOB)), [f"{v:g}" for v in AOB])
+        ax.set_xlabel("spin φ c/τ")
+        ax.set_title(f"creep direction {d:.0f}°")
+    axes[0].set_ylabel("a/b")
+    fig.colorbar(im, ax=axes, label="max |ΔF|/(μFz)")
+    fig.suptitle("Table model against the exact solver on 60 × 60: largest error over creep "
+                 "magnitude and ν = 0.25, 0.28, 0.30 (numbers: 1e-3 μFz)", fontsize=10)  # fmt: skip
+    fig.savefig(FIGURE, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    n = len(cs)
+    lines = [
+        BEGIN,
+        "",
+        "## Table model: error map against the solver on 60 × 60",
+        "",
+        "Generated by `scripts/table_accuracy.py` (this section only). Reference: "
+        f"`exact_rolling` on {REF_GRID} × {REF_GRID} at each ν (the grid of the issue's "
+        "check against CONTACT). "
+        f"{n} cases per ν: a/b ∈ {{{', '.join(f'{v:g}' for v in AOB)}}}, creep direction "
+        f"{', '.join(f'{v:.0f}°' for v in DIRECTIONS)}, magnitude √(ξ'² + η'²) = "
+        f"{', '.join(f'{v:g}' for v in MAGNITUDES)}, spin φ' = "
+        f"{', '.join(f'{v:g}' for v in SPINS)} (ξ' = ξ/τ, φ' = φc/τ, τ = μp0/G, "
+        "c = √(ab)). Error |ΔF|/(μFz), ΔF the vector difference of (Fx, Fy); split into the "
+        "interpolation (table against the solver on its build grid at the creepages it "
+        "interpolates), the build grid (that solver against 60 × 60 at the table's ν) and "
+        "the ν scaling (creepages scaled with Kalker's coefficients, against the solver at ν).",
+        "",
+        "| ν | part | median | 95 % | max | worst case (a/b, direction, magnitude, spin) |",
+        "|---:|---|---:|---:|---:|---|",
+    ]
+    for nu, e in errs.items():
+        for k, name in (("total", "**total**"), ("interp", "interpolation"),
+                        ("grid", "build grid"), ("nuscale", "ν scaling")):  # fmt: skip
+            if k == "nuscale" and nu == TABLE_POISSON:
+                continue
+            v = e[k]
+            i = int(np.argmax(v))
+            lines.append(f"| {nu:g} | {name} | {np.median(v):.4f} | {np.percentile(v, 95):.4f}"
+                         f" | {v.max():.4f} | {aob[i]:g}, {th[i]:.0f}°, {r[i]:g}, {ph[i]:g} |")
+    lines += [
+        "",
+        "Largest total error over ν, creep direction and magnitude, by a/b and spin φ':",
+        "",
+        "| a/b | " + " | ".join(f"φ' = {v:g}" for v in SPINS) + " |",
+        "|---:|" + "---:|" * len(SPINS),
+    ]
+    for q in AOB:
+        lines.append(f"| {q:g} | " + " | ".join(
+            f"{worst[(aob == q) & (ph == sp)].max():.4f}" for sp in SPINS) + " |")  # fmt: skip
+    order = np.argsort(-worst)[:6]
+    lines += ["", "Worst cases (total error, largest over ν; exact solution on 60 × 60 at "
+              "ν = 0.28):", ""]  # fmt: skip
+    ref = errs[TABLE_POISSON]["ref"]
+    for i in order:
+        lines.append(f"* a/b = {aob[i]:g}, direction {th[i]:.0f}°, magnitude {r[i]:g}, "
+                     f"spin {ph[i]:g}: {worst[i]:.4f} μFz (Fx, Fy = {ref[0, i] / (MU * FZ):.4f}, "
+                     f"{ref[1, i] / (MU * FZ):.4f} μFz)")  # fmt: skip
+    lines += ["", "![error map](../figures/exact_table_error_map.png)", "",
+              f"(Runtime of the measurement: {seconds:.0f} s with the 60 × 60 reference "
+              "cached.)", "", END]  # fmt: skip
+    text = PAGE.read_text()
+    section = "\n".join(lines)
+    if BEGIN in text:
+        head, rest = text.split(BEGIN, 1)
+        text = head + section + rest.split(END, 1)[1]
+    else:
+        text = text.rstrip("\n") + "\n\n" + section + "\n"
+    PAGE.write_text(text)
+    print(f"wrote {FIGURE} and the section of {PAGE}")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--cache", type=Path, default=None)
     ap.add_argument("--no-split", action="store_true", help="the total error only")
+    ap.add_argument("--write-docs", action="store_true",
+                    help="write the figure and the section of the validation page")  # fmt: skip
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
     cs, errs = measure(args.jobs, args.cache, not args.no_split)
     report(cs, errs)
-    print(f"{time.perf_counter() - t0:.0f} s")
+    seconds = time.perf_counter() - t0
+    print(f"{seconds:.0f} s")
+    if args.write_docs:
+        write_docs(cs, errs, seconds)
 
 
 if __name__ == "__main__":
