@@ -652,8 +652,8 @@ def exact_table_forces(
     poisson : array_like, optional
         Combined Poisson's ratio nu [-], in [0.25, 0.30] (ValueError outside). The table is
         solved at 0.28; at another nu the creepages are scaled with Kalker's coefficients at
-        that nu (measured against the solver at 0.25 and 0.30: median <= 0.004 muQ, max
-        0.026 and 0.032 muQ, as at 0.28).
+        that nu (measured against the solver on 60 x 60 at 0.25, 0.28 and 0.30: median
+        0.0014-0.0022 muQ, max 0.013-0.016 muQ; docs/validation/exact_models.md).
     speed, friction_ratio, friction_decay : array_like, optional
         Falling friction ``mu(w) = mu [(1 - A) exp(-B w) + A]`` with ``A = friction_ratio``
         in [0, 1], ``B = friction_decay`` [s/m] >= 0 and the rolling speed V [m/s] (as in
@@ -662,8 +662,9 @@ def exact_table_forces(
         where this is meaningful). Defaults: Coulomb friction.
     kalker_correction : bool, optional
         Scale the creepages with Kalker's coefficients (default), which corrects the build
-        grid's excess stiffness (2-4 % on 20 x 20); with False, with the build grid's own
-        coefficients, so that the table reproduces the solver on its build grid.
+        grids' linear coefficients (1-3 % too stiff on 20 x 20, -1.4 to +2.5 % on the long
+        contacts' grids); with False, with the build grids' own coefficients (interpolated in
+        a/b), so that the table reproduces the solver on its build grid at the a/b nodes.
 
     Returns
     -------
