@@ -132,9 +132,9 @@ def test_property_bound_and_symmetries(xi, eta, phi, aob):
 def test_falling_friction_without_spin_against_the_exact_solver():
     # Polach's choice: one coefficient mu(V |creepage|) per contact. Without spin it stays
     # close to the exact solution with the same law (measured over 4 laws x 45 cases on
-    # 40 x 40: within 0.008 muQ median, 0.024 max; docs/validation/exact_models.md); here a
-    # few cases on the
-    # table's own grid, CONTACT's steep example law (A = 0.6, SABSH1 = 0.1 m/s at 45 m/s)
+    # 40 x 40: within 0.008 muQ median, 0.023 max; docs/validation/exact_models.md); here a
+    # few cases on the table's own build grids, CONTACT's steep example law (A = 0.6,
+    # SABSH1 = 0.1 m/s at 45 m/s)
     law = dict(speed=45.0, friction_ratio=0.6, friction_decay=math.log(2) / 0.1)
     aob = np.array([0.3, 1.0, 3.0, 1.0, 0.5, 2.0])
     a, b, tau = _contact(aob)

@@ -694,9 +694,9 @@ def exact_table_forces(
     friction_decay=)`` on 40 x 40; 135 cases each: a/b 0.2-5, creep 0.3-3 mu p0/G in three
     directions, spin 0 and +-2 mu p0/(G c); four laws from Polach's wet and dry sets to
     CONTACT's steep example; ``docs/validation/exact_models.md``): without spin within
-    0.008 muQ median and 0.024 muQ at worst for all four laws; with spin the local slip
+    0.008 muQ median and 0.023 muQ at worst for all four laws; with spin the local slip
     velocity varies over the contact, which one coefficient cannot represent: median
-    0.006-0.017 muQ and max 0.05-0.08 muQ for Polach's laws (worst on long contacts,
+    0.004-0.015 muQ and max 0.014-0.045 muQ for Polach's laws (worst on long contacts,
     a/b = 5, with large creepage and spin), median 0.03-0.05 and max 0.10-0.13 muQ for the
     steep laws (B V mu p0/G >= 0.7: the friction falls by half over a few creepage units;
     worst for small creepage with large spin). Meaningful for creepage-dominated
