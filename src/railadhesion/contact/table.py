@@ -13,13 +13,19 @@ The table (package data ``data/exact_table.npz``, built by ``scripts/build_exact
 with the exact solver) samples these functions in Kalker-scaled creepages
 ``X = 3 C11 xi'/(2 pi)``, ``Y = 3 C22 eta'/(2 pi)``, ``S = 3 C23 phi'/(2 pi)`` (linear theory
 is then ``Fx/(mu Fz) = -X``, ``Fy/(mu Fz) = -Y - S``, nearly independent of a/b) on a 4-D
-grid: log(a/b), the magnitude ``r = sqrt(X^2 + Y^2)`` through ``t = (2/pi) atan(r)``, the
-direction ``theta = atan2(Y, X)`` in [0, pi/2] and the spin through ``u = (2/pi) atan(S)``;
-other quadrants follow from the symmetries (xi, eta, phi) -> -(xi, eta, phi) (all outputs
-change sign) and (eta, phi) -> -(eta, phi) (Fy and Mz change sign). Interpolation in compiled
-code, cubic (Catmull-Rom) along every axis, with a ghost node beyond each end extrapolated
-quadratically (stored in the table as loaded). The nodes are solved with the build grid's own
-linear coefficients and looked up with Kalker's
+grid in polar coordinates of (r, S), ``r = sqrt(X^2 + Y^2)``: log(a/b), the magnitude
+``rho = sqrt(r^2 + S^2)`` through ``t = (2/pi) atan(rho)``, the creep direction
+``theta = atan2(Y, X)`` in [0, pi/2] and the spin's share ``psi = atan2(kappa S, r)``
+(``kappa = sqrt(1 + (b/a)^2)``, :func:`spin_weight`) in
+[-pi/2, pi/2] through ``u = (2/pi) psi``. Deep sliding (rho to infinity) is then one smooth
+function of (theta, psi) on the last t nodes: with separate magnitude and spin axes, large
+creepage and large spin met in a corner where the solution depends on the ratio S/r only,
+which no interpolation along the two axes can carry. Other quadrants follow from the
+symmetries (xi, eta, phi) -> -(xi, eta, phi) (all outputs change sign) and
+(eta, phi) -> -(eta, phi) (Fy and Mz change sign). Interpolation in compiled code, cubic
+(Catmull-Rom) along every axis, with a ghost node beyond each end extrapolated quadratically
+(stored in the table as loaded). The nodes are solved with the build grid's own linear
+coefficients and looked up with Kalker's
 (:func:`railadhesion.contact.kalker.kalker_coefficients`), which removes most of the grid's
 discretisation error (its excess stiffness).
 
@@ -48,6 +54,7 @@ from railadhesion._validate import (
     check_finite,
     check_nonnegative,
     check_positive,
+    check_range,
 )
 from railadhesion.contact.exact import check_friction_law
 from railadhesion.contact.friction import falling_friction_factor
@@ -82,9 +89,11 @@ TABLE_POISSON = 0.28
 #: Range of Poisson's ratio accepted (creepages scaled with Kalker's coefficients at that nu;
 #: error against the exact solver measured in docs/validation/exact_models.md).
 POISSON_MIN, POISSON_MAX = 0.25, 0.30
-#: Scale of the magnitude and spin transforms t = (2/pi) atan(r/R0), u = (2/pi) atan(S/S0).
+#: Scale of the magnitude transform t = (2/pi) atan(rho/R0).
 R0 = 1.0
-S0 = 1.0
+#: Coordinates of the table's last three axes (``coordinates`` in the package data):
+#: t of rho = |(X, Y, S)|, theta, u = psi/(pi/2) with psi = atan2(kappa S, |(X, Y)|).
+COORDINATES = "polar-kappa"
 _TWO_PI = 2.0 / math.pi
 #: a/b range of the table (outside: ValueError).
 AOB_MIN, AOB_MAX = 0.2, 5.0
@@ -93,7 +102,12 @@ BIG = 1e4
 
 
 def table_axes(n_aob=9, n_mag=29, n_dir=7, n_spin=33):
-    """Node coordinates of the table: (a/b, t, theta, u); see :func:`node_creepages`."""
+    """Node coordinates of the table: (a/b, t, theta, u); see :func:`node_creepages`. The
+    node counts are integers >= 4 (the cubic lookup needs four nodes per axis); ValueError
+    naming the count otherwise."""
+    for name, count in (("n_aob", n_aob), ("n_mag", n_mag), ("n_dir", n_dir),
+                        ("n_spin", n_spin)):  # fmt: skip
+        _check_count(count, name, 4)
     aob = np.geomspace(AOB_MIN, AOB_MAX, n_aob)
     tmag = np.linspace(0.0, 1.0, n_mag)
     theta = np.linspace(0.0, 0.5 * math.pi, n_dir)
@@ -101,20 +115,56 @@ def table_axes(n_aob=9, n_mag=29, n_dir=7, n_spin=33):
     return aob, tmag, theta, uspin
 
 
-def node_creepages(tmag, theta, uspin):
-    """Kalker-scaled (X, Y, S) at table nodes (broadcasting); |t| = 1 or |u| = 1 -> BIG.
+def build_grid(aob, n=20):
+    """Elements (nx, ny) of the build grid at a/b: n x n up to a/b = 1; for long contacts
+    more along the rolling direction, ``nx = min(2 n, round(n sqrt(a/b)))``,
+    ``ny = round(n^2/nx)`` (40 x 10 at a/b = 5), about as many elements and closer to the
+    solver on fine square-count grids (docs/validation/exact_models.md). ``aob`` in the
+    table's range, ``n`` an integer >= 4 (ValueError naming them otherwise)."""
+    _check_count(n, "n", 4)
+    aob = float(check_range(aob, "a/b", AOB_MIN, AOB_MAX))
+    if aob <= 1.0:
+        return n, n
+    nx = min(2 * n, round(n * math.sqrt(aob)))
+    return nx, round(n * n / nx)
 
-    Inverse of ``t = (2/pi) atan(r/R0)`` and ``u = (2/pi) atan(S/S0)`` (smooth and odd, so
-    that the cubic interpolation keeps linear theory at vanishing creepage and spin, with
-    nodes out to large creepages)."""
+
+def _check_count(value, name, low):
+    """ValueError naming ``name`` unless ``value`` is an integer (not bool) >= ``low``."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
+        raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
+
+
+@jitable(inline="always")
+def spin_weight(aob):
+    """Weight kappa of the Kalker-scaled spin S in the table's spin angle
+    ``psi = atan2(kappa S, r)``: ``sqrt(1 + (b/a)^2)``, about 1 for long contacts and b/a for
+    wide ones, smooth in log(a/b) (the table is interpolated along it at fixed psi). Wide
+    contacts turn from creepage- to spin-dominated sliding at small S/r (the spin slip phi y
+    reaches b while C23, hence S, is small); with kappa the spin nodes follow."""
+    return math.sqrt(1.0 + 1.0 / (aob * aob))
+
+
+def node_creepages(tmag, theta, uspin, kappa=1.0):
+    """Kalker-scaled (X, Y, S) at table nodes (broadcasting) of a contact with spin weight
+    ``kappa`` (:func:`spin_weight`); t = 1 -> rho = BIG.
+
+    Inverse of ``t = (2/pi) atan(rho/R0)`` (smooth and odd, so that the cubic interpolation
+    keeps linear theory at vanishing creepage and spin, with nodes out to large creepages)
+    and ``psi = atan2(kappa S, r) = u pi/2`` with ``rho = sqrt(r^2 + S^2)`` (module
+    docstring). ValueError naming the argument for coordinates outside the table: ``tmag``
+    in [0, 1] (a negative creepage magnitude rho has no node), ``theta`` in [0, pi/2],
+    ``uspin`` in [-1, 1], ``kappa`` >= 1."""
+    tmag = check_range(tmag, "tmag", 0.0, 1.0)
+    theta = check_range(theta, "theta", 0.0, 0.5 * math.pi)
+    uspin = check_range(uspin, "uspin", -1.0, 1.0)
+    kappa = check_range(kappa, "kappa", 1.0, math.inf, closed="left")
     tmag, theta, uspin = np.broadcast_arrays(tmag, theta, uspin)
-    r = np.where(tmag >= 1.0, BIG, R0 * np.tan(0.5 * np.pi * np.minimum(tmag, 0.999)))
-    ph = np.where(
-        np.abs(uspin) >= 1.0,
-        np.sign(uspin) * BIG,
-        S0 * np.tan(0.5 * np.pi * np.clip(uspin, -0.999, 0.999)),
-    )
-    return r * np.cos(theta), r * np.sin(theta), ph
+    rho = np.where(tmag >= 1.0, BIG, R0 * np.tan(0.5 * np.pi * np.minimum(tmag, 0.999)))
+    psi = 0.5 * np.pi * uspin
+    ang = np.arctan2(np.sin(psi), kappa * np.where(np.abs(uspin) >= 1.0, 0.0, np.cos(psi)))
+    r = rho * np.cos(ang)
+    return r * np.cos(theta), r * np.sin(theta), rho * np.sin(ang)
 
 
 def _with_ghosts(values, axes):
@@ -136,6 +186,9 @@ def _load():
     with resources.files("railadhesion").joinpath("data/exact_table.npz").open("rb") as fh:
         z = np.load(fh)
         data = {k: np.array(z[k]) for k in z.files}
+    if str(data.get("coordinates", "")) != COORDINATES:
+        raise RuntimeError(f"exact_table.npz: not a table in {COORDINATES} coordinates (rebuild "
+                           "it with scripts/build_exact_table.py)")  # fmt: skip
     axes = (np.log(data["aob"]), data["tmag"], data["theta"], data["uspin"])
     for ax in axes:  # the interpolation assumes uniform axes of at least 4 nodes
         if ax.size < 4 or not np.allclose(np.diff(ax), (ax[-1] - ax[0]) / (ax.size - 1),
@@ -234,10 +287,12 @@ def table_scaled_creepages(xi, eta, phi, fz, a, b, mu, g, fac, c11, c22, c23):
 
 
 @jitable(inline="always")
-def table_coordinates(x, y, s):
+def table_coordinates(x, y, s, kappa):
     """Table coordinates (t, theta, u) of Kalker-scaled creepages (X, Y, S), reflected into
-    X, Y >= 0, and the signs (sgn, sy) of the symmetries: (xi, eta, phi) -> -(xi, eta, phi)
-    changes every output's sign, (eta, phi) -> -(eta, phi) those of Fy and Mz."""
+    X, Y >= 0 (module docstring: t of rho = |(X, Y, S)|, theta = atan2(Y, X),
+    u = atan2(kappa S, |(X, Y)|)/(pi/2), ``kappa``: :func:`spin_weight`), and the signs
+    (sgn, sy) of the symmetries: (xi, eta, phi) -> -(xi, eta, phi) changes every output's
+    sign, (eta, phi) -> -(eta, phi) those of Fy and Mz."""
     sgn = -1.0 if x < 0.0 else 1.0
     x = sgn * x
     y = sgn * y
@@ -245,12 +300,18 @@ def table_coordinates(x, y, s):
     sy = -1.0 if y < 0.0 else 1.0
     y = sy * y
     s = sy * s
-    t = _TWO_PI * atan_nonneg(math.sqrt(x * x + y * y) / R0)
+    r = math.sqrt(x * x + y * y)
+    sa = abs(s)
+    t = _TWO_PI * atan_nonneg(math.sqrt(r * r + sa * sa) / R0)
+    sa *= kappa
     hi = max(x, y)
     lo = min(x, y)  # direction in [0, pi/2] from the smaller over the larger
     ang = atan_nonneg(lo / (hi if hi > 0.0 else 1.0))
     th = 0.5 * math.pi - ang if y > x else ang
-    u = _TWO_PI * atan_nonneg(abs(s) / S0)
+    hi = max(r, sa)
+    lo = min(r, sa)  # spin angle in [0, pi/2], likewise
+    ang = atan_nonneg(lo / (hi if hi > 0.0 else 1.0))
+    u = _TWO_PI * (0.5 * math.pi - ang if sa > r else ang)
     return t, th, -u if s < 0.0 else u, sgn, sy
 
 
@@ -314,7 +375,7 @@ def exact_table_law(xi, eta, phi, fz, a, b, mu, g, nu, speed, ratio, decay, tab,
     c11, c22, c23, _ = kalker_law(a / b, nu)
     fac = table_friction_factor(xi, eta, speed, ratio, decay)
     x, y, s, kf, c = table_scaled_creepages(xi, eta, phi, fz, a, b, mu, g, fac, c11, c22, c23)
-    t, th, u, sgn, sy = table_coordinates(x, y, s)
+    t, th, u, sgn, sy = table_coordinates(x, y, s, spin_weight(a / b))
     f0, f1, f2 = table_sums(tab, dims, strides, origin, inv_step, math.log(a / b), t, th, u)
     return table_forces(f0, f1, f2, sgn, sy, kf, c)
 
@@ -352,7 +413,8 @@ def _stage_scaled(buf, m):
             buf[5 * CHUNK + k], buf[6 * CHUNK + k], buf[7 * CHUNK + k], buf[_R_FAC * CHUNK + k],
             buf[_R_C11 * CHUNK + k], buf[(_R_C11 + 1) * CHUNK + k],
             buf[(_R_C11 + 2) * CHUNK + k])  # fmt: skip
-        t, th, u, sgn, sy = table_coordinates(x, y, s)
+        t, th, u, sgn, sy = table_coordinates(
+            x, y, s, spin_weight(buf[4 * CHUNK + k] / buf[5 * CHUNK + k]))
         buf[_R_T * CHUNK + k] = t
         buf[_R_TH * CHUNK + k] = th
         buf[_R_U * CHUNK + k] = u
@@ -590,8 +652,8 @@ def exact_table_forces(
     poisson : array_like, optional
         Combined Poisson's ratio nu [-], in [0.25, 0.30] (ValueError outside). The table is
         solved at 0.28; at another nu the creepages are scaled with Kalker's coefficients at
-        that nu (measured against the solver at 0.25 and 0.30: median <= 0.004 muQ, max
-        0.026 and 0.032 muQ, as at 0.28).
+        that nu (measured against the solver on 60 x 60 at 0.25, 0.28 and 0.30: median
+        0.0014-0.0022 muQ, max 0.013-0.016 muQ; docs/validation/exact_models.md).
     speed, friction_ratio, friction_decay : array_like, optional
         Falling friction ``mu(w) = mu [(1 - A) exp(-B w) + A]`` with ``A = friction_ratio``
         in [0, 1], ``B = friction_decay`` [s/m] >= 0 and the rolling speed V [m/s] (as in
@@ -600,8 +662,9 @@ def exact_table_forces(
         where this is meaningful). Defaults: Coulomb friction.
     kalker_correction : bool, optional
         Scale the creepages with Kalker's coefficients (default), which corrects the build
-        grid's excess stiffness (2-4 % on 20 x 20); with False, with the build grid's own
-        coefficients, so that the table reproduces the solver on its build grid.
+        grids' linear coefficients (1-3 % too stiff on 20 x 20, -1.4 to +2.5 % on the long
+        contacts' grids); with False, with the build grids' own coefficients (interpolated in
+        a/b), so that the table reproduces the solver on its build grid at the a/b nodes.
 
     Returns
     -------
@@ -631,9 +694,9 @@ def exact_table_forces(
     friction_decay=)`` on 40 x 40; 135 cases each: a/b 0.2-5, creep 0.3-3 mu p0/G in three
     directions, spin 0 and +-2 mu p0/(G c); four laws from Polach's wet and dry sets to
     CONTACT's steep example; ``docs/validation/exact_models.md``): without spin within
-    0.008 muQ median and 0.024 muQ at worst for all four laws; with spin the local slip
+    0.008 muQ median and 0.023 muQ at worst for all four laws; with spin the local slip
     velocity varies over the contact, which one coefficient cannot represent: median
-    0.006-0.017 muQ and max 0.05-0.08 muQ for Polach's laws (worst on long contacts,
+    0.004-0.015 muQ and max 0.014-0.045 muQ for Polach's laws (worst on long contacts,
     a/b = 5, with large creepage and spin), median 0.03-0.05 and max 0.10-0.13 muQ for the
     steep laws (B V mu p0/G >= 0.7: the friction falls by half over a few creepage units;
     worst for small creepage with large spin). Meaningful for creepage-dominated
@@ -745,7 +808,10 @@ def _check_inputs(values):
     check_friction_law(v, ratio, decay)
     aob = a_ / b_
     if not np.all((aob >= AOB_MIN * (1 - 1e-12)) & (aob <= AOB_MAX * (1 + 1e-12))):
-        raise ValueError(f"a/b must be in [{AOB_MIN}, {AOB_MAX}] for the table model")
+        bad = aob[~((aob >= AOB_MIN * (1 - 1e-12)) & (aob <= AOB_MAX * (1 + 1e-12)))]
+        raise ValueError(f"a/b (a over b) must be in [{AOB_MIN}, {AOB_MAX}] for the table "
+                         f"model, got {bad.ravel()[:3].tolist()}")  # fmt: skip
+
 
 
 def exact_table_arrays(aob=None):
