@@ -124,8 +124,9 @@ def polach_force(sx, sy, q, v, sc, s, eps_num, abs_syc, k_psi, epsp_num, fys_pre
     f_over_sc = _TWO_OVER_PI * qmu * (x / (1.0 + x * x) + atan_nonneg(k_s * eps)) / sc
     eps_psi = epsp_num / (k_psi * qmu)
     e2 = 1.0 + eps_psi * eps_psi  # may be inf: then F_yS = 0
-    # |psi|/s_C <= 2/a and |s_yC|/e2 is bounded: this order cannot overflow
-    fys = fys_pre * (abs_syc / e2) / e2
+    # |psi|/s_C <= 2/a and |s_yC|/e2 is bounded: this order cannot overflow. fys_pre = 0
+    # (no spin): F_yS is that zero, and a loop whose spin is 0 drops the spin term and cap
+    fys = fys_pre * (abs_syc / e2) / e2 if fys_pre != 0.0 else fys_pre
     fx = -f_over_sc * sx
     fy = -(f_over_sc * sy + fys)
     # spin cap at max(mu Q, |F of the creepage part|): removes only the overshoot of F_yS
@@ -398,6 +399,22 @@ def _polach_rows(buf, ox, oy, m):
 
 
 @jitable
+def _polach_rows_spinless(buf, ox, oy, m):
+    """:func:`_polach_rows` of a chunk without spin (psi = 0 for every contact): the same
+    law with psi = 0, whose spin term and spin cap then fold away."""
+    for k in range(m):
+        t = polach_contact_terms(
+            buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k], 0.0, buf[ROW_A * CHUNK + k],
+            buf[ROW_B * CHUNK + k], buf[ROW_G * CHUNK + k], buf[ROW_C11 * CHUNK + k],
+            buf[ROW_C22 * CHUNK + k], buf[ROW_C23 * CHUNK + k])  # fmt: skip
+        ox[k], oy[k] = polach_force(
+            buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k], buf[ROW_Q * CHUNK + k],
+            buf[ROW_V * CHUNK + k], t[0], t[1], t[2], t[3], t[4], t[5], t[6],
+            buf[_KA * CHUNK + k], buf[_KS * CHUNK + k], buf[_MU0 * CHUNK + k],
+            buf[_BA * CHUNK + k], buf[_BB * CHUNK + k])  # fmt: skip
+
+
+@jitable
 def _polach_same_shape(buf, ox, oy, m, a, b, g, c11, c22, c23):
     """:func:`_polach_rows` for a chunk whose contacts share a, b, G and Kalker's
     coefficients (given as numbers): the same law, the same operations; LLVM computes the
@@ -426,6 +443,7 @@ def _polach_chunks(sx, sy, psi, q, v, a, b, g, nu, mu0, k_a, k_s, big_a, big_b, 
     for j in range(14):
         fill_row(buf, _INPUT_ROWS[j], inputs[j], count)
     fixed, shape_ok = polach_fixed_shape(a, b, nu, buf, ROW_C11, count)
+    spinless = psi.size == 1 and psi[0] == 0.0
     nbad = 0
     for c in range(first, last):
         lo = c * CHUNK
@@ -451,6 +469,8 @@ def _polach_chunks(sx, sy, psi, q, v, a, b, g, nu, mu0, k_a, k_s, big_a, big_b, 
             _polach_same_shape(buf, ox, oy, m, buf[ROW_A * CHUNK], buf[ROW_B * CHUNK],
                                buf[ROW_G * CHUNK], buf[ROW_C11 * CHUNK], buf[ROW_C22 * CHUNK],
                                buf[ROW_C23 * CHUNK])  # fmt: skip
+        elif spinless:
+            _polach_rows_spinless(buf, ox, oy, m)
         else:
             _polach_rows(buf, ox, oy, m)
     return nbad
