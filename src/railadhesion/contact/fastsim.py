@@ -529,8 +529,9 @@ def fastsim_bound(px, py, g):
 
 # Rows of the work array of :func:`fastsim_strips` (ny values each).
 _W_PX, _W_PY, _W_DPX, _W_DPY1, _W_INC, _W_GFAC, _W_SPX, _W_SPY, _W_QPY, _W_NSLIP = range(10)
+_W_SLIP = 10  # the slip flags of the current column (1.0 or 0.0), for ``store``
 #: Rows of the work array :func:`fastsim_strips` needs.
-STRIPS_WORK_ROWS = 10
+STRIPS_WORK_ROWS = 11
 
 
 @jitable(inline="never")
@@ -549,7 +550,7 @@ def fastsim_strips(xi, eta, phi, fz, a, b, mu, l1, l2, l3, eta_j, sq, tx, gy, no
     nx = tx.size
     px, py, dpx, dpy1 = work[_W_PX], work[_W_PY], work[_W_DPX], work[_W_DPY1]
     inc, gfac, spx, spy = work[_W_INC], work[_W_GFAC], work[_W_SPX], work[_W_SPY]
-    qpy, nslip = work[_W_QPY], work[_W_NSLIP]
+    qpy, nslip, slip = work[_W_QPY], work[_W_NSLIP], work[_W_SLIP]
     phi_l3 = phi / l3
     xi_l1 = xi / l1
     eta_l2 = eta / l2
@@ -579,18 +580,20 @@ def fastsim_strips(xi, eta, phi, fz, a, b, mu, l1, l2, l3, eta_j, sq, tx, gy, no
                 inc[j] += dpy1[j]
                 px[j] += dpx[j]
                 py[j] += inc[j]
-        for j in range(ny):  # back onto the bound where |p| exceeds it (slip)
+        for j in range(ny):  # back onto the bound where |p| exceeds it (slip); vectorised
             pxj, pyj, slipping = fastsim_bound(px[j], py[j], gfac[j] * t)
-            nslip[j] += 1.0 if slipping else 0.0
+            slip[j] = 1.0 if slipping else 0.0
+            nslip[j] += slip[j]
             px[j] = pxj
             py[j] = pyj
             spx[j] += pxj
             spy[j] += pyj
             qpy[j] += spy[j]
-            if store:
-                px_out[j, i] = pxj
-                py_out[j, i] = pyj
-                slip_out[j, i] = slipping
+        if store:  # a loop of its own: a store in the loop above keeps it from vectorising
+            for j in range(ny):
+                px_out[j, i] = px[j]
+                py_out[j, i] = py[j]
+                slip_out[j, i] = slip[j] != 0.0
     dy = (2.0 / ny) * b
     sfx = 0.0
     sfy = 0.0
@@ -613,9 +616,9 @@ def fastsim_strips(xi, eta, phi, fz, a, b, mu, l1, l2, l3, eta_j, sq, tx, gy, no
 
 
 # Rows of the work array of :func:`fastsim_rectangular` (ny values each).
-_R_PX, _R_PY, _R_DPX, _R_SPX, _R_SPY, _R_SXPY, _R_NSLIP = range(7)
+_R_PX, _R_PY, _R_DPX, _R_SPX, _R_SPY, _R_SXPY, _R_NSLIP, _R_SLIP = range(8)
 #: Rows of the work array :func:`fastsim_rectangular` needs.
-RECT_WORK_ROWS = 7
+RECT_WORK_ROWS = 8
 
 
 @jitable(inline="never")
@@ -632,7 +635,7 @@ def fastsim_rectangular(xi, eta, phi, fz, a, b, mu, l1, l2, l3, scale, xh, yh, m
     nx = xh.size
     ny = yh.size
     px, py, dpx, spx = work[_R_PX], work[_R_PY], work[_R_DPX], work[_R_SPX]
-    spy, sxpy, nslip = work[_R_SPY], work[_R_SXPY], work[_R_NSLIP]
+    spy, sxpy, nslip, slip = work[_R_SPY], work[_R_SXPY], work[_R_NSLIP], work[_R_SLIP]
     dx = (2.0 * scale / nx) * a
     dy = (2.0 * scale / ny) * b
     phi_l3 = phi / l3
@@ -657,16 +660,18 @@ def fastsim_rectangular(xi, eta, phi, fz, a, b, mu, l1, l2, l3, scale, xh, yh, m
             m = mask[i, j]
             pxj, pyj, slipping = fastsim_bound((px[j] + dpx[j]) * m, (py[j] + dpy) * m,
                                                gfac * shape[i, j])  # fmt: skip
-            nslip[j] += 1.0 if slipping else 0.0
+            slip[j] = 1.0 if slipping else 0.0
+            nslip[j] += slip[j]
             px[j] = pxj
             py[j] = pyj
             spx[j] += pxj
             spy[j] += pyj
             sxpy[j] += pyj * xh[i]
-            if store:
-                px_out[j, i] = pxj
-                py_out[j, i] = pyj
-                slip_out[j, i] = slipping
+        if store:  # a loop of its own, as in fastsim_strips
+            for j in range(ny):
+                px_out[j, i] = px[j]
+                py_out[j, i] = py[j]
+                slip_out[j, i] = slip[j] != 0.0
     da = dx * dy
     sx = 0.0
     sy = 0.0

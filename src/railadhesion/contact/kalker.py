@@ -220,41 +220,54 @@ def kalker_rows(buf, ratio_row, nu_row, out_row, chunk, m):
     """Kalker's C11, C22, C23 (:func:`kalker_law`) of the m contacts of a chunk buffer (rows
     of ``chunk`` values in the 1-d ``buf``: a/b in row ``ratio_row``, nu in ``nu_row``) into
     the rows ``out_row`` to ``out_row + 2``. A lookup cache of a batch loop, not a law: each
-    distinct (a/b, nu) is looked up once (an a/b that is constant up to rounding takes a few
-    values); after :data:`_MEMO` distinct pairs the rest contact by contact. Returns False if
-    an a/b is outside [AOB_MIN, AOB_MAX] (its coefficients are then those of a/b = 1)."""
-    memo = np.empty((_MEMO, 5))
-    used = 0
-    last = -1
-    ok = True
+    distinct (a/b, nu) is looked up once and written to every contact that has it in one
+    pass over the chunk (vectorised, no branch per contact: an a/b that is constant up to
+    rounding takes a few values, in any order); after :data:`_MEMO` distinct pairs, or one
+    that fewer than :data:`_MEMO` contacts share (a/b varying), the rest contact by
+    contact. Returns False if an a/b is outside [AOB_MIN, AOB_MAX] (its coefficients are
+    then those of a/b = 1)."""
     rb, nb, ob = ratio_row * chunk, nu_row * chunk, out_row * chunk
+    ratio, nus = buf[rb : rb + m], buf[nb : nb + m]
+    c11s, c22s, c23s = buf[ob : ob + m], buf[ob + chunk : ob + chunk + m], buf[
+        ob + 2 * chunk : ob + 2 * chunk + m]  # fmt: skip
     for k in range(m):
-        r = buf[rb + k]
-        nk = buf[nb + k]
-        j = last
-        if j < 0 or not (memo[j, 0] == r and memo[j, 1] == nk):
-            j = -1
-            for e in range(used):
-                if memo[e, 0] == r and memo[e, 1] == nk:
-                    j = e
-                    break
-        if j >= 0:
-            c11, c22, c23 = memo[j, 2], memo[j, 3], memo[j, 4]
-            last = j
-        else:
+        c11s[k] = math.nan  # not looked up yet
+    ok = True
+    todo = 0  # a contact not looked up yet, or -1
+    for _ in range(_MEMO):
+        if todo < 0:
+            break
+        r0, n0 = ratio[todo], nus[todo]
+        r = r0
+        if not AOB_MIN <= r <= AOB_MAX:
+            ok = False
+            r = 1.0
+        c11, c22, c23, _ = kalker_law(r, n0)
+        nsame = 0
+        for k in range(m):  # the loads before the selects: vectorised
+            same = (ratio[k] == r0) & (nus[k] == n0)
+            old11, old22, old23 = c11s[k], c22s[k], c23s[k]
+            c11s[k] = c11 if same else old11
+            c22s[k] = c22 if same else old22
+            c23s[k] = c23 if same else old23
+            nsame += 1 if same else 0
+        if nsame < _MEMO:  # a pair this rare: a/b varies, the rest contact by contact
+            break
+        first = todo
+        todo = -1
+        for k in range(first, m):  # the next contact not looked up yet
+            if c11s[k] != c11s[k]:
+                todo = k
+                break
+    if todo < 0:
+        return ok
+    for k in range(m):  # more than _MEMO distinct pairs (or NaN): contact by contact
+        if c11s[k] != c11s[k]:
+            r = ratio[k]
             if not AOB_MIN <= r <= AOB_MAX:
                 ok = False
                 r = 1.0
-            c11, c22, c23, _ = kalker_law(r, nk)
-            if used < _MEMO:
-                memo[used, 0] = buf[rb + k]
-                memo[used, 1] = nk
-                memo[used, 2], memo[used, 3], memo[used, 4] = c11, c22, c23
-                last = used
-                used += 1
-        buf[ob + k] = c11
-        buf[ob + chunk + k] = c22
-        buf[ob + 2 * chunk + k] = c23
+            c11s[k], c22s[k], c23s[k], _ = kalker_law(r, nus[k])
     return ok
 
 

@@ -124,8 +124,9 @@ def polach_force(sx, sy, q, v, sc, s, eps_num, abs_syc, k_psi, epsp_num, fys_pre
     f_over_sc = _TWO_OVER_PI * qmu * (x / (1.0 + x * x) + atan_nonneg(k_s * eps)) / sc
     eps_psi = epsp_num / (k_psi * qmu)
     e2 = 1.0 + eps_psi * eps_psi  # may be inf: then F_yS = 0
-    # |psi|/s_C <= 2/a and |s_yC|/e2 is bounded: this order cannot overflow
-    fys = fys_pre * (abs_syc / e2) / e2
+    # |psi|/s_C <= 2/a and |s_yC|/e2 is bounded: this order cannot overflow. fys_pre = 0
+    # (no spin): F_yS is that zero, and a loop whose spin is 0 drops the spin term and cap
+    fys = fys_pre * (abs_syc / e2) / e2 if fys_pre != 0.0 else fys_pre
     fx = -f_over_sc * sx
     fy = -(f_over_sc * sy + fys)
     # spin cap at max(mu Q, |F of the creepage part|): removes only the overshoot of F_yS
@@ -350,6 +351,84 @@ def chunk_contact_terms(buf, k):
         buf[ROW_C11 * CHUNK + k], buf[ROW_C22 * CHUNK + k], buf[ROW_C23 * CHUNK + k])  # fmt: skip
 
 
+@jitable
+def row_same(buf, row, m):
+    """True if the first m values of row ``row`` of a chunk buffer are all equal
+    (vectorised)."""
+    base = row * CHUNK
+    first = buf[base]
+    ndiff = 0
+    for k in range(m):
+        ndiff += 0 if buf[base + k] == first else 1
+    return ndiff == 0
+
+
+@jitable
+def chunk_same_shape(buf, m):
+    """True if a chunk's contacts share one a, b, G and nu (rows ROW_A, ROW_B, ROW_G,
+    ROW_NU)."""
+    return (row_same(buf, ROW_A, m) and row_same(buf, ROW_B, m) and row_same(buf, ROW_G, m)
+            and row_same(buf, ROW_NU, m))  # fmt: skip
+
+
+@jitable
+def chunk_shape_coefficients(buf):
+    """Kalker's coefficients of a chunk whose contacts share one a, b and nu
+    (:func:`chunk_same_shape`): looked up once, into the first value of rows ROW_C11 to
+    ROW_C23; False if a/b is outside Kalker's range (as :func:`chunk_coefficients`)."""
+    r = buf[ROW_A * CHUNK] / buf[ROW_B * CHUNK]
+    ok = AOB_MIN <= r <= AOB_MAX
+    c11, c22, c23, _ = kalker_law(r if ok else 1.0, buf[ROW_NU * CHUNK])
+    buf[ROW_C11 * CHUNK] = c11
+    buf[ROW_C22 * CHUNK] = c22
+    buf[ROW_C23 * CHUNK] = c23
+    return ok
+
+
+@jitable
+def _polach_rows(buf, ox, oy, m):
+    """:func:`polach_law` of the m contacts of a chunk buffer (Kalker's coefficients in their
+    rows) into ox, oy: the law inlined in one loop, vectorised."""
+    for k in range(m):
+        t = chunk_contact_terms(buf, k)
+        ox[k], oy[k] = polach_force(
+            buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k], buf[ROW_Q * CHUNK + k],
+            buf[ROW_V * CHUNK + k], t[0], t[1], t[2], t[3], t[4], t[5], t[6],
+            buf[_KA * CHUNK + k], buf[_KS * CHUNK + k], buf[_MU0 * CHUNK + k],
+            buf[_BA * CHUNK + k], buf[_BB * CHUNK + k])  # fmt: skip
+
+
+@jitable
+def _polach_rows_spinless(buf, ox, oy, m):
+    """:func:`_polach_rows` of a chunk without spin (psi = 0 for every contact): the same
+    law with psi = 0, whose spin term and spin cap then fold away."""
+    for k in range(m):
+        t = polach_contact_terms(
+            buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k], 0.0, buf[ROW_A * CHUNK + k],
+            buf[ROW_B * CHUNK + k], buf[ROW_G * CHUNK + k], buf[ROW_C11 * CHUNK + k],
+            buf[ROW_C22 * CHUNK + k], buf[ROW_C23 * CHUNK + k])  # fmt: skip
+        ox[k], oy[k] = polach_force(
+            buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k], buf[ROW_Q * CHUNK + k],
+            buf[ROW_V * CHUNK + k], t[0], t[1], t[2], t[3], t[4], t[5], t[6],
+            buf[_KA * CHUNK + k], buf[_KS * CHUNK + k], buf[_MU0 * CHUNK + k],
+            buf[_BA * CHUNK + k], buf[_BB * CHUNK + k])  # fmt: skip
+
+
+@jitable
+def _polach_same_shape(buf, ox, oy, m, a, b, g, c11, c22, c23):
+    """:func:`_polach_rows` for a chunk whose contacts share a, b, G and Kalker's
+    coefficients (given as numbers): the same law, the same operations; LLVM computes the
+    parts that depend on the shape alone (K_psi with its exp, G c^3 C23, ...) once."""
+    for k in range(m):
+        t = polach_contact_terms(buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k],
+                                 buf[ROW_PSI * CHUNK + k], a, b, g, c11, c22, c23)  # fmt: skip
+        ox[k], oy[k] = polach_force(
+            buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k], buf[ROW_Q * CHUNK + k],
+            buf[ROW_V * CHUNK + k], t[0], t[1], t[2], t[3], t[4], t[5], t[6],
+            buf[_KA * CHUNK + k], buf[_KS * CHUNK + k], buf[_MU0 * CHUNK + k],
+            buf[_BA * CHUNK + k], buf[_BB * CHUNK + k])  # fmt: skip
+
+
 @kernel(nogil=True)
 def _polach_chunks(sx, sy, psi, q, v, a, b, g, nu, mu0, k_a, k_s, big_a, big_b, fx, fy, first,
                    last):  # fmt: skip
@@ -364,6 +443,7 @@ def _polach_chunks(sx, sy, psi, q, v, a, b, g, nu, mu0, k_a, k_s, big_a, big_b, 
     for j in range(14):
         fill_row(buf, _INPUT_ROWS[j], inputs[j], count)
     fixed, shape_ok = polach_fixed_shape(a, b, nu, buf, ROW_C11, count)
+    spinless = psi.size == 1 and psi[0] == 0.0
     nbad = 0
     for c in range(first, last):
         lo = c * CHUNK
@@ -374,18 +454,25 @@ def _polach_chunks(sx, sy, psi, q, v, a, b, g, nu, mu0, k_a, k_s, big_a, big_b, 
             + count_outside(big_b, NONNEGATIVE, lo, m))  # fmt: skip
         for j in range(14):
             load_row(buf, _INPUT_ROWS[j], inputs[j], lo, m)
-        ok = chunk_coefficients(buf, fixed, m) and bad == 0 and shape_ok
-        ox, oy = output_chunk(fx, fy, lo, m, ok)  # views: the loop writes the outputs directly
+        # one shape (a, b, G, nu) over the chunk: Kalker's coefficients looked up once and
+        # the loop with the shape as constants (what depends on it alone is hoisted)
+        same = chunk_same_shape(buf, m)
+        if same and not fixed:
+            coefficients_ok = chunk_shape_coefficients(buf)
+        else:
+            coefficients_ok = same or chunk_coefficients(buf, fixed, m)
+        ok = coefficients_ok and bad == 0 and shape_ok
+        ox, oy = output_chunk(fx, fy, lo, m, ok)  # views: the loops write the outputs directly
         if not ok:
             nbad += 1
-            continue
-        for k in range(m):  # the law, inlined: vectorised
-            t = chunk_contact_terms(buf, k)
-            ox[k], oy[k] = polach_force(
-                buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k], buf[ROW_Q * CHUNK + k],
-                buf[ROW_V * CHUNK + k], t[0], t[1], t[2], t[3], t[4], t[5], t[6],
-                buf[_KA * CHUNK + k], buf[_KS * CHUNK + k], buf[_MU0 * CHUNK + k],
-                buf[_BA * CHUNK + k], buf[_BB * CHUNK + k])  # fmt: skip
+        elif same:
+            _polach_same_shape(buf, ox, oy, m, buf[ROW_A * CHUNK], buf[ROW_B * CHUNK],
+                               buf[ROW_G * CHUNK], buf[ROW_C11 * CHUNK], buf[ROW_C22 * CHUNK],
+                               buf[ROW_C23 * CHUNK])  # fmt: skip
+        elif spinless:
+            _polach_rows_spinless(buf, ox, oy, m)
+        else:
+            _polach_rows(buf, ox, oy, m)
     return nbad
 
 
