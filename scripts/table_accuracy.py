@@ -112,7 +112,8 @@ def grid_coefficients(aob, nu, nx, ny):
 def reference(cs, nu, cache: Path, jobs):
     """Solver at 60 x 60 at nu; and at the table's nu with the creepages scaled by Kalker's
     coefficients at nu over those at the table's nu (the same when nu is the table's)."""
-    key = hashlib.sha1(cs.tobytes() + repr((nu, REF_GRID, TABLE_POISSON)).encode()).hexdigest()
+    tag = repr((nu, REF_GRID, TABLE_POISSON, "compliance"))
+    key = hashlib.sha1(cs.tobytes() + tag.encode()).hexdigest()
     path = cache / f"table_accuracy_{key[:16]}.npz"
     if path.exists():
         z = np.load(path)
@@ -122,7 +123,8 @@ def reference(cs, nu, cache: Path, jobs):
     if nu == TABLE_POISSON:
         scaled = ref
     else:
-        kn, k0 = kalker_coefficients(aob, nu), kalker_coefficients(aob, TABLE_POISSON)
+        kn = kalker_coefficients(aob, nu, compliance=True)
+        k0 = kalker_coefficients(aob, TABLE_POISSON, compliance=True)
         sx, sy, ss = kn.c11 / k0.c11, kn.c22 / k0.c22, kn.c23 / k0.c23
         scaled = solve(xi * sx, eta * sy, phi * ss, a, b, TABLE_POISSON, REF_GRID, jobs)
     np.savez(path, ref=ref, scaled=scaled)
@@ -139,7 +141,7 @@ def build_grid_solution(cs, nu, d):
     for q in np.unique(aob):
         i = aob == q
         nx, ny = build_grid(q, n) if "grids" in d else (n, n)
-        k = kalker_coefficients(q, nu)
+        k = kalker_coefficients(q, nu, compliance=True)
         s = np.array([k.c11, k.c22, k.c23]) / grid_coefficients(q, nu0, nx, ny)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", PlausibilityWarning)

@@ -68,12 +68,13 @@ def test_table_reproduces_solver_on_its_grid_between_nodes():
 
 @pytest.mark.parametrize("aob, tol_spin", [(0.25, 0.10), (0.8, 0.015), (1.0, 0.015), (3.0, 0.015)])
 def test_linear_theory_with_kalker_correction(aob, tol_spin):
-    # Kalker's linear coefficients at vanishing creepage (the table is scaled with them). The
-    # spin slope of narrow contacts (a/b = 0.25) is resolved only to 10 %: the spin force
-    # bends already below the first spin node there (absolute error < 0.01 mu Fz).
+    # Kalker's linear coefficients at vanishing creepage (the table is scaled with them,
+    # their compliances 1/C interpolated between the rows). The spin slope of narrow
+    # contacts (a/b = 0.25) is resolved only to 10 %: the spin force bends already below the
+    # first spin node there (absolute error < 0.01 mu Fz).
     a, b, _ = _contact(aob)
     c = math.sqrt(a * b)
-    k = kalker_coefficients(aob, 0.28)
+    k = kalker_coefficients(aob, 0.28, compliance=True)
     fx, fy, _ = exact_table_forces([1e-7, 0, 0], [0, 1e-7, 0], [0, 0, 1e-5], FZ, a, b, MU)
     assert -fx[0] / (G * c * c * 1e-7) == pytest.approx(k.c11, rel=0.015)
     assert -fy[1] / (G * c * c * 1e-7) == pytest.approx(k.c22, rel=0.015)
@@ -160,7 +161,7 @@ def test_falling_friction_limits_of_the_table():
     mu_w = MU * ((1 - ratio) * math.exp(-decay * v * 0.1) + ratio)
     assert math.hypot(fx, fy) == pytest.approx(mu_w * FZ, rel=0.005)
     # vanishing creepage: linear theory, whatever the law
-    k = kalker_coefficients(1.4, 0.28)
+    k = kalker_coefficients(1.4, 0.28, compliance=True)
     fx, _, _ = exact_table_forces(1e-7, 0.0, 0.0, FZ, a, b, MU, **law)
     assert -fx / (G * a * b * 1e-7) == pytest.approx(k.c11, rel=0.015)
     # A = 1 (or B = 0, or V = 0) is Coulomb friction
@@ -191,7 +192,7 @@ def test_poisson_range_against_the_solver(nu):
     assert err.max() < 0.03
     # linear theory with Kalker's coefficients at nu
     a1, b1, _ = _contact(0.8)
-    k = kalker_coefficients(0.8, nu)
+    k = kalker_coefficients(0.8, nu, compliance=True)
     gx, _, _ = exact_table_forces(1e-7, 0.0, 0.0, FZ, a1, b1, MU, poisson=nu)
     assert -gx / (G * a1 * b1 * 1e-7) == pytest.approx(k.c11, rel=0.015)
 

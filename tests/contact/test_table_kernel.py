@@ -48,7 +48,7 @@ def _reference(xi, eta, phi, a, b, nu=0.28):
     aob = a / b
     c = np.sqrt(a * b)
     tau = MU * 1.5 / np.pi * FZ / (a * b * G)
-    k = kalker_coefficients(aob, nu)
+    k = kalker_coefficients(aob, nu, compliance=True)  # the table's interpolation
     f = 1.5 / np.pi / tau
     x, y, s = xi * f * k.c11, eta * f * k.c22, phi * c * f * k.c23
     sgn = np.where(x < 0, -1.0, 1.0)

@@ -110,6 +110,8 @@ _COORD, _TABLE = _load_table()
 _NROW = _COORD.size  # 19
 # (19 rows, 4 coefficients, 3 nu); compiled code freezes global arrays as constants
 _ROWS = np.ascontiguousarray(np.moveaxis(_TABLE, -1, 0))
+# their reciprocals, the compliances 1/C (``kalker_law(..., compliance=True)``)
+_INV_ROWS = np.ascontiguousarray(1.0 / _ROWS)
 # C33 on the a > b branch at its last two rows (b/a = 0.1 and 0.2), per Poisson column; for
 # b/a < 0.1 C33 is extended as a power law through these two rows (after the nu interpolation).
 _C33_01 = np.ascontiguousarray(_TABLE[3, :, -1])
@@ -155,17 +157,17 @@ def kalker_asymptotes(g, nu, le):
 
 
 @jitable(inline="never")
-def kalker_law(a_over_b, nu):
+def kalker_law(a_over_b, nu, compliance=False):
     """Kalker's C11, C22, C23, C33 at a/b and Poisson's ratio nu: the law of
     :func:`kalker_coefficients` (its Notes), for one contact, without validation (a/b in
     [AOB_MIN, AOB_MAX], nu in [0, 0.5]).
 
     The table row pair is found from ``t = g`` (a <= b) or ``2 - g`` (a > b), rows 0.1 apart,
-    snapping round-off so that table points are exact; the coefficients are linear in t
-    between the rows, the parabola in 1/C across nu, and below g = 0.1 the corrected
-    asymptotes. A plain function compiled where compiled code calls it (not inlined: it is
-    large and called from several places); from Python call the compiled
-    :data:`kalker_scalar`.
+    snapping round-off so that table points are exact; between the rows the coefficients
+    are linear in t (CONTACT's interpolation) or, with ``compliance``, their reciprocals 1/C
+    are; the parabola in 1/C across nu, and below g = 0.1 the corrected asymptotes. A plain
+    function compiled where compiled code calls it (not inlined: it is large and called
+    from several places); from Python call the compiled :data:`kalker_scalar`.
     """
     le = a_over_b <= 1.0
     g = a_over_b if le else 1.0 / a_over_b
@@ -181,10 +183,15 @@ def kalker_law(a_over_b, nu):
     f = s - i
     out0 = out1 = out2 = out3 = 0.0
     for k in range(4):
-        c0 = _ROWS[i, k, 0] * (1.0 - f) + _ROWS[i + 1, k, 0] * f
-        c1 = _ROWS[i, k, 1] * (1.0 - f) + _ROWS[i + 1, k, 1] * f
-        c2 = _ROWS[i, k, 2] * (1.0 - f) + _ROWS[i + 1, k, 2] * f
-        c = _nu_blend(w0, w1, w2, c0, c1, c2)
+        if compliance:  # 1/C linear in t, then its parabola across nu
+            c = 1.0 / (w0 * (_INV_ROWS[i, k, 0] * (1.0 - f) + _INV_ROWS[i + 1, k, 0] * f)
+                       + w1 * (_INV_ROWS[i, k, 1] * (1.0 - f) + _INV_ROWS[i + 1, k, 1] * f)
+                       + w2 * (_INV_ROWS[i, k, 2] * (1.0 - f) + _INV_ROWS[i + 1, k, 2] * f))
+        else:
+            c0 = _ROWS[i, k, 0] * (1.0 - f) + _ROWS[i + 1, k, 0] * f
+            c1 = _ROWS[i, k, 1] * (1.0 - f) + _ROWS[i + 1, k, 1] * f
+            c2 = _ROWS[i, k, 2] * (1.0 - f) + _ROWS[i + 1, k, 2] * f
+            c = _nu_blend(w0, w1, w2, c0, c1, c2)
         if k == 0:
             out0 = c
         elif k == 1:
@@ -216,16 +223,16 @@ _MEMO = 8
 
 
 @jitable(inline="never")
-def kalker_rows(buf, ratio_row, nu_row, out_row, chunk, m):
-    """Kalker's C11, C22, C23 (:func:`kalker_law`) of the m contacts of a chunk buffer (rows
-    of ``chunk`` values in the 1-d ``buf``: a/b in row ``ratio_row``, nu in ``nu_row``) into
-    the rows ``out_row`` to ``out_row + 2``. A lookup cache of a batch loop, not a law: each
-    distinct (a/b, nu) is looked up once and written to every contact that has it in one
-    pass over the chunk (vectorised, no branch per contact: an a/b that is constant up to
-    rounding takes a few values, in any order); after :data:`_MEMO` distinct pairs, or one
-    that fewer than :data:`_MEMO` contacts share (a/b varying), the rest contact by
-    contact. Returns False if an a/b is outside [AOB_MIN, AOB_MAX] (its coefficients are
-    then those of a/b = 1)."""
+def kalker_rows(buf, ratio_row, nu_row, out_row, chunk, m, compliance=False):
+    """Kalker's C11, C22, C23 (:func:`kalker_law`, its ``compliance``) of the m contacts of a
+    chunk buffer (rows of ``chunk`` values in the 1-d ``buf``: a/b in row ``ratio_row``, nu in
+    ``nu_row``) into the rows ``out_row`` to ``out_row + 2``. A lookup cache of a batch loop,
+    not a law: each distinct (a/b, nu) is looked up once and written to every contact that
+    has it in one pass over the chunk (vectorised, no branch per contact: an a/b that is
+    constant up to rounding takes a few values, in any order); after :data:`_MEMO` distinct
+    pairs, or one that fewer than :data:`_MEMO` contacts share (a/b varying), the rest
+    contact by contact. Returns False if an a/b is outside [AOB_MIN, AOB_MAX] (its
+    coefficients are then those of a/b = 1)."""
     rb, nb, ob = ratio_row * chunk, nu_row * chunk, out_row * chunk
     ratio, nus = buf[rb : rb + m], buf[nb : nb + m]
     c11s, c22s, c23s = buf[ob : ob + m], buf[ob + chunk : ob + chunk + m], buf[
@@ -242,7 +249,7 @@ def kalker_rows(buf, ratio_row, nu_row, out_row, chunk, m):
         if not AOB_MIN <= r <= AOB_MAX:
             ok = False
             r = 1.0
-        c11, c22, c23, _ = kalker_law(r, n0)
+        c11, c22, c23, _ = kalker_law(r, n0, compliance)
         nsame = 0
         for k in range(m):  # the loads before the selects: vectorised
             same = (ratio[k] == r0) & (nus[k] == n0)
@@ -267,7 +274,7 @@ def kalker_rows(buf, ratio_row, nu_row, out_row, chunk, m):
             if not AOB_MIN <= r <= AOB_MAX:
                 ok = False
                 r = 1.0
-            c11s[k], c22s[k], c23s[k], _ = kalker_law(r, nus[k])
+            c11s[k], c22s[k], c23s[k], _ = kalker_law(r, nus[k], compliance)
     return ok
 
 
@@ -278,16 +285,17 @@ kalker_scalar = kernel(kalker_law)
 
 
 @kernel(nogil=True)
-def _kalker_into(a_over_b, nu, out):
+def _kalker_into(a_over_b, nu, compliance, out):
     """Kalker's coefficients of 1-d arrays a/b and nu (length n or 1) into out (4, n)."""
     sr = 1 if a_over_b.size > 1 else 0
     sn = 1 if nu.size > 1 else 0
     for i in range(out.shape[1]):
-        out[0, i], out[1, i], out[2, i], out[3, i] = kalker_law(a_over_b[i * sr], nu[i * sn])
+        out[0, i], out[1, i], out[2, i], out[3, i] = kalker_law(a_over_b[i * sr], nu[i * sn],
+                                                                compliance)
 
 
 @labelled(units="1")
-def kalker_coefficients(a_over_b, poisson) -> KalkerCoefficients:
+def kalker_coefficients(a_over_b, poisson, *, compliance: bool = False) -> KalkerCoefficients:
     """Kalker's linear-theory creepage coefficients C11, C22, C23, C33 of an elliptical contact.
 
     Parameters
@@ -298,6 +306,11 @@ def kalker_coefficients(a_over_b, poisson) -> KalkerCoefficients:
     poisson : array_like
         Poisson's ratio nu [-], in [0, 0.5] (combined value of wheel and rail, see
         :func:`railadhesion.contact.hertz.combined_elastic_constants`).
+    compliance : bool, optional
+        Interpolate the compliances 1/C, rather than C, linearly between the table's rows
+        (Notes). False (the default) is CONTACT's interpolation, which Polach's model,
+        FASTSIM and linear theory use; the table model of the exact theory
+        (:func:`railadhesion.contact.table.exact_table_forces`) uses True.
 
     Returns
     -------
@@ -312,6 +325,16 @@ def kalker_coefficients(a_over_b, poisson) -> KalkerCoefficients:
     header of ``data/kalker_coefficients.csv``). Between rows, ``C`` is linear in
     ``g = min(a/b, b/a)``; across Poisson's ratio ``1/C`` is the parabola through the columns
     ``nu = 0, 0.25, 0.5`` (as CONTACT). At the table points the table values are returned.
+
+    For long contacts C grows like ``g^-1`` (C11, C22) and ``g^-1.5`` (C23) as g = b/a
+    falls (the asymptotes below), so C linear in g overshoots between the rows: at
+    a/b = 3.94 (g = 0.254) by 1.3 % (C11, C22) and 4.3 % (C23) against the exact solver's
+    own coefficients converged on 160 x 160 elements (a measurement of this library,
+    ``scripts/table_accuracy.py``; the solver matches the rows a/b = 2.5 and 3.33 within
+    0.8 %). The compliance 1/C is nearly linear in g there: interpolated so
+    (``compliance=True``), the coefficients at a/b = 3.94 are within 0.3 % (C11, C23) and
+    0.1 % (C22) of the converged ones, and at a/b = 2.9 within 0.3 %. On the a <= b branch
+    the two interpolations differ by less than 0.1 % (C11, C22) and 0.8 % (C23).
 
     For ``g < 0.1`` Kalker's asymptotes (Kalker 1990, Table E.3, as in CONTACT ``linrol``)
     are used:
@@ -358,11 +381,13 @@ def kalker_coefficients(a_over_b, poisson) -> KalkerCoefficients:
     r = check_range(a_over_b, "a_over_b", AOB_MIN, AOB_MAX)
     nu = check_range(poisson, "poisson", 0.0, 0.5)
     if r.ndim == 0 and nu.ndim == 0:  # one contact: one compiled call
-        return KalkerCoefficients(*kalker_scalar.dispatcher(float(r), float(nu)))
+        return KalkerCoefficients(*kalker_scalar.dispatcher(float(r), float(nu),
+                                                            bool(compliance)))
     shape = np.broadcast_shapes(r.shape, nu.shape)
     coef = np.empty((4, math.prod(shape)))
     _kalker_into(*(read_only(np.ascontiguousarray(np.broadcast_to(x, shape)).reshape(-1))
-                   if x.size > 1 else read_only(x.reshape(1)) for x in (r, nu)), coef)  # fmt: skip
+                   if x.size > 1 else read_only(x.reshape(1)) for x in (r, nu)),
+                 bool(compliance), coef)  # fmt: skip
     return KalkerCoefficients(*(c.reshape(shape) for c in coef))
 
 
