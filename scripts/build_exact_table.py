@@ -2,7 +2,7 @@
 
 Usage::
 
-    PYTHONPATH=src python3 scripts/build_exact_table.py [--grid 20] [--out PATH] [--jobs 2]
+    PYTHONPATH=src python3 scripts/build_exact_table.py [--grid 24] [--out PATH] [--jobs 2]
 
 Solves Kalker's exact theory (:func:`railadhesion.contact.exact.exact_rolling`, nu = 0.28)
 at every node of :func:`railadhesion.contact.table.table_axes` in normalised form (Fz, mu, G
@@ -11,8 +11,8 @@ normalised creepages), on the build grid :func:`railadhesion.contact.table.build
 each a/b (``--grid`` n: n x n up to a/b = 1, up to 2n x n/2 for long contacts). The
 Kalker-scaled node creepages are converted with the linear coefficients of the build grid
 itself (solved first, stored as ``cgrid``). ``--jobs 2`` solves two a/b rows at a time.
-Runtime: 78 s with ``--jobs 2`` on the project machine's two cores (141 s of CPU time, load
-average about 1; docs/exact-solver.md).
+Runtime with ``--jobs 2`` on a two-core Intel Xeon at 2.5 GHz (2026-11-28): 347 s (671 s of
+CPU time) at the default ``--grid 24``, 231 s at ``--grid 20`` (docs/exact-solver.md).
 """
 
 from __future__ import annotations
@@ -29,6 +29,7 @@ import numpy as np
 from railadhesion.contact.exact import exact_rolling
 from railadhesion.contact.kalker import kalker_coefficients
 from railadhesion.contact.table import (
+    BUILD_N,
     COORDINATES,
     TABLE_POISSON,
     build_grid,
@@ -118,8 +119,8 @@ def _count(low):
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--grid", type=_count(4), default=20,
-        help="elements per axis of the build grid up to a/b = 1 (default 20)")  # fmt: skip
+    ap.add_argument("--grid", type=_count(4), default=BUILD_N,
+        help=f"elements per axis of the build grid up to a/b = 1 (default {BUILD_N})")  # fmt: skip
     ap.add_argument("--out", type=Path, default=DEFAULT_OUT)
     ap.add_argument("--jobs", type=_count(1), default=1,
                     help="processes, one a/b row each at a time (default 1)")  # fmt: skip

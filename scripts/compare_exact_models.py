@@ -176,7 +176,7 @@ def main(out: Path = DEFAULT_OUT) -> None:
         "",
         "* The table model carries the exact theory's spin effects, which Polach's closed "
         "form and FASTSIM approximate; its error is that of the interpolation plus the "
-        "build grid (20 × 20 up to a/b = 1, up to 40 × 10 for long contacts) after the "
+        "build grid (24 × 24 up to a/b = 1, up to 48 × 12 for long contacts) after the "
         "Kalker-coefficient correction. The split of the two, against the solver on 60 × 60, "
         "is the error map at the end of this page.",
         "",

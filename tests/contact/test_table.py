@@ -1,6 +1,7 @@
 """Tests of the fast exact-theory table model (railadhesion.contact.table)."""
 
 import math
+from importlib import resources
 
 import numpy as np
 import pytest
@@ -10,6 +11,7 @@ from hypothesis import strategies as st
 from railadhesion.contact import kalker_coefficients
 from railadhesion.contact.exact import exact_rolling
 from railadhesion.contact.table import (
+    BUILD_N,
     build_grid,
     exact_table_forces,
     node_creepages,
@@ -56,7 +58,7 @@ def _on_build_grid(xi, eta, phi, a, b, **kw):
 
 
 def test_table_reproduces_solver_on_its_grid_between_nodes():
-    # interpolation error only: the solver on the table's own 20 x 20 grid, random cases over
+    # interpolation error only: the solver on the table's own build grid, random cases over
     # a/b, creep direction and magnitude, spin (issue 12 target: 0.01 muQ median, 0.03 max)
     a, b, xi, eta, phi = _random_cases(seed=7)
     fx, fy, _ = exact_table_forces(xi, eta, phi, FZ, a, b, MU, kalker_correction=False)
@@ -341,7 +343,14 @@ def test_rebuild_spec_is_checked():
         build_grid(6.0)
     with pytest.raises(ValueError, match="n must be an integer"):
         build_grid(1.0, n=True)
-    assert build_grid(5.0) == (40, 10) and build_grid(0.2) == (20, 20)
+    assert build_grid(5.0, 20) == (40, 10) and build_grid(0.2, 20) == (20, 20)
+    assert build_grid(5.0) == (48, 12) and build_grid(0.2) == (24, 24)
+
+
+def test_build_grid_default_is_the_packaged_tables():
+    # the packaged table records the n it was built with (scripts/build_exact_table.py)
+    with resources.files("railadhesion").joinpath("data/exact_table.npz").open("rb") as f:
+        assert int(np.load(f)["grid"][0]) == BUILD_N
 
 
 @pytest.mark.parametrize("argv, option", [(["--grid", "2"], "--grid"),

@@ -101,6 +101,11 @@ _TWO_PI = 2.0 / math.pi
 AOB_MIN, AOB_MAX = 0.2, 5.0
 #: Finite stand-in for an infinite normalised creepage / spin at the last nodes.
 BIG = 1e4
+#: Elements per axis of the packaged table's build grids up to a/b = 1 (:func:`build_grid`;
+#: ``scripts/build_exact_table.py --grid``). 24 rather than 20 brings the worst cases (long
+#: contacts, lateral creepage against spin) closer to the converged solution, for 1.5 times
+#: the rebuild time (docs/validation/exact_models.md).
+BUILD_N = 24
 
 
 def table_axes(n_aob=9, n_mag=29, n_dir=7, n_spin=33):
@@ -117,12 +122,13 @@ def table_axes(n_aob=9, n_mag=29, n_dir=7, n_spin=33):
     return aob, tmag, theta, uspin
 
 
-def build_grid(aob, n=20):
+def build_grid(aob, n=BUILD_N):
     """Elements (nx, ny) of the build grid at a/b: n x n up to a/b = 1; for long contacts
     more along the rolling direction, ``nx = min(2 n, round(n sqrt(a/b)))``,
-    ``ny = round(n^2/nx)`` (40 x 10 at a/b = 5), about as many elements and closer to the
-    solver on fine square-count grids (docs/validation/exact_models.md). ``aob`` in the
-    table's range, ``n`` an integer >= 4 (ValueError naming them otherwise)."""
+    ``ny = round(n^2/nx)`` (48 x 12 at a/b = 5 for n = 24), about as many elements and
+    closer to the solver on fine square-count grids (docs/validation/exact_models.md).
+    ``aob`` in the table's range, ``n`` an integer >= 4 (ValueError naming them otherwise);
+    the default is the packaged table's."""
     _check_count(n, "n", 4)
     aob = float(check_range(aob, "a/b", AOB_MIN, AOB_MAX))
     if aob <= 1.0:
@@ -654,8 +660,8 @@ def exact_table_forces(
     poisson : array_like, optional
         Combined Poisson's ratio nu [-], in [0.25, 0.30] (ValueError outside). The table is
         solved at 0.28; at another nu the creepages are scaled with Kalker's coefficients at
-        that nu (measured against the solver on 60 x 60 at 0.25, 0.28 and 0.30: median
-        0.0014-0.0022 muQ, max 0.013-0.016 muQ; docs/validation/exact_models.md).
+        that nu (measured against the solver on 60 x 60 at 0.25, 0.28 and 0.30; the figures
+        are in docs/validation/exact_models.md).
     speed, friction_ratio, friction_decay : array_like, optional
         Falling friction ``mu(w) = mu [(1 - A) exp(-B w) + A]`` with ``A = friction_ratio``
         in [0, 1], ``B = friction_decay`` [s/m] >= 0 and the rolling speed V [m/s] (as in
@@ -664,7 +670,7 @@ def exact_table_forces(
         where this is meaningful). Defaults: Coulomb friction.
     kalker_correction : bool, optional
         Scale the creepages with Kalker's coefficients (default), which corrects the build
-        grids' linear coefficients (1-3 % too stiff on 20 x 20, -1.4 to +2.5 % on the long
+        grids' linear coefficients (-1.4 to +0.4 % on 24 x 24, -0.9 to +2.2 % on the long
         contacts' grids); with False, with the build grids' own coefficients (interpolated in
         a/b), so that the table reproduces the solver on its build grid at the a/b nodes.
 
