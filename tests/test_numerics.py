@@ -131,7 +131,7 @@ F64 = types.float64
 
 
 @pytest.mark.parametrize(("law", "signature"), [
-    (kalker_law, types.UniTuple(F64, 4)(F64, F64)),
+    (kalker_law, types.UniTuple(F64, 4)(F64, F64, types.boolean)),
     (falling_friction_factor, F64(F64, F64, F64)),
     (polach_contact_terms, types.UniTuple(F64, 7)(*[F64] * 9)),
     (polach_force, types.UniTuple(F64, 2)(*[F64] * 16)),

@@ -717,7 +717,7 @@ def exact_table_forces(
 
     >>> fx, fy, mz = exact_table_forces(1e-6, 0.0, 0.0, 1e5, 6e-3, 6e-3, 0.3)
     >>> round(-fx / (8.2e10 * 36e-6 * 1e-6), 2)
-    4.26
+    4.27
     """
     if kalker_correction is True and all(
         _is_real(x) for x in (creep_long, creep_lat, spin, normal_force, a, b, mu,
