@@ -183,15 +183,15 @@ def kalker_law(a_over_b, nu, compliance=False):
     f = s - i
     out0 = out1 = out2 = out3 = 0.0
     for k in range(4):
-        if compliance:  # 1/C linear in t, then its parabola across nu
-            c = 1.0 / (w0 * (_INV_ROWS[i, k, 0] * (1.0 - f) + _INV_ROWS[i + 1, k, 0] * f)
-                       + w1 * (_INV_ROWS[i, k, 1] * (1.0 - f) + _INV_ROWS[i + 1, k, 1] * f)
-                       + w2 * (_INV_ROWS[i, k, 2] * (1.0 - f) + _INV_ROWS[i + 1, k, 2] * f))
-        else:
+        if compliance:  # 1/C linear in t between the rows
+            c0 = 1.0 / (_INV_ROWS[i, k, 0] * (1.0 - f) + _INV_ROWS[i + 1, k, 0] * f)
+            c1 = 1.0 / (_INV_ROWS[i, k, 1] * (1.0 - f) + _INV_ROWS[i + 1, k, 1] * f)
+            c2 = 1.0 / (_INV_ROWS[i, k, 2] * (1.0 - f) + _INV_ROWS[i + 1, k, 2] * f)
+        else:  # C linear in t (CONTACT)
             c0 = _ROWS[i, k, 0] * (1.0 - f) + _ROWS[i + 1, k, 0] * f
             c1 = _ROWS[i, k, 1] * (1.0 - f) + _ROWS[i + 1, k, 1] * f
             c2 = _ROWS[i, k, 2] * (1.0 - f) + _ROWS[i + 1, k, 2] * f
-            c = _nu_blend(w0, w1, w2, c0, c1, c2)
+        c = _nu_blend(w0, w1, w2, c0, c1, c2)
         if k == 0:
             out0 = c
         elif k == 1:
@@ -328,13 +328,13 @@ def kalker_coefficients(a_over_b, poisson, *, compliance: bool = False) -> Kalke
 
     For long contacts C grows like ``g^-1`` (C11, C22) and ``g^-1.5`` (C23) as g = b/a
     falls (the asymptotes below), so C linear in g overshoots between the rows: at
-    a/b = 3.94 (g = 0.254) by 1.3 % (C11, C22) and 4.3 % (C23) against the exact solver's
-    own coefficients converged on 160 x 160 elements (a measurement of this library,
-    ``scripts/table_accuracy.py``; the solver matches the rows a/b = 2.5 and 3.33 within
-    0.8 %). The compliance 1/C is nearly linear in g there: interpolated so
-    (``compliance=True``), the coefficients at a/b = 3.94 are within 0.3 % (C11, C23) and
-    0.1 % (C22) of the converged ones, and at a/b = 2.9 within 0.3 %. On the a <= b branch
-    the two interpolations differ by less than 0.1 % (C11, C22) and 0.8 % (C23).
+    a/b = 3.94 (g = 0.254), nu = 0.28, by 1.3 % (C11, C22) and 4.5 % (C23) against the exact
+    solver's own coefficients converged on 160 x 160 elements (a measurement of this
+    library, ``scripts/table_accuracy.py``'s ``grid_coefficients``; the solver matches the
+    rows a/b = 2.5 and 3.33 within 0.8 %). The compliance 1/C is nearly linear in g there:
+    interpolated so (``compliance=True``), the coefficients at a/b = 3.94 are within 0.3 %
+    (C11) and 0.2 % (C22, C23) of the converged ones, and at a/b = 2.9 within 0.3 %. On the
+    a <= b branch the two interpolations differ by less than 0.1 % (C11, C22) and 0.8 % (C23).
 
     For ``g < 0.1`` Kalker's asymptotes (Kalker 1990, Table E.3, as in CONTACT ``linrol``)
     are used:
