@@ -188,16 +188,17 @@ def _stats(x):
 CONVERGED_GRIDS = (90, 120)
 
 
-def converged_check(cs, err, k, nu=TABLE_POISSON):
-    """The k cases of ``cs`` with the largest total error ``err`` (against 60 x 60) at nu,
-    against the solver extrapolated to a converged grid from :data:`CONVERGED_GRIDS`: rows
-    (case index, table - 60 x 60, table - converged, 60 x 60 - converged) in mu Fz."""
+def converged_check(cs, err, ref, k, nu=TABLE_POISSON):
+    """The k cases of ``cs`` with the largest total error ``err`` against ``ref`` (the solver
+    on 60 x 60 at nu, :func:`reference`), against the solver extrapolated to a converged
+    grid from :data:`CONVERGED_GRIDS`: rows (case index, table - 60 x 60, table - converged,
+    60 x 60 - converged) in mu Fz."""
     aob, _, _, _, a, b, xi, eta, phi = cs.T
     idx = np.argsort(-err)[:k]
     n1, n2 = CONVERGED_GRIDS
     f1 = solve(xi[idx], eta[idx], phi[idx], a[idx], b[idx], nu, n1)
     f2 = solve(xi[idx], eta[idx], phi[idx], a[idx], b[idx], nu, n2)
-    f60 = solve(xi[idx], eta[idx], phi[idx], a[idx], b[idx], nu, REF_GRID)
+    f60 = ref[:, idx]
     conv = (n2 * f2 - n1 * f1) / (n2 - n1)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PlausibilityWarning)
@@ -434,7 +435,8 @@ def main(argv=None):
             print(f"  nu = {nu}: {_stats(v)}")
     conv = None
     if args.random and args.converged:
-        rows = converged_check(rc, rnd[TABLE_POISSON], args.converged)
+        rows = converged_check(rc, rnd[TABLE_POISSON], rerrs[TABLE_POISSON]["ref"],
+                               args.converged)
         conv = (rc, rows)
         print(f"worst {args.converged} random cases at nu = {TABLE_POISSON} against the "
               "converged solver: table - 60x60, table - converged, 60x60 - converged")
