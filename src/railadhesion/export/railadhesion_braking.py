@@ -15,24 +15,10 @@ settings, ideal sensors) sets the valves, which are then outputs.
 
 from __future__ import annotations
 
-import json
 import math
-from pathlib import Path
 
-from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
+from pythonfmu import Fmi2Slave
 from pythonfmu.enums import Fmi2Status
-
-
-def _release_at_exit(resources) -> None:
-    """Avoid pythonfmu's use-after-free at exit in a Python host (railadhesion.export._host)."""
-    try:
-        from railadhesion.export._host import release_pythonfmu_state_at_exit
-    except ImportError:  # the package is missing or older: said where it is needed
-        return
-    release_pythonfmu_state_at_exit(resources)
-
-
-CONFIG_FILE = "railadhesion_fmu.json"
 
 
 class RailadhesionBraking(Fmi2Slave):
@@ -42,22 +28,18 @@ class RailadhesionBraking(Fmi2Slave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        # a Python host would otherwise risk an abort at exit in pythonfmu's binary
-        _release_at_exit(self.resources)
-        resources = Path(self.resources)
-        config = json.loads((resources / CONFIG_FILE).read_text(encoding="utf-8"))
-        self.description = config["description"]
-        self.version = config["fmu_version"]
         try:
             import numpy as np
 
             from railadhesion.braking import BrakingSimulator
             from railadhesion.braking.scenario import load_scenario
+            from railadhesion.export.slave import open_slave, register_variables
         except ImportError as exc:
             raise ImportError(
                 "the railadhesion braking FMU needs the Python package 'railadhesion' "
                 f"importable by the Python interpreter that runs the FMU: {exc}"
             ) from exc
+        resources, config = open_slave(self)  # the exit work-around, the config
         self._np = np
         scenario = load_scenario(resources / config["scenario_file"])
         self._n = scenario.vehicle.n_axles
@@ -73,21 +55,7 @@ class RailadhesionBraking(Fmi2Slave):
             refresh_period=scenario.refresh_period, record=False, wsp=wsp,
         )  # fmt: skip
         self._failed = False
-        for var in config["variables"]:
-            name = var["name"]
-            causality = Fmi2Causality[var["causality"]]
-            if causality == Fmi2Causality.output:
-                setattr(self, name, 0.0)
-                self.register_variable(
-                    Real(name, causality=causality, description=var["description"])
-                )
-                continue
-            setattr(self, name, float(var["start"]))
-            variability = Fmi2Variability.fixed if var["causality"] == "parameter" else None
-            self.register_variable(
-                Real(name, causality=causality, variability=variability,
-                     description=var["description"])
-            )  # fmt: skip
+        register_variables(self, config["variables"])
         self._publish(self._sim.state())
 
     def _publish(self, state) -> None:

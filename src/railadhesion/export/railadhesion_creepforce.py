@@ -16,24 +16,10 @@ FMU log and, at ``doStep``, a failed step (``fmi2Discard``).
 
 from __future__ import annotations
 
-import json
 import math
-from pathlib import Path
 
-from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
+from pythonfmu import Fmi2Slave
 from pythonfmu.enums import Fmi2Status
-
-
-def _release_at_exit(resources) -> None:
-    """Avoid pythonfmu's use-after-free at exit in a Python host (railadhesion.export._host)."""
-    try:
-        from railadhesion.export._host import release_pythonfmu_state_at_exit
-    except ImportError:  # the package is missing or older: said where it is needed
-        return
-    release_pythonfmu_state_at_exit(resources)
-
-
-CONFIG_FILE = "railadhesion_fmu.json"
 
 
 def _import_railadhesion():
@@ -56,17 +42,11 @@ class RailadhesionCreepForce(Fmi2Slave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        resources = Path(self.resources)
-        # a Python host would otherwise risk an abort at exit in pythonfmu's binary
-        _release_at_exit(self.resources)
-        config = json.loads((resources / CONFIG_FILE).read_text(encoding="utf-8"))
-        self.description = config["description"]
-        self.version = config["fmu_version"]
-        if config.get("license"):
-            self.license = config["license"]
         ra = _import_railadhesion()
+        from railadhesion.export.slave import open_slave, register_variables
         from railadhesion.io.paramfiles import load_parameter_file
 
+        resources, config = open_slave(self)  # the exit work-around, the config
         self._model = config["model"]
         params = load_parameter_file(resources / config["parameter_file"])
         self._params = params
@@ -90,21 +70,8 @@ class RailadhesionCreepForce(Fmi2Slave):
         self.Fy = 0.0
         self.adhesion = 0.0
         self.Mz = 0.0
-        for var in config["variables"]:
-            name = var["name"]
-            causality = Fmi2Causality[var["causality"]]
-            if causality == Fmi2Causality.output:
-                self.register_variable(
-                    Real(name, causality=causality, description=var["description"],
-                         getter=self._output_getter(name))
-                )  # fmt: skip
-                continue
-            setattr(self, name, float(var["start"]))
-            variability = Fmi2Variability.fixed if var["causality"] == "parameter" else None
-            self.register_variable(
-                Real(name, causality=causality, variability=variability,
-                     description=var["description"], setter=self._input_setter(name))
-            )  # fmt: skip
+        register_variables(self, config["variables"], getter=self._output_getter,
+                           setter=self._input_setter)  # fmt: skip
 
     # -- variable access --------------------------------------------------------------------
 

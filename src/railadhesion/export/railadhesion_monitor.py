@@ -10,21 +10,8 @@ per-sample step at ``t + h``: the outputs equal the per-sample call's with the s
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
-from pythonfmu import Fmi2Causality, Fmi2Slave, Real
-
-
-def _release_at_exit(resources) -> None:
-    """Avoid pythonfmu's use-after-free at exit in a Python host (railadhesion.export._host)."""
-    try:
-        from railadhesion.export._host import release_pythonfmu_state_at_exit
-    except ImportError:  # the package is missing or older: said where it is needed
-        return
-    release_pythonfmu_state_at_exit(resources)
-
-
-CONFIG_FILE = "railadhesion_fmu.json"
+from pythonfmu import Fmi2Slave
 
 
 class RailadhesionMonitor(Fmi2Slave):
@@ -35,19 +22,16 @@ class RailadhesionMonitor(Fmi2Slave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        _release_at_exit(self.resources)
-        resources = Path(self.resources)
-        config = json.loads((resources / CONFIG_FILE).read_text(encoding="utf-8"))
-        self.description = config["description"]
-        self.version = config["fmu_version"]
         try:
             from railadhesion.braking import load_vehicle
+            from railadhesion.export.slave import open_slave, register_variables
             from railadhesion.monitor import AdhesionMonitor, MonitorSettings
         except ImportError as exc:
             raise ImportError(
                 "the railadhesion monitor FMU needs the Python package 'railadhesion' "
                 f"importable by the Python interpreter that runs the FMU: {exc}"
             ) from exc
+        resources, config = open_slave(self)  # the exit work-around, the config
         vehicle = load_vehicle(resources / config["vehicle_file"])
         settings = MonitorSettings.from_dict(json.loads(
             (resources / config["settings_file"]).read_text(encoding="utf-8")))
@@ -56,12 +40,7 @@ class RailadhesionMonitor(Fmi2Slave):
         self._n = vehicle.n_axles
         self._pressure = config["pressure"]
         self._torque = config["torque"]
-        for var in config["variables"]:
-            name = var["name"]
-            causality = Fmi2Causality[var["causality"]]
-            setattr(self, name, float(var["start"]) if var["start"] is not None else 0.0)
-            self.register_variable(Real(name, causality=causality,
-                                        description=var["description"]))
+        register_variables(self, config["variables"])
         self._publish()
 
     def _publish(self) -> None:
