@@ -16,9 +16,23 @@ import tempfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
-from railadhesion.export.fmu import FmuVariable, build_fmu
+from railadhesion.export.fmu import (
+    RUNS_PYTHON,
+    FmuVariable,
+    build_fmu,
+    documentation_page,
+    variables_table,
+)
 
-__all__ = ["braking_fmu_variables", "build_braking_fmu", "valve_control_text"]
+__all__ = [
+    "braking_description",
+    "braking_documentation",
+    "braking_fmu_variables",
+    "build_braking_fmu",
+    "load_scenario_alone",
+    "scenario_file",
+    "valve_control_text",
+]
 
 _CONFIG_FILE = "railadhesion_fmu.json"
 _SCENARIO_FILE = "scenario.toml"
@@ -77,6 +91,61 @@ def valve_control_text(wsp: bool, own: bool) -> str:
             f"({settings}, ideal sensors) sets the valves (outputs)")
 
 
+def scenario_file(scenario) -> Path:
+    """``scenario`` (str or os.PathLike) as a path; ValueError unless it is an existing file."""
+    path = Path(scenario)
+    if not path.is_file():
+        raise ValueError(f"scenario must be an existing TOML file, got {str(path)!r}")
+    return path
+
+
+def load_scenario_alone(path: Path):
+    """The text of the scenario file ``path`` and the scenario loaded from a copy of it alone,
+    as the FMU holds it; ValueError if the copy does not load (a file it names by a relative
+    path)."""
+    from railadhesion.braking.scenario import load_scenario
+
+    text = path.read_text(encoding="utf-8")
+    with tempfile.TemporaryDirectory() as tmp:  # the copy must load on its own, as in the FMU
+        copy = Path(tmp) / _SCENARIO_FILE
+        copy.write_text(text, encoding="utf-8")
+        try:
+            loaded = load_scenario(copy)
+        except ValueError as exc:
+            raise ValueError(
+                f"scenario {str(path)!r} does not load on its own (files it names must be "
+                f"built-in names or absolute paths): {exc}"
+            ) from exc
+    return text, loaded
+
+
+def braking_description(loaded, wsp: bool, where: str) -> str:
+    """The ``description`` of a braking FMU of the scenario ``loaded``: the vehicle, the
+    scenario, what commands the valves, then ``where`` (where the FMU holds the scenario)."""
+    import railadhesion
+
+    vehicle = loaded.vehicle
+    return (
+        f"railadhesion {railadhesion.__version__}: braking vehicle '{vehicle.name}' "
+        f"({vehicle.n_axles} axles) from scenario '{loaded.name}', initial speed "
+        f"{loaded.initial_speed:g} m/s; {valve_control_text(wsp, loaded.wsp is not None)}. "
+        f"{where}"
+    )
+
+
+def braking_documentation(description, variables, text, *, native: bool) -> str:
+    """``documentation/index.html`` of a braking FMU: description, the variables and the
+    scenario's ``text``; the Python FMU also says what its host needs."""
+    esc = html.escape
+    runs = "" if native else f"<p>{RUNS_PYTHON}</p>\n"
+    return documentation_page(
+        "Braking-vehicle FMU (native)" if native else "Braking-vehicle FMU",
+        f"<p>{esc(description)}</p>\n{runs}{variables_table(variables)}\n"
+        f"<h2>Scenario</h2>\n<pre>{esc(text)}</pre>\n",
+        heading="Braking-vehicle FMU (railadhesion, native)" if native else None,
+    )
+
+
 def build_braking_fmu(out, scenario, *, wsp: bool = False) -> Path:
     """Write an FMI 2.0 co-simulation FMU of a braking vehicle (the stepping API).
 
@@ -110,30 +179,13 @@ def build_braking_fmu(out, scenario, *, wsp: bool = False) -> Path:
     with ``railadhesion`` installed.
     """
     import railadhesion
-    from railadhesion.braking.scenario import load_scenario
 
-    path = Path(scenario)
-    if not path.is_file():
-        raise ValueError(f"scenario must be an existing TOML file, got {str(path)!r}")
-    text = path.read_text(encoding="utf-8")
-    with tempfile.TemporaryDirectory() as tmp:  # the copy must load on its own, as in the FMU
-        copy = Path(tmp) / _SCENARIO_FILE
-        copy.write_text(text, encoding="utf-8")
-        try:
-            loaded = load_scenario(copy)
-        except ValueError as exc:
-            raise ValueError(
-                f"scenario {str(path)!r} does not load on its own (files it names must be "
-                f"built-in names or absolute paths): {exc}"
-            ) from exc
+    text, loaded = load_scenario_alone(scenario_file(scenario))
     vehicle = loaded.vehicle
     variables = braking_fmu_variables(vehicle.n_axles, wsp=wsp)
     sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
-    description = (
-        f"railadhesion {railadhesion.__version__}: braking vehicle '{vehicle.name}' "
-        f"({vehicle.n_axles} axles) from scenario '{loaded.name}', initial speed "
-        f"{loaded.initial_speed:g} m/s; {valve_control_text(wsp, loaded.wsp is not None)}. "
-        f"Scenario embedded as resources/{_SCENARIO_FILE} (sha256 {sha[:12]}...)."
+    description = braking_description(
+        loaded, wsp, f"Scenario embedded as resources/{_SCENARIO_FILE} (sha256 {sha[:12]}...)."
     )
     config = {
         "scenario_file": _SCENARIO_FILE,
@@ -148,18 +200,7 @@ def build_braking_fmu(out, scenario, *, wsp: bool = False) -> Path:
     prov = ET.SubElement(meta, "VehicleProvenance")
     for key, value in dict(vehicle.provenance).items():
         prov.set(str(key), str(value))
-    rows = "".join(
-        f"<tr><td>{html.escape(v.name)}</td><td>{v.causality}</td><td>{html.escape(v.unit)}"
-        f"</td><td>{html.escape(v.description)}</td></tr>" for v in variables
-    )
-    documentation = (
-        "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>Braking-vehicle FMU"
-        f"</title></head><body>\n<h1>Braking-vehicle FMU (railadhesion)</h1>\n"
-        f"<p>{html.escape(description)}</p>\n<p>Runs Python: the host needs a Python "
-        "interpreter with the railadhesion package installed.</p>\n<table border='1'>"
-        f"<tr><th>name</th><th>causality</th><th>unit</th><th>description</th></tr>{rows}"
-        f"</table>\n<h2>Scenario</h2>\n<pre>{html.escape(text)}</pre>\n</body></html>\n"
-    )
+    documentation = braking_documentation(description, variables, text, native=False)
     return build_fmu(
         Path(__file__).with_name("railadhesion_braking.py"),
         variables,

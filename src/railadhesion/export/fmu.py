@@ -44,9 +44,11 @@ __all__ = [
     "check_friction",
     "creep_force_documentation",
     "creep_force_variables",
+    "documentation_page",
     "resolve_parameters",
     "table_friction_text",
     "unit_definitions",
+    "variables_table",
 ]
 
 #: Models the creep-force FMU can wrap (``"table"``: the table model of Kalker's exact theory
@@ -615,38 +617,55 @@ def build_creep_force_fmu(
             _PARAMETER_FILE: resolved.toml,
         },
         documentation=creep_force_documentation(
-            description, resolved, variables, runs=_RUNS_PYTHON,
+            description, resolved, variables, runs=RUNS_PYTHON,
             file=f"resources/{_PARAMETER_FILE}",
         ),  # fmt: skip
         metadata=meta,
     )
 
 
-_RUNS_PYTHON = ("Runs Python: the host needs a Python interpreter with the railadhesion "
-                "package installed.")
+#: What a Python FMU's documentation says its host needs.
+RUNS_PYTHON = ("Runs Python: the host needs a Python interpreter with the railadhesion "
+               "package installed.")  # fmt: skip
+
+
+def documentation_page(title: str, body: str, heading: str | None = None) -> str:
+    """``documentation/index.html`` of an FMU: the page titled ``title``, its heading
+    (default: "``title`` (railadhesion)"), then ``body`` (HTML)."""
+    heading = heading or f"{title} (railadhesion)"
+    return (
+        f"<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>{title}</title></head>"
+        f"<body>\n<h1>{heading}</h1>\n{body}</body></html>\n"
+    )
+
+
+def variables_table(variables: Iterable[FmuVariable]) -> str:
+    """The HTML table of an FMU's variables (name, causality, unit, description)."""
+    esc = html.escape
+    rows = "".join(
+        f"<tr><td>{esc(v.name)}</td><td>{v.causality}</td><td>{esc(v.unit)}</td>"
+        f"<td>{esc(v.description)}</td></tr>"
+        for v in variables
+    )
+    return (
+        "<table border='1'><tr><th>name</th><th>causality</th><th>unit</th>"
+        f"<th>description</th></tr>{rows}</table>"
+    )
 
 
 def creep_force_documentation(description, resolved, variables, *, runs: str, file: str) -> str:
     """``documentation/index.html`` of a creep-force FMU: description, what the host needs
     (``runs``), the variables, the parameter set (held in ``file``) and its provenance."""
     esc = html.escape
-    label = resolved.label
-    rows = "".join(
-        f"<tr><td>{esc(v.name)}</td><td>{v.causality}</td><td>{esc(v.unit)}</td>"
-        f"<td>{esc(v.description)}</td></tr>"
-        for v in variables
-    )
     prov = "".join(
         f"<tr><td>{esc(k)}</td><td>{esc(str(v))}</td></tr>" for k, v in resolved.provenance.items()
     )
-    return (
-        "<!DOCTYPE html>\n<html><head><meta charset='utf-8'>"
-        f"<title>{label} creep-force FMU</title></head><body>\n"
-        f"<h1>{label} creep-force FMU (railadhesion)</h1>\n<p>{esc(description)}</p>\n"
+    return documentation_page(
+        f"{resolved.label} creep-force FMU",
+        f"<p>{esc(description)}</p>\n"
         f"<p>{esc(runs)} Sign convention: Kalker's (creepage (V - omega R)/V, braking "
         "positive; forces of the rail on the wheel oppose the creepages).</p>\n"
-        f"<h2>Variables</h2>\n<table border='1'><tr><th>name</th><th>causality</th>"
-        f"<th>unit</th><th>description</th></tr>{rows}</table>\n"
+        f"<h2>Variables</h2>\n{variables_table(variables)}\n"
         f"<h2>Parameter set '{esc(resolved.name)}'</h2>\n<p>File: {esc(file)} "
-        f"(sha256 {resolved.sha256}).</p>\n<table border='1'>{prov}</table>\n</body></html>\n"
+        f"(sha256 {resolved.sha256}).</p>\n<table border='1'>{prov}</table>\n",
     )

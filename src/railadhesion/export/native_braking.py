@@ -23,13 +23,17 @@ the physics is not retyped, and the outputs equal the stepping API's.
 from __future__ import annotations
 
 import hashlib
-import html
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from railadhesion.export.braking_fmu import braking_fmu_variables, valve_control_text
+from railadhesion.export.braking_fmu import (
+    braking_description,
+    braking_documentation,
+    braking_fmu_variables,
+    load_scenario_alone,
+    scenario_file,
+)
 from railadhesion.export.native import (
     NativeUnsupported,
     RecordVariable,
@@ -183,9 +187,7 @@ def build_native_braking_fmu(out, scenario, *, wsp: bool = False) -> Path:
     the variable); a failed step returns ``fmi2Error`` with the reason logged.
     ``fmi2GetFMUstate``/``fmi2SetFMUstate`` save and restore the whole vehicle.
     """
-    path = Path(scenario)
-    if not path.is_file():
-        raise ValueError(f"scenario must be an existing TOML file, got {str(path)!r}")
+    path = scenario_file(scenario)
     if not _generic_cpu():
         return _build_in_generic_process(out, path, wsp)
     return _build(out, path, wsp)
@@ -228,21 +230,9 @@ def _build_in_generic_process(out, path: Path, wsp: bool) -> Path:
 def _build(out, path, wsp: bool = False) -> Path:
     import railadhesion
     from railadhesion.braking import BrakingSimulator
-    from railadhesion.braking.scenario import load_scenario
     from railadhesion.braking.wsp import WheelSlideProtection
 
-    path = Path(path)
-    text = path.read_text(encoding="utf-8")
-    with tempfile.TemporaryDirectory() as tmp:  # the copy must load on its own
-        copy = Path(tmp) / _SCENARIO_FILE
-        copy.write_text(text, encoding="utf-8")
-        try:
-            loaded = load_scenario(copy)
-        except ValueError as exc:
-            raise ValueError(
-                f"scenario {str(path)!r} does not load on its own (files it names must be "
-                f"built-in names or absolute paths): {exc}"
-            ) from exc
+    text, loaded = load_scenario_alone(Path(path))
     sim = BrakingSimulator(
         loaded.vehicle, loaded.adhesion(), loaded.initial_speed, cylinders=loaded.cylinders,
         gradient=loaded.gradient, refresh_period=loaded.refresh_period, record=False,
@@ -251,25 +241,12 @@ def _build(out, path, wsp: bool = False) -> Path:
     model = braking_step_model(sim)
     vehicle = loaded.vehicle
     sha = hashlib.sha256(text.encode("utf-8")).hexdigest()
-    description = (
-        f"railadhesion {railadhesion.__version__}: braking vehicle '{vehicle.name}' "
-        f"({vehicle.n_axles} axles) from scenario '{loaded.name}', initial speed "
-        f"{loaded.initial_speed:g} m/s; {valve_control_text(wsp, loaded.wsp is not None)}. "
-        f"Native: no Python at run time. Scenario in documentation/{_SCENARIO_FILE} "
-        f"(sha256 {sha[:12]}...)."
-    )
-    rows = "".join(
-        f"<tr><td>{html.escape(rv.variable.name)}</td><td>{rv.variable.causality}</td>"
-        f"<td>{html.escape(rv.variable.unit)}</td><td>{html.escape(rv.variable.description)}"
-        "</td></tr>" for rv in model.variables
-    )
-    documentation = (
-        "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>Braking-vehicle FMU "
-        "(native)</title></head><body>\n<h1>Braking-vehicle FMU (railadhesion, native)</h1>\n"
-        f"<p>{html.escape(description)}</p>\n<table border='1'><tr><th>name</th>"
-        f"<th>causality</th><th>unit</th><th>description</th></tr>{rows}</table>\n"
-        f"<h2>Scenario</h2>\n<pre>{html.escape(text)}</pre>\n</body></html>\n"
-    )
+    description = braking_description(
+        loaded, wsp, f"Native: no Python at run time. Scenario in documentation/{_SCENARIO_FILE} "
+        f"(sha256 {sha[:12]}...).",
+    )  # fmt: skip
+    variables = [rv.variable for rv in model.variables]
+    documentation = braking_documentation(description, variables, text, native=True)
     return build_step_fmu(
         model, out,
         model_name=f"railadhesion braking vehicle '{vehicle.name}' (native)",
