@@ -25,7 +25,13 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
-from railadhesion.export.fmu import FmuVariable, build_fmu
+from railadhesion.export.fmu import (
+    RUNS_PYTHON,
+    FmuVariable,
+    build_fmu,
+    documentation_page,
+    variables_table,
+)
 
 __all__ = ["build_monitor_fmu", "build_native_monitor_fmu", "monitor_fmu_variables",
            "monitor_step_model"]
@@ -33,6 +39,25 @@ __all__ = ["build_monitor_fmu", "build_native_monitor_fmu", "monitor_fmu_variabl
 _CONFIG_FILE = "railadhesion_fmu.json"
 _VEHICLE_FILE = "vehicle.toml"
 _SETTINGS_FILE = "monitor_settings.json"
+
+
+# per-axle outputs: FMU variable prefix -> (field of the monitor's output record, unit,
+# description of axle {k}'s variable)
+_AXLE_OUTPUTS = {
+    "creep": ("creep", "1",
+              "creepage of axle {k}, (v - omega R)/v, braking > 0 (filtered, 2 Hz)"),
+    "adhesion_used": ("adhesion_used", "1",
+                      "adhesion in use by axle {k} (seed 002 eq. 10; braking > 0)"),
+    "adhesion_available": ("estimate", "1",
+                           "available adhesion of axle {k}, estimated (NaN before any estimate)"),
+    "adhesion_lower": ("lower", "1",
+                       "lower end of the band of the available adhesion of axle {k}"),
+    "adhesion_upper": ("upper", "1",
+                       "upper end of the band of axle {k} (+inf: no upper bound seen)"),
+    "level": ("level", "1", "level of axle {k}: 0 unknown, 1 normal, 2 caution, 3 low"),
+    "reason": ("reason", "1", "reason code of axle {k}'s level (see the documentation)"),
+    "level_since": ("level_since", "s", "time of the last change of axle {k}'s level"),
+}  # fmt: skip
 
 
 def monitor_fmu_variables(n_axles: int, pressure=True, torque=False) -> list[FmuVariable]:
@@ -53,24 +78,8 @@ def monitor_fmu_variables(n_axles: int, pressure=True, torque=False) -> list[Fmu
     v.append(FmuVariable("vehicle_level", "output", "1",
                          "most severe axle level: 0 unknown, 1 normal, 2 caution, 3 low"))
     for k in range(1, n_axles + 1):
-        v += [
-            FmuVariable(f"creep_{k}", "output", "1",
-                        f"creepage of axle {k}, (v - omega R)/v, braking > 0 (filtered, 2 Hz)"),
-            FmuVariable(f"adhesion_used_{k}", "output", "1",
-                        f"adhesion in use by axle {k} (seed 002 eq. 10; braking > 0)"),
-            FmuVariable(f"adhesion_available_{k}", "output", "1",
-                        f"available adhesion of axle {k}, estimated (NaN before any estimate)"),
-            FmuVariable(f"adhesion_lower_{k}", "output", "1",
-                        f"lower end of the band of the available adhesion of axle {k}"),
-            FmuVariable(f"adhesion_upper_{k}", "output", "1",
-                        f"upper end of the band of axle {k} (+inf: no upper bound seen)"),
-            FmuVariable(f"level_{k}", "output", "1",
-                        f"level of axle {k}: 0 unknown, 1 normal, 2 caution, 3 low"),
-            FmuVariable(f"reason_{k}", "output", "1",
-                        f"reason code of axle {k}'s level (see the documentation)"),
-            FmuVariable(f"level_since_{k}", "output", "s",
-                        f"time of the last change of axle {k}'s level"),
-        ]
+        v += [FmuVariable(f"{name}_{k}", "output", unit, text.format(k=k))
+              for name, (_, unit, text) in _AXLE_OUTPUTS.items()]  # fmt: skip
     return v
 
 
@@ -151,19 +160,14 @@ def _documentation(description, variables, settings_text) -> str:
     from railadhesion.monitor.layout import REASONS
 
     esc = html.escape
-    rows = "".join(f"<tr><td>{esc(v.name)}</td><td>{v.causality}</td><td>{esc(v.unit)}</td>"
-                   f"<td>{esc(v.description)}</td></tr>" for v in variables)
     reasons = "".join(f"<tr><td>{code}</td><td>{esc(label)}</td><td>{esc(text)}</td></tr>"
                       for code, (label, text) in sorted(REASONS.items()))
-    return (
-        "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>Adhesion monitor FMU"
-        "</title></head><body>\n<h1>Adhesion monitor FMU (railadhesion)</h1>\n"
-        f"<p>{esc(description)}</p>\n<p>Runs Python: the host needs a Python interpreter with "
-        "the railadhesion package installed.</p>\n<table border='1'><tr><th>name</th>"
-        f"<th>causality</th><th>unit</th><th>description</th></tr>{rows}</table>\n"
+    return documentation_page(
+        "Adhesion monitor FMU",
+        f"<p>{esc(description)}</p>\n<p>{RUNS_PYTHON}</p>\n{variables_table(variables)}\n"
         "<h2>Reason codes</h2>\n<table border='1'><tr><th>code</th><th>label</th>"
         f"<th>sentence (its values v1, v2)</th></tr>{reasons}</table>\n"
-        f"<h2>Settings</h2>\n<pre>{esc(settings_text)}</pre>\n</body></html>\n"
+        f"<h2>Settings</h2>\n<pre>{esc(settings_text)}</pre>\n",
     )
 
 
@@ -208,12 +212,6 @@ def _native_step(state_t, config_t, inputs_t, n_axles):
     return step
 
 
-_NATIVE_OUTPUTS = {"creep": "creep", "adhesion_used": "adhesion_used",
-                   "adhesion_available": "estimate", "adhesion_lower": "lower",
-                   "adhesion_upper": "upper", "level": "level", "reason": "reason",
-                   "level_since": "level_since"}
-
-
 def monitor_step_model(vehicle="coach_default", settings=None, *, pressure=True,
                        torque=False):
     """The monitor as a :class:`railadhesion.export.native.StepModel` (for
@@ -246,7 +244,7 @@ def monitor_step_model(vehicle="coach_default", settings=None, *, pressure=True,
             rv.append(RecordVariable(v, "out.vehicle_level"))
         else:
             field, k = name.rsplit("_", 1)
-            rv.append(RecordVariable(v, f"out.{_NATIVE_OUTPUTS[field]}", (int(k) - 1,)))
+            rv.append(RecordVariable(v, f"out.{_AXLE_OUTPUTS[field][0]}", (int(k) - 1,)))
     return StepModel(identifier="railadhesion_monitor",
                      step=_native_step(state_t, config.dtype, inputs_t, n), state=state,
                      settings=config, inputs=np.zeros(1, inputs_t), variables=rv)
