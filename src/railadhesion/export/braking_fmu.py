@@ -23,6 +23,7 @@ from railadhesion.export.fmu import (
     documentation_page,
     variables_table,
 )
+from railadhesion.export.slave import CONFIG_FILE
 
 __all__ = [
     "braking_description",
@@ -34,7 +35,6 @@ __all__ = [
     "valve_control_text",
 ]
 
-_CONFIG_FILE = "railadhesion_fmu.json"
 _SCENARIO_FILE = "scenario.toml"
 
 
@@ -205,7 +205,7 @@ def build_braking_fmu(out, scenario, *, wsp: bool = False) -> Path:
         Path(__file__).with_name("railadhesion_braking.py"),
         variables,
         out,
-        resources={_CONFIG_FILE: json.dumps(config, indent=2), _SCENARIO_FILE: text},
+        resources={CONFIG_FILE: json.dumps(config, indent=2), _SCENARIO_FILE: text},
         documentation=documentation,
         metadata=meta,
     )

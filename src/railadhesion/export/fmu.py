@@ -32,6 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
+from railadhesion.export.slave import CONFIG_FILE
 from railadhesion.plausibility import check_plausible
 
 __all__ = [
@@ -74,7 +75,6 @@ UNIT_DEFINITIONS: dict[str, dict[str, str]] = {
 }
 
 _CAUSALITIES = ("input", "output", "parameter")
-_CONFIG_FILE = "railadhesion_fmu.json"
 _PARAMETER_FILE = "parameters.toml"
 
 
@@ -613,7 +613,7 @@ def build_creep_force_fmu(
         variables,
         out,
         resources={
-            _CONFIG_FILE: json.dumps(config, indent=2),
+            CONFIG_FILE: json.dumps(config, indent=2),
             _PARAMETER_FILE: resolved.toml,
         },
         documentation=creep_force_documentation(

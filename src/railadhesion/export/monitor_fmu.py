@@ -32,11 +32,11 @@ from railadhesion.export.fmu import (
     documentation_page,
     variables_table,
 )
+from railadhesion.export.slave import CONFIG_FILE
 
 __all__ = ["build_monitor_fmu", "build_native_monitor_fmu", "monitor_fmu_variables",
            "monitor_step_model"]
 
-_CONFIG_FILE = "railadhesion_fmu.json"
 _VEHICLE_FILE = "vehicle.toml"
 _SETTINGS_FILE = "monitor_settings.json"
 
@@ -150,7 +150,7 @@ def build_monitor_fmu(out, vehicle="coach_default", settings=None, *, pressure=T
                                   "railadhesionVersion": railadhesion.__version__})
     return build_fmu(
         Path(__file__).with_name("railadhesion_monitor.py"), variables, out,
-        resources={_CONFIG_FILE: json.dumps(config, indent=2), _VEHICLE_FILE: vehicle_text,
+        resources={CONFIG_FILE: json.dumps(config, indent=2), _VEHICLE_FILE: vehicle_text,
                    _SETTINGS_FILE: settings_text},
         documentation=_documentation(description, variables, settings_text), metadata=meta,
     )
