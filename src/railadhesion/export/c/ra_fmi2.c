@@ -140,6 +140,22 @@ static int wrong_phase(Instance *c, const char *function, unsigned allowed) {
     return 1;
 }
 
+/* The instance, if it is one and in an allowed phase (else NULL, the wrong phase logged). */
+static Instance *instance_in(fmi2Component component, const char *function, unsigned allowed) {
+    Instance *c = instance(component);
+    if (c == NULL || wrong_phase(c, function, allowed)) return NULL;
+    return c;
+}
+
+/* Moves the instance from an allowed phase to the phase ``to``. */
+static fmi2Status change_phase(fmi2Component component, const char *function,
+                               unsigned allowed, int to) {
+    Instance *c = instance_in(component, function, allowed);
+    if (c == NULL) return fmi2Error;
+    c->now.phase = to;
+    return fmi2OK;
+}
+
 static void *field(Snapshot *s, const ra_variable *v) {
     char *base = v->record == RA_STATE      ? (char *)&s->state
                  : v->record == RA_SETTINGS ? (char *)&s->settings
@@ -311,10 +327,9 @@ void fmi2FreeInstance(fmi2Component component) {
 fmi2Status fmi2SetupExperiment(fmi2Component component, fmi2Boolean toleranceDefined,
                                fmi2Real tolerance, fmi2Real startTime,
                                fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
-    Instance *c = instance(component);
+    Instance *c = instance_in(component, "fmi2SetupExperiment", IN_INSTANTIATED);
     (void)toleranceDefined, (void)tolerance, (void)stopTimeDefined, (void)stopTime;
     if (c == NULL) return fmi2Error;
-    if (wrong_phase(c, "fmi2SetupExperiment", IN_INSTANTIATED)) return fmi2Error;
     if (!isfinite(startTime))
         return fail(c, "fmi2SetupExperiment: startTime = %g is not finite", startTime);
     c->now.time = startTime;
@@ -322,17 +337,13 @@ fmi2Status fmi2SetupExperiment(fmi2Component component, fmi2Boolean toleranceDef
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component component) {
-    Instance *c = instance(component);
-    if (c == NULL) return fmi2Error;
-    if (wrong_phase(c, "fmi2EnterInitializationMode", IN_INSTANTIATED)) return fmi2Error;
-    c->now.phase = PHASE_INITIALIZATION;
-    return fmi2OK;
+    return change_phase(component, "fmi2EnterInitializationMode", IN_INSTANTIATED,
+                        PHASE_INITIALIZATION);
 }
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component component) {
-    Instance *c = instance(component);
+    Instance *c = instance_in(component, "fmi2ExitInitializationMode", IN_INITIALIZATION);
     if (c == NULL) return fmi2Error;
-    if (wrong_phase(c, "fmi2ExitInitializationMode", IN_INITIALIZATION)) return fmi2Error;
 #if RA_HAS_INIT
     {
         int code = RA_INIT(&c->now.state, &c->now.settings, &c->now.inputs);
@@ -351,11 +362,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component component) {
 }
 
 fmi2Status fmi2Terminate(fmi2Component component) {
-    Instance *c = instance(component);
-    if (c == NULL) return fmi2Error;
-    if (wrong_phase(c, "fmi2Terminate", IN_STEPPING | IN_ERROR)) return fmi2Error;
-    c->now.phase = PHASE_TERMINATED;
-    return fmi2OK;
+    return change_phase(component, "fmi2Terminate", IN_STEPPING | IN_ERROR, PHASE_TERMINATED);
 }
 
 fmi2Status fmi2Reset(fmi2Component component) {
@@ -369,11 +376,10 @@ fmi2Status fmi2Reset(fmi2Component component) {
 
 fmi2Status fmi2SetReal(fmi2Component component, const fmi2ValueReference vr[], size_t nvr,
                        const fmi2Real value[]) {
-    Instance *c = instance(component);
+    Instance *c = instance_in(component, "fmi2SetReal",
+                              IN_INSTANTIATED | IN_INITIALIZATION | IN_STEPPING);
     size_t i;
     if (c == NULL) return fmi2Error;
-    if (wrong_phase(c, "fmi2SetReal", IN_INSTANTIATED | IN_INITIALIZATION | IN_STEPPING))
-        return fmi2Error;
     if (nvr > 0 && (vr == NULL || value == NULL))
         return fail(c, "fmi2SetReal: vr or value is NULL");
     for (i = 0; i < nvr; i++) { /* check every value before storing any */
@@ -469,10 +475,9 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 /* ---- FMU states: a copy of the records ---------------------------------------------------- */
 
 fmi2Status fmi2GetFMUstate(fmi2Component component, fmi2FMUstate *FMUstate) {
-    Instance *c = instance(component);
+    Instance *c = instance_in(component, "fmi2GetFMUstate", IN_ANY & ~IN_ERROR);
     Snapshot *s;
     if (c == NULL) return fmi2Error;
-    if (wrong_phase(c, "fmi2GetFMUstate", IN_ANY & ~IN_ERROR)) return fmi2Error;
     if (FMUstate == NULL) return fail(c, "fmi2GetFMUstate: FMUstate is NULL");
     s = (Snapshot *)*FMUstate;
     if (s != NULL && s->magic != RA_SNAPSHOT_MAGIC)
@@ -611,10 +616,9 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component component, const fmi2Value
 fmi2Status fmi2DoStep(fmi2Component component, fmi2Real currentCommunicationPoint,
                       fmi2Real communicationStepSize,
                       fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
-    Instance *c = instance(component);
+    Instance *c = instance_in(component, "fmi2DoStep", IN_STEPPING);
     (void)noSetFMUStatePriorToCurrentPoint;
     if (c == NULL) return fmi2Error;
-    if (wrong_phase(c, "fmi2DoStep", IN_STEPPING)) return fmi2Error;
     if (!(communicationStepSize > 0.0) || !isfinite(communicationStepSize))
         return fail(c, "fmi2DoStep: communicationStepSize must be > 0 and finite, got %g",
                     communicationStepSize);
