@@ -49,6 +49,7 @@ from railadhesion._validate import (
     check_range,
 )
 from railadhesion.contact.friction import falling_friction_factor
+from railadhesion.contact.kalker import check_creepages, check_rolling_inputs
 from railadhesion.numerics import jit
 from railadhesion.plausibility import input_checker
 
@@ -1158,15 +1159,9 @@ def exact_rolling(
     >>> round(float(r.fy / (0.3 * 82e3)), 4)
     -0.6097
     """
-    xi = check_finite(creep_long, "creep_long")
-    eta = check_finite(creep_lat, "creep_lat")
-    phi = check_finite(spin, "spin")
-    fz = check_nonnegative(normal_force, "normal_force")
-    a_ = check_positive(a, "a")
-    b_ = check_positive(b, "b")
-    mu_ = check_nonnegative(mu, "mu")
-    g_mod = check_positive(shear_modulus, "shear_modulus")
-    nu = check_range(poisson, "poisson", 0.0, 0.5)
+    xi, eta, phi, fz, a_, b_, mu_, g_mod, nu = check_rolling_inputs(
+        creep_long, creep_lat, spin, normal_force, a, b, mu, shear_modulus, poisson
+    )
     ratio, decay, v = check_friction_law(speed, friction_ratio, friction_decay)
     tol_friction = float(check_range(tol_friction, "tol_friction", 1e-12, 1e-1))
     max_friction_iter = _check_grid(max_friction_iter, "max_friction_iter")
@@ -1325,9 +1320,7 @@ def solve_tangential(
     """
     pn = check_nonnegative(pressure, "pressure")
     ny, nx, dx_, dy_ = _grid_cells(pn, "pressure", dx, dy)
-    xi = float(check_finite(creep_long, "creep_long"))
-    eta = float(check_finite(creep_lat, "creep_lat"))
-    phi = float(check_finite(spin, "spin"))
+    xi, eta, phi = (float(c) for c in check_creepages(creep_long, creep_lat, spin))
     mu_ = float(check_nonnegative(mu, "mu"))
     g = float(check_positive(shear_modulus, "shear_modulus"))
     nu = float(check_range(poisson, "poisson", 0.0, 0.5))

@@ -38,12 +38,17 @@ import numpy as np
 from railadhesion._labelled import FASTSIM_UNITS, labelled
 from railadhesion._validate import (
     check_choice,
-    check_finite,
-    check_nonnegative,
     check_positive,
     check_range,
 )
-from railadhesion.contact.kalker import AOB_MAX, AOB_MIN, axis_ratio, kalker_law
+from railadhesion.contact.kalker import (
+    AOB_MAX,
+    AOB_MIN,
+    axis_ratio,
+    check_rolling_inputs,
+    creepage_docs,
+    kalker_law,
+)
 from railadhesion.numerics import flatten, jitable, kernel, read_only, run_chunks
 from railadhesion.plausibility import input_checker
 
@@ -211,6 +216,7 @@ _PLAUSIBLE = input_checker(("creep_long", "creep_lat", "spin", "normal_force", "
 
 
 @labelled(units=FASTSIM_UNITS)
+@creepage_docs
 def fastsim(
     creep_long,
     creep_lat,
@@ -234,12 +240,7 @@ def fastsim(
 
     Parameters
     ----------
-    creep_long : array_like
-        Longitudinal creepage xi = (V - omega R)/V [-] (braking positive).
-    creep_lat : array_like
-        Lateral creepage eta [-].
-    spin : array_like
-        Spin creepage phi [rad/m].
+    {creepages}
     normal_force : array_like
         Normal force Fz [N], >= 0.
     a : array_like
@@ -389,15 +390,9 @@ def fastsim(
             if out is not None:
                 _PLAUSIBLE(values)  # implausible inputs warn (docs/checks.md)
                 return out
-    xi = check_finite(creep_long, "creep_long")
-    eta = check_finite(creep_lat, "creep_lat")
-    phi = check_finite(spin, "spin")
-    fz = check_nonnegative(normal_force, "normal_force")
-    a_ = check_positive(a, "a")
-    b_ = check_positive(b, "b")
-    mu_ = check_nonnegative(mu, "mu")
-    g_mod = check_positive(shear_modulus, "shear_modulus")
-    nu = check_range(poisson, "poisson", 0.0, 0.5)
+    xi, eta, phi, fz, a_, b_, mu_, g_mod, nu = check_rolling_inputs(
+        creep_long, creep_lat, spin, normal_force, a, b, mu, shear_modulus, poisson
+    )
     check_choice(bound, "bound", _BOUNDS)
     check_choice(grid, "grid", _GRIDS)
     flx_given = _check_flexibility(flexibility)
