@@ -214,27 +214,21 @@ def _pandas_call(func, args, kwargs, units, leading):
             return value.to_numpy(dtype=float)
         return value
 
-    args2 = [strip(a) for a in args]
-    kwargs2 = {k: strip(v) for k, v in kwargs.items()}
-    out = func(*args2, **kwargs2)
+    out = _call_stripped(func, args, kwargs, strip)
     n = len(index)
 
-    def wrap(value, unit, name):
+    def label(value, name):
         arr = np.asarray(value) if isinstance(value, np.ndarray | np.generic) else None
         if arr is None or arr.ndim == 0 or arr.shape[-1] != n:
-            return value
+            return None
         if arr.ndim == 1:
-            s = pd.Series(arr, index=index, name=name)
-        elif arr.ndim == 2:
+            return pd.Series(arr, index=index, name=name)
+        if arr.ndim == 2:
             labels = list(leading.values())[0] if leading else range(arr.shape[0])
-            s = pd.DataFrame(arr.T, index=index, columns=list(labels))
-        else:
-            return value
-        if unit:
-            s.attrs["units"] = unit
-        return s
+            return pd.DataFrame(arr.T, index=index, columns=list(labels))
+        return None
 
-    return _map_result(out, units, wrap)
+    return _map_result(out, units, label)
 
 
 # --------------------------------------------------------------------------------------------
@@ -258,32 +252,26 @@ def _xarray_call(func, args, kwargs, units, leading):
             return value.broadcast_like(template).transpose(*dims).to_numpy().astype(float)
         return value
 
-    args2 = [strip(a) for a in args]
-    kwargs2 = {k: strip(v) for k, v in kwargs.items()}
-    out = func(*args2, **kwargs2)
+    out = _call_stripped(func, args, kwargs, strip)
     coords = {k: v for k, v in template.coords.items()}
 
-    def wrap(value, unit, name):
+    def label(value, name):
         if not isinstance(value, np.ndarray | np.generic | float):
-            return value
+            return None
         arr = np.asarray(value)
         extra = arr.ndim - len(dims)
         if extra < 0 or arr.shape[extra:] != shape:
-            return value
+            return None
         if extra == 0:
-            da = xr.DataArray(arr, dims=dims, coords=coords, name=name)
-        elif extra == 1 and leading:
+            return xr.DataArray(arr, dims=dims, coords=coords, name=name)
+        if extra == 1 and leading:
             (dim, labels), = leading.items()
-            da = xr.DataArray(
+            return xr.DataArray(
                 arr, dims=(dim, *dims), coords={**coords, dim: list(labels)}, name=name
             )
-        else:
-            return value
-        if unit:
-            da.attrs["units"] = unit
-        return da
+        return None
 
-    return _map_result(out, units, wrap)
+    return _map_result(out, units, label)
 
 
 # --------------------------------------------------------------------------------------------
@@ -300,7 +288,24 @@ def _unit_of(units, i, name):
     return units[i] if i < len(units) else None
 
 
-def _map_result(out, units, wrap):
+def _call_stripped(func, args, kwargs, strip):
+    """``func`` called with every argument passed through ``strip`` (labels to arrays)."""
+    return func(*[strip(a) for a in args], **{k: strip(v) for k, v in kwargs.items()})
+
+
+def _map_result(out, units, label):
+    """``out`` with each result labelled: ``label(value, name)`` gives the Series, DataFrame
+    or DataArray of an array result, or None to keep ``value`` as it is (not of the labelled
+    shape); the labelled results get ``attrs["units"]``."""
+
+    def wrap(value, unit, name):
+        labelled_value = label(value, name)
+        if labelled_value is None:
+            return value
+        if unit:
+            labelled_value.attrs["units"] = unit
+        return labelled_value
+
     if isinstance(out, tuple) and hasattr(out, "_fields"):  # named tuple
         fields = zip(out._fields, out, strict=True)
         return type(out)._make(wrap(v, _unit_of(units, i, f), f) for i, (f, v) in enumerate(fields))

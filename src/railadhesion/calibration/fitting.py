@@ -436,10 +436,25 @@ def _run_fit(model_name, names, residual, starts, lo, hi, fitted, fixed, s, y, c
     )
 
 
+#: The docstring entry of the ``warn_untrusted`` argument of the fits (:func:`_fit_docs`).
+_WARN_UNTRUSTED_DOC = """warn_untrusted : bool, default True
+        Issue an :class:`~railadhesion.plausibility.UntrustedResultWarning` when the quality
+        gate flags the fit (its findings are in ``warnings`` either way)."""
+
+
+def _fit_docs(func):
+    """``func`` with :data:`_WARN_UNTRUSTED_DOC` in place of ``{warn_untrusted}`` in its
+    docstring."""
+    if func.__doc__:  # None under python -OO
+        func.__doc__ = func.__doc__.replace("{warn_untrusted}", _WARN_UNTRUSTED_DOC)
+    return func
+
+
 # ---------------------------------------------------------------------------------------------
 # Polach
 
 
+@_fit_docs
 def fit_polach(
     creep,
     adhesion,
@@ -489,9 +504,7 @@ def fit_polach(
         Combined shear modulus G [Pa].
     poisson : float, default 0.28
         Combined Poisson's ratio [-].
-    warn_untrusted : bool, default True
-        Issue an :class:`~railadhesion.plausibility.UntrustedResultWarning` when the quality
-        gate flags the fit (its findings are in ``warnings`` either way).
+    {warn_untrusted}
 
     Returns
     -------
@@ -674,6 +687,7 @@ def fit_polach(
 # Fletcher
 
 
+@_fit_docs
 def fit_fletcher(
     creep,
     adhesion,
@@ -711,9 +725,7 @@ def fit_fletcher(
     bounds : mapping of str to (low, high), optional
         Overrides :data:`FLETCHER_DEFAULT_BOUNDS` (k_a in [1e-4, 5], k_s in [1e-4, 2],
         mu in [1e-4, 1.5]).
-    warn_untrusted : bool, default True
-        Issue an :class:`~railadhesion.plausibility.UntrustedResultWarning` when the quality
-        gate flags the fit (its findings are in ``warnings`` either way).
+    {warn_untrusted}
 
     Returns
     -------

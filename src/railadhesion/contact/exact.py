@@ -49,6 +49,7 @@ from railadhesion._validate import (
     check_range,
 )
 from railadhesion.contact.friction import falling_friction_factor
+from railadhesion.contact.kalker import check_creepages, check_rolling_inputs
 from railadhesion.numerics import jit
 from railadhesion.plausibility import input_checker
 
@@ -113,6 +114,28 @@ def _influence_array(x, y, hx, hy, nu, out_xx, out_xy, out_yy):
         out_xx[k], out_xy[k], out_yy[k] = _influence_point(x[k], y[k], hx, hy, nu[k])
 
 
+def _influence(x, y, dx, dy, poisson, shear_modulus, *, with_nu: bool):
+    """Validated inputs of the influence functions and the rectangle integrals.
+
+    Returns ``(nu, G, shape, (axx, axy, ayy))``: the broadcast Poisson's ratio, the shear
+    modulus, the broadcast shape of ``x, y, nu`` and the corner sums of
+    :func:`_influence_point` (flat), evaluated with that ``nu`` if ``with_nu``, else with
+    nu = 0.
+    """
+    x_, y_, nu = np.broadcast_arrays(
+        check_finite(x, "x"), check_finite(y, "y"), check_range(poisson, "poisson", 0.0, 0.5)
+    )
+    dx_ = float(check_positive(dx, "dx"))
+    dy_ = float(check_positive(dy, "dy"))
+    g = float(check_positive(shear_modulus, "shear_modulus"))
+    shape = x_.shape
+    xf, yf = (np.ascontiguousarray(v, dtype=float).ravel() for v in (x_, y_))
+    nuf = np.ascontiguousarray(nu, dtype=float).ravel() if with_nu else np.zeros_like(xf)
+    axx, axy, ayy = np.empty_like(xf), np.empty_like(xf), np.empty_like(xf)
+    _influence_array(xf, yf, 0.5 * dx_, 0.5 * dy_, nuf, axx, axy, ayy)
+    return nu, g, shape, (axx, axy, ayy)
+
+
 def tangential_influence(x, y, dx, dy, poisson=0.28, shear_modulus=8.2e10):
     """Tangential influence coefficients of the half-space for a uniform load on a rectangle.
 
@@ -151,18 +174,9 @@ def tangential_influence(x, y, dx, dy, poisson=0.28, shear_modulus=8.2e10):
     F(x-hx, y-hy)``, ``hx = dx/2``, ``hy = dy/2``), and ``u = (1/(pi G)) (...)``. Checked
     against a numerical quadrature of the point-load solution in the tests.
     """
-    x_, y_, nu = np.broadcast_arrays(
-        check_finite(x, "x"), check_finite(y, "y"), check_range(poisson, "poisson", 0.0, 0.5)
-    )
-    dx_ = float(check_positive(dx, "dx"))
-    dy_ = float(check_positive(dy, "dy"))
-    g = float(check_positive(shear_modulus, "shear_modulus"))
-    shape = x_.shape
-    xf, yf, nuf = (np.ascontiguousarray(v, dtype=float).ravel() for v in (x_, y_, nu))
-    axx, axy, ayy = np.empty_like(xf), np.empty_like(xf), np.empty_like(xf)
-    _influence_array(xf, yf, 0.5 * dx_, 0.5 * dy_, nuf, axx, axy, ayy)
+    _, g, shape, sums = _influence(x, y, dx, dy, poisson, shear_modulus, with_nu=True)
     f = 1.0 / (math.pi * g)
-    return tuple((f * v).reshape(shape) for v in (axx, axy, ayy))
+    return tuple((f * v).reshape(shape) for v in sums)
 
 
 def normal_influence(x, y, dx, dy, poisson=0.28, shear_modulus=8.2e10):
@@ -174,18 +188,18 @@ def normal_influence(x, y, dx, dy, poisson=0.28, shear_modulus=8.2e10):
     body): ``(1 - nu)/(pi G) * integral of 1/r over the rectangle`` [m/Pa]. Parameters as in
     :func:`tangential_influence`.
     """
-    x_, y_, nu = np.broadcast_arrays(
-        check_finite(x, "x"), check_finite(y, "y"), check_range(poisson, "poisson", 0.0, 0.5)
-    )
-    dx_ = float(check_positive(dx, "dx"))
-    dy_ = float(check_positive(dy, "dy"))
-    g = float(check_positive(shear_modulus, "shear_modulus"))
-    shape = x_.shape
-    xf, yf = (np.ascontiguousarray(v, dtype=float).ravel() for v in (x_, y_))
-    axx, axy, ayy = np.empty_like(xf), np.empty_like(xf), np.empty_like(xf)
     # with nu = 0 the tangential xx-coefficient is the integral of 1/r over the rectangle
-    _influence_array(xf, yf, 0.5 * dx_, 0.5 * dy_, np.zeros_like(xf), axx, axy, ayy)
+    nu, g, shape, (axx, _, _) = _influence(x, y, dx, dy, poisson, shear_modulus, with_nu=False)
     return ((1.0 - nu) / (math.pi * g)) * axx.reshape(shape)
+
+
+def _grid_cells(field: np.ndarray, name: str, dx, dy) -> tuple[int, int, float, float]:
+    """``(ny, nx, dx, dy)`` of a field on the element grid: ``field`` (named ``name`` in the
+    error) must be 2-D, (ny, nx); the element sizes ``dx``, ``dy`` [m] must be > 0."""
+    if field.ndim != 2:
+        raise ValueError(f"{name} must be a 2-D array (ny, nx), got shape {field.shape}")
+    ny, nx = field.shape
+    return ny, nx, float(check_positive(dx, "dx")), float(check_positive(dy, "dy"))
 
 
 @dataclass(frozen=True)
@@ -228,11 +242,7 @@ def solve_normal(gap, dx, dy, normal_force, *, shear_modulus=8.2e10, poisson=0.2
     NormalSolution
     """
     h = check_finite(gap, "gap")
-    if h.ndim != 2:
-        raise ValueError(f"gap must be a 2-D array (ny, nx), got shape {h.shape}")
-    ny, nx = h.shape
-    dx_ = float(check_positive(dx, "dx"))
-    dy_ = float(check_positive(dy, "dy"))
+    ny, nx, dx_, dy_ = _grid_cells(h, "gap", dx, dy)
     fz = float(check_positive(normal_force, "normal_force"))
     g = float(check_positive(shear_modulus, "shear_modulus"))
     nu = float(check_range(poisson, "poisson", 0.0, 0.5))
@@ -1149,15 +1159,9 @@ def exact_rolling(
     >>> round(float(r.fy / (0.3 * 82e3)), 4)
     -0.6097
     """
-    xi = check_finite(creep_long, "creep_long")
-    eta = check_finite(creep_lat, "creep_lat")
-    phi = check_finite(spin, "spin")
-    fz = check_nonnegative(normal_force, "normal_force")
-    a_ = check_positive(a, "a")
-    b_ = check_positive(b, "b")
-    mu_ = check_nonnegative(mu, "mu")
-    g_mod = check_positive(shear_modulus, "shear_modulus")
-    nu = check_range(poisson, "poisson", 0.0, 0.5)
+    xi, eta, phi, fz, a_, b_, mu_, g_mod, nu = check_rolling_inputs(
+        creep_long, creep_lat, spin, normal_force, a, b, mu, shear_modulus, poisson
+    )
     ratio, decay, v = check_friction_law(speed, friction_ratio, friction_decay)
     tol_friction = float(check_range(tol_friction, "tol_friction", 1e-12, 1e-1))
     max_friction_iter = _check_grid(max_friction_iter, "max_friction_iter")
@@ -1315,14 +1319,8 @@ def solve_tangential(
         Scalars and the fields (always returned here).
     """
     pn = check_nonnegative(pressure, "pressure")
-    if pn.ndim != 2:
-        raise ValueError(f"pressure must be a 2-D array (ny, nx), got shape {pn.shape}")
-    ny, nx = pn.shape
-    dx_ = float(check_positive(dx, "dx"))
-    dy_ = float(check_positive(dy, "dy"))
-    xi = float(check_finite(creep_long, "creep_long"))
-    eta = float(check_finite(creep_lat, "creep_lat"))
-    phi = float(check_finite(spin, "spin"))
+    ny, nx, dx_, dy_ = _grid_cells(pn, "pressure", dx, dy)
+    xi, eta, phi = (float(c) for c in check_creepages(creep_long, creep_lat, spin))
     mu_ = float(check_nonnegative(mu, "mu"))
     g = float(check_positive(shear_modulus, "shear_modulus"))
     nu = float(check_range(poisson, "poisson", 0.0, 0.5))

@@ -38,12 +38,17 @@ import numpy as np
 from railadhesion._labelled import FASTSIM_UNITS, labelled
 from railadhesion._validate import (
     check_choice,
-    check_finite,
-    check_nonnegative,
     check_positive,
     check_range,
 )
-from railadhesion.contact.kalker import AOB_MAX, AOB_MIN, axis_ratio, kalker_law
+from railadhesion.contact.kalker import (
+    AOB_MAX,
+    AOB_MIN,
+    axis_ratio,
+    check_rolling_inputs,
+    creepage_docs,
+    kalker_law,
+)
 from railadhesion.numerics import flatten, jitable, kernel, read_only, run_chunks
 from railadhesion.plausibility import input_checker
 
@@ -211,6 +216,7 @@ _PLAUSIBLE = input_checker(("creep_long", "creep_lat", "spin", "normal_force", "
 
 
 @labelled(units=FASTSIM_UNITS)
+@creepage_docs
 def fastsim(
     creep_long,
     creep_lat,
@@ -234,12 +240,7 @@ def fastsim(
 
     Parameters
     ----------
-    creep_long : array_like
-        Longitudinal creepage xi = (V - omega R)/V [-] (braking positive).
-    creep_lat : array_like
-        Lateral creepage eta [-].
-    spin : array_like
-        Spin creepage phi [rad/m].
+    {creepages}
     normal_force : array_like
         Normal force Fz [N], >= 0.
     a : array_like
@@ -389,15 +390,9 @@ def fastsim(
             if out is not None:
                 _PLAUSIBLE(values)  # implausible inputs warn (docs/checks.md)
                 return out
-    xi = check_finite(creep_long, "creep_long")
-    eta = check_finite(creep_lat, "creep_lat")
-    phi = check_finite(spin, "spin")
-    fz = check_nonnegative(normal_force, "normal_force")
-    a_ = check_positive(a, "a")
-    b_ = check_positive(b, "b")
-    mu_ = check_nonnegative(mu, "mu")
-    g_mod = check_positive(shear_modulus, "shear_modulus")
-    nu = check_range(poisson, "poisson", 0.0, 0.5)
+    xi, eta, phi, fz, a_, b_, mu_, g_mod, nu = check_rolling_inputs(
+        creep_long, creep_lat, spin, normal_force, a, b, mu, shear_modulus, poisson
+    )
     check_choice(bound, "bound", _BOUNDS)
     check_choice(grid, "grid", _GRIDS)
     flx_given = _check_flexibility(flexibility)
@@ -527,6 +522,33 @@ def fastsim_bound(px, py, g):
     return px * f, py * f, r > g
 
 
+@jitable(inline="always")
+def _settle(j, px_j, py_j, bound, px, py, spx, spy, slip, nslip):
+    """One step of the marches at element j of a column: the traction ``(px_j, py_j)`` back
+    onto the ``bound`` (:func:`fastsim_bound`) into ``px[j]``, ``py[j]``, its slip flag (1.0 or
+    0.0) into ``slip[j]``, added to the sums ``spx[j]``, ``spy[j]`` and the slip count
+    ``nslip[j]``. Returns the bounded py. Inlined where it is called (once per march), so that
+    the loop over the strips stays one loop that vectorises."""
+    pxj, pyj, slipping = fastsim_bound(px_j, py_j, bound)
+    slip[j] = 1.0 if slipping else 0.0
+    nslip[j] += slip[j]
+    px[j] = pxj
+    py[j] = pyj
+    spx[j] += pxj
+    spy[j] += pyj
+    return pyj
+
+
+@jitable(inline="always")
+def _store_column(i, px, py, slip, px_out, py_out, slip_out):
+    """Column i of the outputs of the marches (``store``): the tractions and the slip flags of
+    the current column (inlined where it is called, once per march)."""
+    for j in range(px.size):
+        px_out[j, i] = px[j]
+        py_out[j, i] = py[j]
+        slip_out[j, i] = slip[j] != 0.0
+
+
 # Rows of the work array of :func:`fastsim_strips` (ny values each).
 _W_PX, _W_PY, _W_DPX, _W_DPY1, _W_INC, _W_GFAC, _W_SPX, _W_SPY, _W_QPY, _W_NSLIP = range(10)
 _W_SLIP = 10  # the slip flags of the current column (1.0 or 0.0), for ``store``
@@ -581,19 +603,10 @@ def fastsim_strips(xi, eta, phi, fz, a, b, mu, l1, l2, l3, eta_j, sq, tx, gy, no
                 px[j] += dpx[j]
                 py[j] += inc[j]
         for j in range(ny):  # back onto the bound where |p| exceeds it (slip); vectorised
-            pxj, pyj, slipping = fastsim_bound(px[j], py[j], gfac[j] * t)
-            slip[j] = 1.0 if slipping else 0.0
-            nslip[j] += slip[j]
-            px[j] = pxj
-            py[j] = pyj
-            spx[j] += pxj
-            spy[j] += pyj
+            _settle(j, px[j], py[j], gfac[j] * t, px, py, spx, spy, slip, nslip)
             qpy[j] += spy[j]
         if store:  # a loop of its own: a store in the loop above keeps it from vectorising
-            for j in range(ny):
-                px_out[j, i] = px[j]
-                py_out[j, i] = py[j]
-                slip_out[j, i] = slip[j] != 0.0
+            _store_column(i, px, py, slip, px_out, py_out, slip_out)
     dy = (2.0 / ny) * b
     sfx = 0.0
     sfy = 0.0
@@ -658,20 +671,11 @@ def fastsim_rectangular(xi, eta, phi, fz, a, b, mu, l1, l2, l3, scale, xh, yh, m
         for j in range(ny):
             # step from the previous element; elements outside the contact reset to zero
             m = mask[i, j]
-            pxj, pyj, slipping = fastsim_bound((px[j] + dpx[j]) * m, (py[j] + dpy) * m,
-                                               gfac * shape[i, j])  # fmt: skip
-            slip[j] = 1.0 if slipping else 0.0
-            nslip[j] += slip[j]
-            px[j] = pxj
-            py[j] = pyj
-            spx[j] += pxj
-            spy[j] += pyj
+            pyj = _settle(j, (px[j] + dpx[j]) * m, (py[j] + dpy) * m, gfac * shape[i, j], px,
+                          py, spx, spy, slip, nslip)  # fmt: skip
             sxpy[j] += pyj * xh[i]
         if store:  # a loop of its own, as in fastsim_strips
-            for j in range(ny):
-                px_out[j, i] = px[j]
-                py_out[j, i] = py[j]
-                slip_out[j, i] = slip[j] != 0.0
+            _store_column(i, px, py, slip, px_out, py_out, slip_out)
     da = dx * dy
     sx = 0.0
     sy = 0.0

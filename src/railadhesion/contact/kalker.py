@@ -30,7 +30,12 @@ from typing import NamedTuple
 import numpy as np
 
 from railadhesion._labelled import labelled
-from railadhesion._validate import check_finite, check_positive, check_range
+from railadhesion._validate import (
+    check_finite,
+    check_nonnegative,
+    check_positive,
+    check_range,
+)
 from railadhesion.numerics import jitable, kernel, read_only
 from railadhesion.plausibility import input_checker
 
@@ -404,23 +409,66 @@ def axis_ratio(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return r
 
 
+#: The numpydoc entries of the three creepages, shared by the creep-force functions'
+#: docstrings (:func:`creepage_docs` puts them in place of ``{creepages}``).
+CREEPAGE_PARAMETERS = """creep_long : array_like
+        Longitudinal creepage xi = (V - omega R)/V [-] (braking positive).
+    creep_lat : array_like
+        Lateral creepage eta [-].
+    spin : array_like
+        Spin creepage phi [rad/m]."""
+
+
+def creepage_docs(func):
+    """``func`` with :data:`CREEPAGE_PARAMETERS` in place of ``{creepages}`` in its docstring
+    (a module-level function: the entries are indented for it)."""
+    if func.__doc__:  # None under python -OO
+        func.__doc__ = func.__doc__.replace("{creepages}", CREEPAGE_PARAMETERS)
+    return func
+
+
+def check_creepages(creep_long, creep_lat, spin) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The creepages ``(xi, eta, phi)`` as float arrays; each must be finite, else
+    ``ValueError`` naming the argument."""
+    return (
+        check_finite(creep_long, "creep_long"),
+        check_finite(creep_lat, "creep_lat"),
+        check_finite(spin, "spin"),
+    )
+
+
+def check_rolling_inputs(creep_long, creep_lat, spin, normal_force, a, b, mu, shear_modulus,
+                         poisson) -> tuple[np.ndarray, ...]:  # fmt: skip
+    """The inputs of a rolling-contact solver (FASTSIM, the exact theory) as float arrays.
+
+    Returns ``(xi, eta, phi, Fz, a, b, mu, G, nu)``, checked in that order: the creepages
+    finite (:func:`check_creepages`), Fz >= 0, a, b > 0, mu >= 0, G > 0, nu in [0, 0.5];
+    ``ValueError`` naming the first argument out of range.
+    """
+    return (
+        *check_creepages(creep_long, creep_lat, spin),
+        check_nonnegative(normal_force, "normal_force"),
+        check_positive(a, "a"),
+        check_positive(b, "b"),
+        check_nonnegative(mu, "mu"),
+        check_positive(shear_modulus, "shear_modulus"),
+        check_range(poisson, "poisson", 0.0, 0.5),
+    )
+
+
 #: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
 _PLAUSIBLE = input_checker(("creep_long", "creep_lat", "spin", "a", "b", "shear_modulus",
                             "poisson"))
 
 
 @labelled(units=("N", "N", "N m"))
+@creepage_docs
 def linear_creep_forces(creep_long, creep_lat, spin, a, b, shear_modulus, poisson):
     """Creep forces and spin moment of Kalker's linear theory (small creepages, full stick).
 
     Parameters
     ----------
-    creep_long : array_like
-        Longitudinal creepage xi = (V - omega R)/V [-] (braking positive).
-    creep_lat : array_like
-        Lateral creepage eta [-].
-    spin : array_like
-        Spin creepage phi [rad/m].
+    {creepages}
     a : array_like
         Contact semi-axis in the rolling direction [m], > 0.
     b : array_like
@@ -469,9 +517,7 @@ def linear_creep_forces(creep_long, creep_lat, spin, a, b, shear_modulus, poisso
     >>> round(float(fy), 1), round(float(mz), 3)
     (-394.3, -0.671)
     """
-    xi = check_finite(creep_long, "creep_long")
-    eta = check_finite(creep_lat, "creep_lat")
-    phi = check_finite(spin, "spin")
+    xi, eta, phi = check_creepages(creep_long, creep_lat, spin)
     a_ = check_positive(a, "a")
     b_ = check_positive(b, "b")
     g_mod = check_positive(shear_modulus, "shear_modulus")
