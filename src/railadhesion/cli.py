@@ -50,8 +50,11 @@ console = Console()
 #: Output formats of the table commands.
 FORMATS = ("table", "csv", "json")
 
-# The --params option of the wilac commands (typer copies an option it reads: one serves all).
+# Options of the wilac commands (typer copies an option it reads: one serves all): --params,
+# and the tram rig's normal force and speed.
 _WILAC_PARAMS_OPTION = typer.Option(None, "--params", help="WILAC TOML file.")
+_TRAM_NORMAL_FORCE_OPTION = typer.Option(4200.0, help="Normal force Q [N].")
+_TRAM_SPEED_OPTION = typer.Option(5.0, help="Rolling speed [m/s].")
 
 
 def _version(value: bool) -> None:
@@ -364,8 +367,8 @@ def wilac_weights_cmd(
 @wilac_app.command("water")
 def wilac_water(
     creep_percent: str = typer.Option("3,10,30,60", help="Fixed creepages [%], comma-separated."),
-    normal_force: float = typer.Option(4200.0, help="Normal force Q [N]."),
-    speed: float = typer.Option(5.0, help="Rolling speed [m/s]."),
+    normal_force: float = _TRAM_NORMAL_FORCE_OPTION,
+    speed: float = _TRAM_SPEED_OPTION,
     params_file: Path | None = _WILAC_PARAMS_OPTION,
     out: Path = typer.Option(Path("wilac_water.png"), help="Figure file."),
 ) -> None:
@@ -399,8 +402,8 @@ def wilac_speeds(
 def wilac_table(
     water: str = typer.Option("0,25,35,60,350", help="Water flow rates [µl/s]."),
     creep_percent: str = typer.Option("1,3,10,30,60,90", help="Creepages [%] (braking sign)."),
-    normal_force: float = typer.Option(4200.0, help="Normal force Q [N]."),
-    speed: float = typer.Option(5.0, help="Rolling speed [m/s]."),
+    normal_force: float = _TRAM_NORMAL_FORCE_OPTION,
+    speed: float = _TRAM_SPEED_OPTION,
     params_file: Path | None = _WILAC_PARAMS_OPTION,
     fmt: str = _format_option(),
     out: Path | None = typer.Option(None, help="Write the table here (.csv, .json or text)."),
