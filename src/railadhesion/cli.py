@@ -50,6 +50,12 @@ console = Console()
 #: Output formats of the table commands.
 FORMATS = ("table", "csv", "json")
 
+# Options of the wilac commands (typer copies an option it reads: one serves all): --params,
+# and the tram rig's normal force and speed.
+_WILAC_PARAMS_OPTION = typer.Option(None, "--params", help="WILAC TOML file.")
+_TRAM_NORMAL_FORCE_OPTION = typer.Option(4200.0, help="Normal force Q [N].")
+_TRAM_SPEED_OPTION = typer.Option(5.0, help="Rolling speed [m/s].")
+
 
 def _version(value: bool) -> None:
     if value:
@@ -196,6 +202,16 @@ def _save(fig, out: Path | None) -> None:
     console.print(f"figure written to {escape(str(out))}")
 
 
+def _figure(out: Path | None, draw) -> None:
+    """Save the figure ``draw()`` returns to ``out`` (:func:`_save`); a ValueError while
+    drawing (an option value out of range, an unreadable parameter file) is a user error."""
+    try:
+        fig = draw()
+    except ValueError as exc:
+        _fail(exc)
+    _save(fig, out)
+
+
 @app.command()
 def demo(
     out: Path = typer.Option(Path("demo-output"), help="Folder for the demo figures."),
@@ -325,56 +341,44 @@ def wilac_curves(
     water: str = typer.Option("0,25,35,60,350", help="Water flow rates [µl/s], comma-separated."),
     normal_force: float = typer.Option(4200.0, help="Normal force Q [N] (tram rig: 4.2 kN)."),
     speed: float = typer.Option(5.0, help="Rolling speed [m/s] (tram rig: 5 m/s)."),
-    params_file: Path | None = typer.Option(None, "--params", help="WILAC TOML file."),
+    params_file: Path | None = _WILAC_PARAMS_OPTION,
     out: Path = typer.Option(Path("wilac_curves.png"), help="Figure file."),
 ) -> None:
     """Creep curves at several water flow rates (paper Fig. 7)."""
     from railadhesion.plotting import plot_wilac_curves
 
-    try:
-        fig = plot_wilac_curves(
-            water_flows=tuple(_floats(water, "--water")), normal_force=normal_force, speed=speed,
-            params=_load_wilac(params_file),
-        )
-    except ValueError as exc:
-        _fail(exc)
-    _save(fig, out)
+    _figure(out, lambda: plot_wilac_curves(
+        water_flows=tuple(_floats(water, "--water")), normal_force=normal_force, speed=speed,
+        params=_load_wilac(params_file),
+    ))  # fmt: skip
 
 
 @wilac_app.command("weights")
 def wilac_weights_cmd(
-    params_file: Path | None = typer.Option(None, "--params", help="WILAC TOML file."),
+    params_file: Path | None = _WILAC_PARAMS_OPTION,
     out: Path = typer.Option(Path("wilac_weights.png"), help="Figure file."),
 ) -> None:
     """Blending weights f_i(w) and transitions e_i(w) (paper Figs. 5 and 6)."""
     from railadhesion.plotting import plot_wilac_weights
 
-    try:
-        fig = plot_wilac_weights(params=_load_wilac(params_file))
-    except ValueError as exc:
-        _fail(exc)
-    _save(fig, out)
+    _figure(out, lambda: plot_wilac_weights(params=_load_wilac(params_file)))
 
 
 @wilac_app.command("water")
 def wilac_water(
     creep_percent: str = typer.Option("3,10,30,60", help="Fixed creepages [%], comma-separated."),
-    normal_force: float = typer.Option(4200.0, help="Normal force Q [N]."),
-    speed: float = typer.Option(5.0, help="Rolling speed [m/s]."),
-    params_file: Path | None = typer.Option(None, "--params", help="WILAC TOML file."),
+    normal_force: float = _TRAM_NORMAL_FORCE_OPTION,
+    speed: float = _TRAM_SPEED_OPTION,
+    params_file: Path | None = _WILAC_PARAMS_OPTION,
     out: Path = typer.Option(Path("wilac_water.png"), help="Figure file."),
 ) -> None:
     """Adhesion against water flow rate at fixed creepages (paper Fig. 8)."""
     from railadhesion.plotting import plot_wilac_water
 
-    try:
-        fig = plot_wilac_water(
-            creeps=tuple(_creep_percent(creep_percent)),
-            normal_force=normal_force, speed=speed, params=_load_wilac(params_file),
-        )
-    except ValueError as exc:
-        _fail(exc)
-    _save(fig, out)
+    _figure(out, lambda: plot_wilac_water(
+        creeps=tuple(_creep_percent(creep_percent)),
+        normal_force=normal_force, speed=speed, params=_load_wilac(params_file),
+    ))  # fmt: skip
 
 
 @wilac_app.command("speeds")
@@ -382,29 +386,25 @@ def wilac_speeds(
     speeds: str = typer.Option("5,10,20", help="Rolling speeds [m/s], comma-separated."),
     water: float = typer.Option(0.0, help="Water flow rate [µl/s]."),
     normal_force: float = typer.Option(110e3, help="Normal force Q [N] (locomotive: 110 kN)."),
-    params_file: Path | None = typer.Option(None, "--params", help="WILAC TOML file."),
+    params_file: Path | None = _WILAC_PARAMS_OPTION,
     out: Path = typer.Option(Path("wilac_speeds.png"), help="Figure file."),
 ) -> None:
     """Creep curves at several speeds (paper Figs. 9 and 11)."""
     from railadhesion.plotting import plot_wilac_speeds
 
-    try:
-        fig = plot_wilac_speeds(
-            speeds=tuple(_floats(speeds, "--speeds")), water_flow=water,
-            normal_force=normal_force, params=_load_wilac(params_file),
-        )
-    except ValueError as exc:
-        _fail(exc)
-    _save(fig, out)
+    _figure(out, lambda: plot_wilac_speeds(
+        speeds=tuple(_floats(speeds, "--speeds")), water_flow=water,
+        normal_force=normal_force, params=_load_wilac(params_file),
+    ))  # fmt: skip
 
 
 @wilac_app.command("table")
 def wilac_table(
     water: str = typer.Option("0,25,35,60,350", help="Water flow rates [µl/s]."),
     creep_percent: str = typer.Option("1,3,10,30,60,90", help="Creepages [%] (braking sign)."),
-    normal_force: float = typer.Option(4200.0, help="Normal force Q [N]."),
-    speed: float = typer.Option(5.0, help="Rolling speed [m/s]."),
-    params_file: Path | None = typer.Option(None, "--params", help="WILAC TOML file."),
+    normal_force: float = _TRAM_NORMAL_FORCE_OPTION,
+    speed: float = _TRAM_SPEED_OPTION,
+    params_file: Path | None = _WILAC_PARAMS_OPTION,
     fmt: str = _format_option(),
     out: Path | None = typer.Option(None, help="Write the table here (.csv, .json or text)."),
 ) -> None:
@@ -638,11 +638,7 @@ def fit_polach_cmd(
     if figure is not None:
         from railadhesion.plotting import plot_fit
 
-        try:
-            fig = plot_fit(result, title=f"Polach fit to {csv_file.name}")
-        except ValueError as exc:
-            _fail(exc)
-        _save(fig, figure)
+        _figure(figure, lambda: plot_fit(result, title=f"Polach fit to {csv_file.name}"))
     if out is not None:
         try:
             save_polach_parameters(result.as_polach_parameters(), out)

@@ -43,13 +43,42 @@ def _failures(result, what: str) -> tuple[str, list[str]]:
     return f"failed {what}: {n} (first: {first})", [f"{n} failed {what}; first: {first}"]
 
 
+# The --scheduler option of both commands (typer copies an option it reads: one serves both).
+_SCHEDULER_OPTION = typer.Option(
+    None, help="Dask cluster address (tcp://HOST:PORT), or a local scheduler: threads "
+    "(default), processes, synchronous.")  # fmt: skip
+
+
+def _plan(load, spec: Path):
+    """``(the spec load(spec) reads, its plan, its dimensions as "dim n x dim n")``; a spec
+    that is not valid (ValueError) is a user error."""
+    try:
+        loaded = load(spec)
+        plan = loaded.plan()
+    except ValueError as exc:
+        _fail(exc)
+    dims = " x ".join(f"{d} {n}" for d, n in zip(plan.dims, plan.shape, strict=True))
+    return loaded, plan, dims
+
+
+def _run(progress, run, cannot_write: str):
+    """``run()``; on a ValueError (a user error) or an OSError (``cannot_write: ...``) the
+    progress bar is stopped and the command fails."""
+    try:
+        return run()
+    except ValueError as exc:
+        progress.stop()
+        _fail(exc)
+    except OSError as exc:
+        progress.stop()
+        _fail(f"{cannot_write}: {exc}")
+
+
 def sweep(
     spec: Path = typer.Argument(..., help="Sweep spec file (TOML; see examples/wilac_map.toml)."),
     out: Path = typer.Option(..., "--out", help="Output: a Zarr store (*.zarr, resumable) or "
                              "NetCDF file (*.nc)."),
-    scheduler: str | None = typer.Option(
-        None, help="Dask cluster address (tcp://HOST:PORT), or a local scheduler: threads "
-        "(default), processes, synchronous."),
+    scheduler: str | None = _SCHEDULER_OPTION,
     overwrite: bool = typer.Option(False, "--overwrite", help="Replace an existing output."),
     allow_untrusted: bool = allow_untrusted_option(),
 ) -> None:
@@ -60,12 +89,7 @@ def sweep(
     """
     from railadhesion.sweeps import load_sweep_spec
 
-    try:
-        sweep_spec = load_sweep_spec(spec)
-        plan = sweep_spec.plan()
-    except ValueError as exc:
-        _fail(exc)
-    dims = " x ".join(f"{d} {n}" for d, n in zip(plan.dims, plan.shape, strict=True))
+    sweep_spec, plan, dims = _plan(load_sweep_spec, spec)
     console.print(f"{escape(plan.model.name)} over {escape(dims)} = {plan.size:,} points in "
                   f"{plan.n_chunks} chunks", highlight=False)  # fmt: skip
     progress = Progress(
@@ -87,14 +111,9 @@ def sweep(
         progress.update(task["id"], completed=done)
 
     try:
-        result = sweep_spec.run(out, scheduler=scheduler, overwrite=overwrite,
-                                on_start=on_start, on_chunk=on_chunk)  # fmt: skip
-    except ValueError as exc:
-        progress.stop()
-        _fail(exc)
-    except OSError as exc:
-        progress.stop()
-        _fail(f"cannot write {out}: {exc}")
+        result = _run(progress, lambda: sweep_spec.run(
+            out, scheduler=scheduler, overwrite=overwrite, on_start=on_start, on_chunk=on_chunk,
+        ), f"cannot write {out}")  # fmt: skip
     except KeyboardInterrupt:
         progress.stop()
         console.print("interrupted: chunks already written are kept; re-run the same command "
@@ -118,9 +137,7 @@ def study(
                                 "examples/braking_study.toml)."),
     out: Path = typer.Option(..., "--out", help="Output folder: study.zarr (resumable), "
                              "study.csv, extension.png."),
-    scheduler: str | None = typer.Option(
-        None, help="Dask cluster address (tcp://HOST:PORT), or a local scheduler: threads "
-        "(default), processes, synchronous."),
+    scheduler: str | None = _SCHEDULER_OPTION,
     overwrite: bool = typer.Option(False, "--overwrite", help="Replace an existing study."),
     allow_untrusted: bool = allow_untrusted_option(),
 ) -> None:
@@ -134,12 +151,7 @@ def study(
 
     from railadhesion.sweeps.study import load_study_spec, run_study
 
-    try:
-        study_spec = load_study_spec(spec)
-        plan = study_spec.plan()
-    except ValueError as exc:
-        _fail(exc)
-    dims = " x ".join(f"{d} {n}" for d, n in zip(plan.dims, plan.shape, strict=True))
+    study_spec, plan, dims = _plan(load_study_spec, spec)
     console.print(f"braking study over {escape(dims)} = {plan.size:,} stops", highlight=False)
     progress = Progress(TextColumn("stops"), BarColumn(), MofNCompleteColumn(),
                         TimeRemainingColumn(), console=console)  # fmt: skip
@@ -151,17 +163,10 @@ def study(
         task["id"] = progress.add_task("study", total=result.chunks_computed)
         progress.start()
 
-    try:
-        result = run_study(study_spec, out, scheduler=scheduler, overwrite=overwrite,
-                           on_start=on_start,
-                           on_chunk=lambda done, total: progress.update(task["id"],
-                                                                        completed=done))
-    except ValueError as exc:
-        progress.stop()
-        _fail(exc)
-    except OSError as exc:
-        progress.stop()
-        _fail(f"cannot write to {out}: {exc}")
+    result = _run(progress, lambda: run_study(
+        study_spec, out, scheduler=scheduler, overwrite=overwrite, on_start=on_start,
+        on_chunk=lambda done, total: progress.update(task["id"], completed=done),
+    ), f"cannot write to {out}")  # fmt: skip
     progress.stop()
     ds = result.dataset
     if "water_flow" in ds.dims:

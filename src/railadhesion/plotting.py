@@ -99,13 +99,16 @@ def _draw_distinguishable(axes, x, rows, labels, styles, tol=2e-3):
         drawn.append((row, label.split(" (same as")[0]))
 
 
-def _finish_zoom(ax_zoom, zoom: float, ax=None) -> None:
+def _finish_creep_panels(ax, ax_zoom, zoom, creep_max: float, title: str, **legend) -> None:
+    """Finish the panels of :func:`_creep_panels`: the main axes (creep 0 to
+    ``-100 creep_max`` %, :func:`_finish_adhesion_axes`) and the zoom panel, if any."""
+    _finish_adhesion_axes(ax, _CREEP_LABEL, title, (-100 * float(creep_max), 0.0), **legend)
     if ax_zoom is None:
         return
-    if ax is not None:  # the figure's title above both panels; the main panel: full range
-        ax.figure.suptitle(ax.get_title())
-        ax.set_title("full range")
-        ax.set_ylabel("")
+    # the figure's title above both panels; the main panel: full range
+    ax.figure.suptitle(ax.get_title())
+    ax.set_title("full range")
+    ax.set_ylabel("")
     ax_zoom.set_xlim(-float(zoom), 0.0)
     ax_zoom.set_ylim(bottom=0.0)
     ax_zoom.set_xlabel(f"creep $c_x$ [%], 0 to {-float(zoom):g} %")
@@ -114,15 +117,17 @@ def _finish_zoom(ax_zoom, zoom: float, ax=None) -> None:
     ax_zoom.grid(True, alpha=0.3)
 
 
-def _creep_panels(ax, creep_max: float, n_points: int, zoom):
-    """Creepages of a traction creep-curve figure (negative, dense at low creep and in the
-    zoomed range) and its panels: ``(creep, figure, main axes, zoom axes or None, the axes to
-    draw on)`` (:func:`_creep_axes`)."""
+def _creep_panels(geometry, q: float, ax, creep_max: float, n_points: int, zoom):
+    """The contact semi-axes at the normal force ``q`` [N], the creepages of a traction
+    creep-curve figure (negative, dense at low creep and in the zoomed range) and its panels:
+    ``(a, b, creep, figure, main axes, zoom axes or None, the axes to draw on)``
+    (:func:`_creep_axes`)."""
+    a, b = contact_semi_axes(geometry, q)
     creep = -_traction_creep(creep_max, n_points)
     if zoom is not None:
         creep = np.unique(np.concatenate([creep, -np.linspace(0, float(zoom) / 100, 120)]))
     fig, ax, ax_zoom = _creep_axes(ax, zoom)
-    return creep, fig, ax, ax_zoom, [x for x in (ax_zoom, ax) if x is not None]
+    return a, b, creep, fig, ax, ax_zoom, [x for x in (ax_zoom, ax) if x is not None]
 
 
 def _traction_creep(creep_max: float, n_points: int) -> np.ndarray:
@@ -257,20 +262,16 @@ def plot_wilac_curves(
     q = float(check_positive(normal_force, "normal_force"))
     v = float(check_nonnegative(speed, "speed"))
     flows = check_nonnegative(np.atleast_1d(np.asarray(water_flows, dtype=float)), "water_flows")
-    a, b = contact_semi_axes(geometry, q)
-    creep, fig, ax, ax_zoom, axes = _creep_panels(ax, creep_max, n_points, zoom)
+    a, b, creep, fig, ax, ax_zoom, axes = _creep_panels(geometry, q, ax, creep_max, n_points, zoom)
     fx, _ = wilac_forces(creep[None, :], 0.0, 0.0, q, v, a, b, flows[:, None], p)
     _draw_distinguishable(
         axes, 100 * creep, list(np.asarray(fx) / q), [f"w = {w:g} µl/s" for w in flows],
         [{"color": f"C{i}"} for i in range(flows.size)],
     )  # fmt: skip
-    _finish_adhesion_axes(
-        ax,
-        _CREEP_LABEL,
+    _finish_creep_panels(
+        ax, ax_zoom, zoom, creep_max,
         f"WILAC, Q = {q / 1e3:g} kN, v = {v:g} m/s (cf. Trummer et al., Fig. 7)",
-        (-100 * float(creep_max), 0.0),
-    )
-    _finish_zoom(ax_zoom, zoom, ax)
+    )  # fmt: skip
     return fig
 
 
@@ -424,8 +425,7 @@ def plot_wilac_speeds(
     q = float(check_positive(normal_force, "normal_force"))
     w = float(check_nonnegative(water_flow, "water_flow"))
     vs = check_nonnegative(np.atleast_1d(np.asarray(speeds, dtype=float)), "speeds")
-    a, b = contact_semi_axes(geometry, q)
-    creep, fig, ax, ax_zoom, axes = _creep_panels(ax, creep_max, n_points, zoom)
+    a, b, creep, fig, ax, ax_zoom, axes = _creep_panels(geometry, q, ax, creep_max, n_points, zoom)
     fx, _ = wilac_forces(creep[None, :], 0.0, 0.0, q, vs[:, None], a, b, w, p)
     colors = [f"C{i}" for i in range(len(vs))]
     rows = list(np.asarray(fx) / q)
@@ -449,14 +449,11 @@ def plot_wilac_speeds(
             labels.append(f"Polach, fixed parameters of {vp:g} m/s, v = {v:g} m/s")
             styles.append({"color": col, "ls": "--"})
     _draw_distinguishable(axes, 100 * creep, rows, labels, styles)
-    _finish_adhesion_axes(
-        ax,
-        _CREEP_LABEL,
+    _finish_creep_panels(
+        ax, ax_zoom, zoom, creep_max,
         f"WILAC, Q = {q / 1e3:g} kN, w = {w:g} µl/s (cf. Trummer et al., Figs. 9 and 11)",
-        (-100 * float(creep_max), 0.0),
         fontsize="small",
-    )
-    _finish_zoom(ax_zoom, zoom, ax)
+    )  # fmt: skip
     return fig
 
 

@@ -64,6 +64,24 @@ def _sample_rows(ident, phase, max_points):
             ident.mu[rows, axles], total)
 
 
+def _finish(fig, ax, xlabel: str, ylabel: str, title: str, legend_size: float):
+    """Label, grid, legend (font size ``legend_size``) and title of a one-panel figure, laid
+    out; returns ``fig``."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=legend_size)
+    ax.set_title(title)
+    fig.tight_layout()
+    return fig
+
+
+def _plot_curve(ax, curve, slip_floor: float, *style, **kwargs) -> None:
+    """Draw a fitted ``curve`` over slip 0 to the end of its data (at least ``slip_floor``)."""
+    s = np.linspace(0.0, max(curve.slip_range[1], slip_floor), 300)
+    ax.plot(s, curve(s), *style, **kwargs)
+
+
 def plot_log(ident, max_points: int = 2000):
     """Train speed, wheel peripheral speeds R omega and brake pressures over time (Fig. 4)."""
     import matplotlib.pyplot as plt
@@ -108,13 +126,8 @@ def plot_brake_coefficient(ident, max_points: int = 2000):
         lo, hi = np.percentile(finite, [1, 99])
         pad = 0.5 * (hi - lo) + 0.05 * abs(b.mean * BAR)
         ax.set_ylim(lo - pad, hi + pad)
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("c [N m/bar]")
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
-    ax.set_title("Brake coefficient (cf. seed 002 Fig. 6)")
-    fig.tight_layout()
-    return fig
+    return _finish(fig, ax, "time [s]", "c [N m/bar]", "Brake coefficient (cf. seed 002 Fig. 6)",
+                   8)  # fmt: skip
 
 
 def plot_slip_and_adhesion(ident, axle: int = 1, max_points: int = 2000):
@@ -158,19 +171,12 @@ def plot_adhesion_vs_slip(ident, law=None, max_points: int = 30000):
         ax.plot(dv, mu, ".", ms=1.5, color=colour, alpha=0.4,
                 label=f"{phase} of adhesion ({total} samples)")
     if law is not None:
-        c = law.overall
-        s = np.linspace(0.0, max(c.slip_range[1], 1e-3), 300)
-        ax.plot(s, c(s), "k-", lw=2, label="fitted curve (all speeds)")
+        _plot_curve(ax, law.overall, 1e-3, "k-", lw=2, label="fitted curve (all speeds)")
         for b in law.bands:
-            s = np.linspace(0.0, max(b.slip_range[1], 1e-3), 300)
-            ax.plot(s, b(s), "--", lw=1, label=f"{b.speed_band[0]:g}-{b.speed_band[1]:g} m/s")
-    ax.set_xlabel("absolute slip v - R omega [m/s]")
-    ax.set_ylabel("adhesion mu [-]")
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7)
-    ax.set_title("Adhesion against absolute slip (cf. seed 002 Figs. 8-9)")
-    fig.tight_layout()
-    return fig
+            _plot_curve(ax, b, 1e-3, "--", lw=1,
+                        label=f"{b.speed_band[0]:g}-{b.speed_band[1]:g} m/s")  # fmt: skip
+    return _finish(fig, ax, "absolute slip v - R omega [m/s]", "adhesion mu [-]",
+                   "Adhesion against absolute slip (cf. seed 002 Figs. 8-9)", 7)  # fmt: skip
 
 
 def plot_relative_slip(ident, law=None, max_points: int = 30000):
@@ -182,15 +188,10 @@ def plot_relative_slip(ident, law=None, max_points: int = 30000):
     ax.plot(rel, mu, ".", ms=1.2, color="0.6", alpha=0.4, label="samples")
     if law is not None:
         for b in law.bands:
-            s = np.linspace(0.0, max(b.slip_range[1], 1e-4), 300)
-            ax.plot(s, b(s), lw=1.5, label=f"v {b.speed_band[0]:g}-{b.speed_band[1]:g} m/s")
-    ax.set_xlabel("relative slip (v - R omega)/v [-]")
-    ax.set_ylabel("adhesion mu [-]")
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7)
-    ax.set_title("Adhesion against relative slip per speed band (cf. seed 002 Fig. 10)")
-    fig.tight_layout()
-    return fig
+            _plot_curve(ax, b, 1e-4, lw=1.5, label=f"v {b.speed_band[0]:g}-{b.speed_band[1]:g} m/s")
+    return _finish(fig, ax, "relative slip (v - R omega)/v [-]", "adhesion mu [-]",
+                   "Adhesion against relative slip per speed band (cf. seed 002 Fig. 10)",
+                   7)  # fmt: skip
 
 
 def plot_surface(ds, phase: str = "all"):

@@ -107,7 +107,30 @@ class LogIssue:
 
 
 @dataclass(frozen=True, eq=False)
-class BrakingLog:
+class AxleLog:
+    """The channels every log of a train's axles holds, SI units (n samples, N axles): time
+    [s] (n,), train speed [m/s] (n,), wheelset angular speeds [rad/s] (n, N) and
+    brake-cylinder pressures [Pa] (n, N). Base of :class:`BrakingLog` (identification) and
+    :class:`railadhesion.monitor.replay.MonitorLog` (the monitor's replay)."""
+
+    time: np.ndarray
+    train_speed: np.ndarray
+    wheel_speed: np.ndarray
+    brake_pressure: np.ndarray
+
+    @property
+    def n_axles(self) -> int:
+        """Number of axles N."""
+        return int(self.wheel_speed.shape[1])
+
+    @property
+    def n_samples(self) -> int:
+        """Number of samples n."""
+        return int(self.time.size)
+
+
+@dataclass(frozen=True, eq=False)
+class BrakingLog(AxleLog):
     """A braking-test log, sorted and repaired, in SI units.
 
     Attributes
@@ -139,10 +162,6 @@ class BrakingLog:
         such findings should not be identified from until they are explained.
     """
 
-    time: np.ndarray
-    train_speed: np.ndarray
-    wheel_speed: np.ndarray
-    brake_pressure: np.ndarray
     valid: np.ndarray
     segment: np.ndarray
     issues: tuple = ()
@@ -150,16 +169,6 @@ class BrakingLog:
     rows: np.ndarray = field(default=None)
     substituted: np.ndarray = field(default=None)
     warnings: tuple = ()
-
-    @property
-    def n_axles(self) -> int:
-        """Number of axles N."""
-        return int(self.wheel_speed.shape[1])
-
-    @property
-    def n_samples(self) -> int:
-        """Number of samples n."""
-        return int(self.time.size)
 
     @property
     def period(self) -> float:

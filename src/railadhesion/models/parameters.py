@@ -132,34 +132,39 @@ class PolachParameters:
         return dataclasses.replace(self, **changes)
 
 
+def instance_or_default(value, cls: type, name: str, default):
+    """An optional argument that must be a ``cls`` (a parameter set, settings): ``default()``
+    when ``value`` is None, else ``value``; a ValueError names the argument ``name`` and the
+    type given otherwise."""
+    if value is None:
+        value = default()
+    if not isinstance(value, cls):
+        raise ValueError(f"{name} must be a {cls.__name__}, got {type(value).__name__}")
+    return value
+
+
 _POLACH2005_SOURCE = (
     "Polach O., Creep forces in simulations of traction vehicles running on adhesion limit, "
     "Wear 258 (2005) 992-1000, as quoted in third-party codes, labelled typical locomotive "
     "values; not read in the paper"
 )
 
+
+def _polach2005(rail: str, **values: float) -> PolachParameters:
+    """The Polach 2005 set for a ``"dry"`` or ``"wet"`` rail, from its five ``values``."""
+    return PolachParameters(
+        **values,
+        name=f"polach2005_{rail}",
+        source=_POLACH2005_SOURCE,
+        notes=f"{rail.capitalize()} rail. Identical values found in two independent "
+        "third-party codes.",
+    )
+
+
 #: Built-in parameter sets, by name.
 POLACH_PARAMETER_SETS: dict[str, PolachParameters] = {
-    "polach2005_dry": PolachParameters(
-        k_A=1.0,
-        k_S=0.4,
-        mu0=0.55,
-        A=0.4,
-        B=0.6,
-        name="polach2005_dry",
-        source=_POLACH2005_SOURCE,
-        notes="Dry rail. Identical values found in two independent third-party codes.",
-    ),
-    "polach2005_wet": PolachParameters(
-        k_A=0.3,
-        k_S=0.1,
-        mu0=0.3,
-        A=0.4,
-        B=0.2,
-        name="polach2005_wet",
-        source=_POLACH2005_SOURCE,
-        notes="Wet rail. Identical values found in two independent third-party codes.",
-    ),
+    "polach2005_dry": _polach2005("dry", k_A=1.0, k_S=0.4, mu0=0.55, A=0.4, B=0.6),
+    "polach2005_wet": _polach2005("wet", k_A=0.3, k_S=0.1, mu0=0.3, A=0.4, B=0.2),
     "contact_eurosprinter": PolachParameters(
         k_A=1.0,
         k_S=1.0,

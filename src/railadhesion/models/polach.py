@@ -385,17 +385,24 @@ def chunk_shape_coefficients(buf):
     return ok
 
 
+@jitable(inline="always")
+def _chunk_force(buf, k, t):
+    """:func:`polach_force` of contact k of a chunk buffer (its creepages, Q, V and Polach
+    parameters in their rows), given its contact terms ``t`` (:func:`polach_contact_terms`)."""
+    return polach_force(
+        buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k], buf[ROW_Q * CHUNK + k],
+        buf[ROW_V * CHUNK + k], t[0], t[1], t[2], t[3], t[4], t[5], t[6],
+        buf[_KA * CHUNK + k], buf[_KS * CHUNK + k], buf[_MU0 * CHUNK + k],
+        buf[_BA * CHUNK + k], buf[_BB * CHUNK + k])  # fmt: skip
+
+
 @jitable
 def _polach_rows(buf, ox, oy, m):
     """:func:`polach_law` of the m contacts of a chunk buffer (Kalker's coefficients in their
     rows) into ox, oy: the law inlined in one loop, vectorised."""
     for k in range(m):
         t = chunk_contact_terms(buf, k)
-        ox[k], oy[k] = polach_force(
-            buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k], buf[ROW_Q * CHUNK + k],
-            buf[ROW_V * CHUNK + k], t[0], t[1], t[2], t[3], t[4], t[5], t[6],
-            buf[_KA * CHUNK + k], buf[_KS * CHUNK + k], buf[_MU0 * CHUNK + k],
-            buf[_BA * CHUNK + k], buf[_BB * CHUNK + k])  # fmt: skip
+        ox[k], oy[k] = _chunk_force(buf, k, t)
 
 
 @jitable
@@ -407,11 +414,7 @@ def _polach_rows_spinless(buf, ox, oy, m):
             buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k], 0.0, buf[ROW_A * CHUNK + k],
             buf[ROW_B * CHUNK + k], buf[ROW_G * CHUNK + k], buf[ROW_C11 * CHUNK + k],
             buf[ROW_C22 * CHUNK + k], buf[ROW_C23 * CHUNK + k])  # fmt: skip
-        ox[k], oy[k] = polach_force(
-            buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k], buf[ROW_Q * CHUNK + k],
-            buf[ROW_V * CHUNK + k], t[0], t[1], t[2], t[3], t[4], t[5], t[6],
-            buf[_KA * CHUNK + k], buf[_KS * CHUNK + k], buf[_MU0 * CHUNK + k],
-            buf[_BA * CHUNK + k], buf[_BB * CHUNK + k])  # fmt: skip
+        ox[k], oy[k] = _chunk_force(buf, k, t)
 
 
 @jitable
@@ -422,11 +425,7 @@ def _polach_same_shape(buf, ox, oy, m, a, b, g, c11, c22, c23):
     for k in range(m):
         t = polach_contact_terms(buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k],
                                  buf[ROW_PSI * CHUNK + k], a, b, g, c11, c22, c23)  # fmt: skip
-        ox[k], oy[k] = polach_force(
-            buf[ROW_X * CHUNK + k], buf[ROW_Y * CHUNK + k], buf[ROW_Q * CHUNK + k],
-            buf[ROW_V * CHUNK + k], t[0], t[1], t[2], t[3], t[4], t[5], t[6],
-            buf[_KA * CHUNK + k], buf[_KS * CHUNK + k], buf[_MU0 * CHUNK + k],
-            buf[_BA * CHUNK + k], buf[_BB * CHUNK + k])  # fmt: skip
+        ox[k], oy[k] = _chunk_force(buf, k, t)
 
 
 @kernel(nogil=True)

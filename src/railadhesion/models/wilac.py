@@ -30,6 +30,7 @@ from railadhesion._labelled import labelled
 from railadhesion._validate import as_float_array, check_nonnegative, check_positive
 from railadhesion.contact.kalker import kalker_law
 from railadhesion.models import wilac_parameters as _parameters
+from railadhesion.models.parameters import instance_or_default
 from railadhesion.models.polach import (
     CONTACT_ROWS,
     ROW_A,
@@ -471,11 +472,8 @@ class Wilac:
 
     def __init__(self, params: WilacParameters | None = None, *, shear_modulus=8.2e10,
                  poisson=0.28):
-        if params is None:
-            params = default_wilac_parameters()
-        if not isinstance(params, WilacParameters):
-            raise ValueError(f"params must be a WilacParameters, got {type(params).__name__}")
-        self.params = params
+        self.params = instance_or_default(params, WilacParameters, "params",
+                                          default_wilac_parameters)  # fmt: skip
         self.shear_modulus = shear_modulus
         self.poisson = poisson
 

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from railadhesion.models.parameters import instance_or_default
 from railadhesion.monitor import layout
 from railadhesion.monitor.settings import POLACH_RATIO, MonitorSettings
 
@@ -319,10 +320,7 @@ class AdhesionMonitor:
 
         if not isinstance(vehicle, Vehicle):
             vehicle = load_vehicle(vehicle)
-        if settings is None:
-            settings = MonitorSettings()
-        if not isinstance(settings, MonitorSettings):
-            raise ValueError(f"settings must be a MonitorSettings, got {type(settings).__name__}")
+        settings = instance_or_default(settings, MonitorSettings, "settings", MonitorSettings)
         self.vehicle = vehicle
         self.settings = settings
         self.n_axles = int(vehicle.n_axles)

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from railadhesion.identification.logs import AxleLog
 from railadhesion.monitor import layout
 from railadhesion.monitor.estimator import AdhesionMonitor
 from railadhesion.monitor.settings import MonitorSettings
@@ -35,7 +36,7 @@ _BAR_LIMIT = 50.0
 
 
 @dataclass(frozen=True, eq=False)
-class MonitorLog:
+class MonitorLog(AxleLog):
     """A log as recorded (rows in the file's order, nothing repaired), SI units.
 
     Attributes
@@ -58,23 +59,11 @@ class MonitorLog:
         The file read ("" if built in memory).
     """
 
-    time: np.ndarray
-    train_speed: np.ndarray
-    wheel_speed: np.ndarray
-    brake_pressure: np.ndarray
     torque: np.ndarray
     has_pressure: np.ndarray
     has_torque: np.ndarray
     issues: tuple = ()
     source: str = ""
-
-    @property
-    def n_samples(self) -> int:
-        return int(self.time.size)
-
-    @property
-    def n_axles(self) -> int:
-        return int(self.wheel_speed.shape[1])
 
 
 def _numbers(col, name, issues):
