@@ -55,6 +55,7 @@ from railadhesion.braking.adhesion import (
 )
 from railadhesion.braking.cylinders import BrakeCylinders
 from railadhesion.braking.metrics import slide_metrics
+from railadhesion.braking.scenario import polach_set_name, wsp_settings_fields
 from railadhesion.braking.sensors import (
     ExternalSpeedSettings,
     SensorModel,
@@ -62,7 +63,7 @@ from railadhesion.braking.sensors import (
     noisy_sensors,
 )
 from railadhesion.braking.simulator import BrakingSimulator, SimulationError
-from railadhesion.braking.vehicle import GRAVITY, Vehicle, load_vehicle
+from railadhesion.braking.vehicle import GRAVITY, Vehicle, vehicle_from_field
 from railadhesion.braking.wsp import (
     WheelSlideProtection,
     WSPSettings,
@@ -256,6 +257,15 @@ def _criteria(tab, where, base):
     return out
 
 
+def _named_set(tab, where, values, either: str) -> PolachParameters:
+    """The Polach set named by ``tab["parameters"]``, which excludes the ``values`` (their
+    error: ``either``)."""
+    for k in values:
+        if k in tab:
+            raise FieldError(f"{where}.{k}", either)
+    return POLACH_PARAMETER_SETS[polach_set_name(tab["parameters"], f"{where}.parameters")]
+
+
 def _adhesion_case(tab, where) -> AdhesionCase:
     tab = table(tab, where)
     model = string(tab.get("model", ""), f"{where}.model")
@@ -271,15 +281,9 @@ def _adhesion_case(tab, where) -> AdhesionCase:
         keys(tab, where, ("model",), ("parameters", "mu0", "A", "B", "k_A", "k_S", "start_m",
                                       "end_m"))
         if "parameters" in tab:
-            for k in ("mu0", "A", "B", "k_A", "k_S"):
-                if k in tab:
-                    raise FieldError(f"{where}.{k}", "give either parameters (a named set) or "
-                                     "the values mu0, A, B, k_A, k_S")
-            name = string(tab["parameters"], f"{where}.parameters")
-            if name not in POLACH_PARAMETER_SETS:
-                raise FieldError(f"{where}.parameters", f"unknown Polach set {name!r}; known: "
-                                 f"{', '.join(sorted(POLACH_PARAMETER_SETS))}")
-            params = POLACH_PARAMETER_SETS[name]
+            params = _named_set(tab, where, ("mu0", "A", "B", "k_A", "k_S"),
+                                "give either parameters (a named set) or the values mu0, A, B, "
+                                "k_A, k_S")
         else:
             if "mu0" not in tab:
                 raise FieldError(f"{where}.mu0", "required for model = 'polach' (or give "
@@ -295,15 +299,8 @@ def _adhesion_case(tab, where) -> AdhesionCase:
     if model == "table":
         keys(tab, where, ("model",), ("parameters", "mu0", "A", "B"))
         if "parameters" in tab:
-            for k in ("mu0", "A", "B"):
-                if k in tab:
-                    raise FieldError(f"{where}.{k}", "give either parameters (a named Polach "
-                                     "set: its mu0, A, B) or the values mu0, A, B")
-            name = string(tab["parameters"], f"{where}.parameters")
-            if name not in POLACH_PARAMETER_SETS:
-                raise FieldError(f"{where}.parameters", f"unknown Polach set {name!r}; known: "
-                                 f"{', '.join(sorted(POLACH_PARAMETER_SETS))}")
-            params = POLACH_PARAMETER_SETS[name]
+            params = _named_set(tab, where, ("mu0", "A", "B"), "give either parameters (a "
+                                "named Polach set: its mu0, A, B) or the values mu0, A, B")
         else:
             if "mu0" not in tab:
                 raise FieldError(f"{where}.mu0", "required for model = 'table' (or give "
@@ -336,17 +333,8 @@ def _programme_from_document(doc, base: Path) -> WSPProgramme:
     wsp = {}
     if "wsp" in doc:
         wt = table(doc["wsp"], "wsp")
-        file_keys = settings_file_keys()
-        keys(wt, "wsp", (), tuple(file_keys))
-        for k, (attr, lo, hi) in file_keys.items():
-            if k in wt:
-                wsp[attr] = (integer(wt[k], f"wsp.{k}", int(lo), int(hi))
-                             if attr == "watchdog_cutout_trips" else number(wt[k], f"wsp.{k}",
-                                                                            lo, hi))
-        try:
-            WSPSettings(**wsp)
-        except ValueError as exc:
-            raise FieldError("wsp", str(exc)) from None
+        keys(wt, "wsp", (), tuple(settings_file_keys()))
+        wsp = wsp_settings_fields(wt)[0]
     cases = doc["case"]
     if not isinstance(cases, list) or not cases:
         raise FieldError("case", "expected one or more [[case]] tables")
@@ -376,11 +364,7 @@ def _programme_from_document(doc, base: Path) -> WSPProgramme:
         value, w = get("vehicle")
         vfile = string(value, w)
         if vfile not in vehicles:
-            vpath = Path(vfile) if Path(vfile).is_absolute() else base / vfile
-            try:
-                vehicles[vfile] = load_vehicle(vpath if vpath.exists() else vfile)
-            except ValueError as exc:
-                raise FieldError(w, str(exc)) from None
+            vehicles[vfile] = vehicle_from_field(vfile, w, base)
         vehicle = vehicles[vfile]
         value, w = get("initial_speed_m_s")
         if value is None:
