@@ -94,6 +94,7 @@ __all__ = [
     "save_figure",
     "write_json",
     "read_cosim_fmu",
+    "fmu_variable_problems",
     "run_wsp_case",
     "run_wsp_programme",
     "run_programme_cases",
@@ -574,6 +575,20 @@ def load_component(text: str, what: str, default: str, prefix: str):
     return load_attribute(text, what, prefix)
 
 
+def fmu_variable_problems(variables, missing, want) -> str:
+    """What is wrong with the ``variables`` of an FMU (FMPy's, by name) for a bench: it lacks
+    the ``missing`` ones, or has one of ``want`` = [(name, causality)] with another causality;
+    ``""`` if nothing."""
+    wrong = [f"{name} (is {variables[name].causality}, must be {c})" for name, c in want
+             if name in variables and variables[name].causality != c]
+    parts = []
+    if missing:
+        parts.append("lacks the variables " + ", ".join(missing))
+    if wrong:
+        parts.append("has " + ", ".join(wrong))
+    return " and ".join(parts)
+
+
 class FmuController:
     """A WSP unit delivered as an FMI 2.0 co-simulation FMU, run with FMPy.
 
@@ -601,17 +616,11 @@ class FmuController:
     def _check_variables(self, n: int):
         want = [(f"wheel_speed_{i}", "input") for i in range(1, n + 1)] + [
             (f"valve_{i}", "output") for i in range(1, n + 1)]
-        missing = [name for name, _ in want if name not in self.vars]
-        wrong = [f"{name} (is {self.vars[name].causality}, must be {caus})" for name, caus in want
-                 if name in self.vars and self.vars[name].causality != caus]
-        if missing or wrong:
-            parts = []
-            if missing:
-                parts.append("lacks the variables " + ", ".join(missing))
-            if wrong:
-                parts.append("has " + ", ".join(wrong))
+        problems = fmu_variable_problems(
+            self.vars, [name for name, _ in want if name not in self.vars], want)
+        if problems:
             raise WSPControllerError(
-                f"{self.path.name}: the FMU {' and '.join(parts)}; a WSP FMU needs inputs "
+                f"{self.path.name}: the FMU {problems}; a WSP FMU needs inputs "
                 f"wheel_speed_1..{n} [rad/s] and outputs valve_1..{n} (0 apply, 1 hold, 2 vent); "
                 f"optional inputs brake_pressure_1..{n} [Pa], pressure_command [Pa], "
                 "external_speed [m/s]")

@@ -48,6 +48,7 @@ from railadhesion.braking.bench import (
     BenchCase,
     ProgrammeResult,
     case_field,
+    fmu_variable_problems,
     load_component,
     load_controller,
     programme_from_document,
@@ -553,28 +554,22 @@ class FmuOdometry:
 
     def _check(self, axles):
         v = self.vars
-        problems = []
+        missing = []
         for i in axles:
             if f"wheel_speed_{i}" not in v and f"pulse_count_{i}" not in v:
-                problems.append(f"wheel_speed_{i} (or pulse_count_{i})")
+                missing.append(f"wheel_speed_{i} (or pulse_count_{i})")
         for name in _OUTPUTS[:4]:
             if name not in v:
-                problems.append(name)
-        wrong = [f"{name} (is {v[name].causality}, must be {c})" for name, c in
-                 [*((f"wheel_speed_{i}", "input") for i in axles),
-                  *((f"pulse_count_{i}", "input") for i in axles),
-                  *((n, "input") for n in ("radar_speed", "acceleration", "drive")),
-                  *((n, "output") for n in _OUTPUTS)]
-                 if name in v and v[name].causality != c]
-        if problems or wrong:
-            parts = []
-            if problems:
-                parts.append("lacks the variables " + ", ".join(problems))
-            if wrong:
-                parts.append("has " + ", ".join(wrong))
+                missing.append(name)
+        problems = fmu_variable_problems(
+            v, missing, [*((f"wheel_speed_{i}", "input") for i in axles),
+                          *((f"pulse_count_{i}", "input") for i in axles),
+                          *((n, "input") for n in ("radar_speed", "acceleration", "drive")),
+                          *((n, "output") for n in _OUTPUTS)])
+        if problems:
             axl = ", ".join(str(i) for i in axles)
             raise OdometryInterfaceError(
-                f"{self.path.name}: the FMU {' and '.join(parts)}; an odometry FMU reading axles "
+                f"{self.path.name}: the FMU {problems}; an odometry FMU reading axles "
                 f"{axl} needs inputs wheel_speed_i [rad/s] or pulse_count_i for each, outputs "
                 "speed, distance, distance_min, distance_max; optional inputs radar_speed, "
                 "acceleration, drive and output status")
