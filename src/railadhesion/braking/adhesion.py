@@ -226,16 +226,12 @@ class AdhesionRecovery:
         return np.exp(-np.asarray(dissipation, float) / self.energy_scale)
 
 
-class _PolachFamily(AxleAdhesion):
-    """Shared machinery: a (n, K) weight table, a (n, K, 5) parameter table and the contact
-    stiffness per axle; the curves of :mod:`railadhesion.braking.curves`."""
+class _CompiledAdhesion(AxleAdhesion):
+    """Shared by the models that also run compiled in the braking step: at most ``MAX_AXLES``
+    axles, a contact geometry (by default Hertz for the vehicle's wheel radius), and μ with
+    both slopes from one call of :meth:`slopes`."""
 
-    def __init__(self, contact: ContactGeometry | None = None):
-        self.contact = contact
-        self.weights = None
-        self.params = None
-        self.stiffness = None
-        self._workspace = None
+    contact: ContactGeometry | None = None
 
     def bind(self, n_axles, wheel_radius):
         from railadhesion.braking.records import MAX_AXLES
@@ -245,6 +241,34 @@ class _PolachFamily(AxleAdhesion):
         super().bind(n_axles, wheel_radius)
         if self.contact is None:
             self.contact = ContactGeometry(wheel_radius=wheel_radius)
+            self._check_contact()
+
+    def _check_contact(self):
+        """Check the contact against the model's range (any contact here)."""
+
+    def evaluate(self, creep, speed):
+        mu, dmu, _ = self.slopes(creep, speed)
+        return mu, dmu
+
+
+def _axle_arrays(creep, n):
+    """Three empty arrays for μ, dμ/dξ and dμ/dV of the ``n`` axles; ``ValueError`` if the
+    array ``creep`` does not have one value per axle."""
+    if creep.shape != (n,):
+        raise ValueError(f"creep must have one value per axle ({n}), got shape {creep.shape}")
+    return np.empty(creep.size), np.empty(creep.size), np.empty(creep.size)
+
+
+class _PolachFamily(_CompiledAdhesion):
+    """Shared machinery: a (n, K) weight table, a (n, K, 5) parameter table and the contact
+    stiffness per axle; the curves of :mod:`railadhesion.braking.curves`."""
+
+    def __init__(self, contact: ContactGeometry | None = None):
+        self.contact = contact
+        self.weights = None
+        self.params = None
+        self.stiffness = None
+        self._workspace = None
 
     def _tables(self):
         if self._workspace is None:
@@ -261,16 +285,9 @@ class _PolachFamily(AxleAdhesion):
 
         creep = np.ascontiguousarray(creep, dtype=float)
         weights, params, stiffness, workspace = self._tables()
-        if creep.shape != (weights.shape[0],):
-            raise ValueError(f"creep must have one value per axle ({weights.shape[0]}), got "
-                             f"shape {creep.shape}")
-        mu, dmu, dmv = np.empty(creep.size), np.empty(creep.size), np.empty(creep.size)
+        mu, dmu, dmv = _axle_arrays(creep, weights.shape[0])
         family_slopes(creep, float(speed), weights, params, stiffness, workspace, mu, dmu, dmv)
         return mu, dmu, dmv
-
-    def evaluate(self, creep, speed):
-        mu, dmu, _ = self.slopes(creep, speed)
-        return mu, dmu
 
     def slope_table(self, creeps, speed):
         """dμ/dξ of every axle (columns) at each of ``creeps`` (rows), at the prepared
@@ -417,7 +434,7 @@ def _real(value, name, low, high, low_open=False):
     return v
 
 
-class ExactTableAdhesion(AxleAdhesion):
+class ExactTableAdhesion(_CompiledAdhesion):
     """The table model of Kalker's exact theory as each axle's creep-force law.
 
     Each wheel's adhesion is ``μ(ξ) = −Fx/Q`` of :func:`railadhesion.contact.exact_table_forces`
@@ -482,16 +499,6 @@ class ExactTableAdhesion(AxleAdhesion):
                              f"{aob:.4g} (semi-axes {c.a0:.4g} m, {c.b0:.4g} m)")
         self.arrays = exact_table_arrays(aob)
 
-    def bind(self, n_axles, wheel_radius):
-        from railadhesion.braking.records import MAX_AXLES
-
-        if n_axles > MAX_AXLES:
-            raise ValueError(f"n_axles must be at most {MAX_AXLES}, got {n_axles}")
-        super().bind(n_axles, wheel_radius)
-        if self.contact is None:
-            self.contact = ContactGeometry(wheel_radius=wheel_radius)
-            self._check_contact()
-
     def prepare(self, speed, normal_loads, positions, time, dissipation=None):
         loads = np.ascontiguousarray(np.broadcast_to(np.asarray(normal_loads, float),
                                                      (self.n_axles,)))
@@ -513,17 +520,10 @@ class ExactTableAdhesion(AxleAdhesion):
         creep = np.ascontiguousarray(creep, dtype=float)
         if self.loads is None:
             raise RuntimeError("prepare() must be called before slopes()")
-        if creep.shape != self.loads.shape:
-            raise ValueError(f"creep must have one value per axle ({self.loads.size}), got "
-                             f"shape {creep.shape}")
-        mu, dmu, dmv = np.empty(creep.size), np.empty(creep.size), np.empty(creep.size)
+        mu, dmu, dmv = _axle_arrays(creep, self.loads.size)
         table_slopes(creep, float(speed), self.loads, self.a, self.b, *self._law(), mu, dmu,
                      dmv)
         return mu, dmu, dmv
-
-    def evaluate(self, creep, speed):
-        mu, dmu, _ = self.slopes(creep, speed)
-        return mu, dmu
 
     def slope_table(self, creeps, speed):
         """dμ/dξ of every axle (columns) at each of ``creeps`` (rows), at the prepared

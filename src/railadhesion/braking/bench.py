@@ -31,6 +31,7 @@ import math
 import os
 import time as _time
 from dataclasses import dataclass, field, replace
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -55,6 +56,7 @@ from railadhesion.braking.adhesion import (
 )
 from railadhesion.braking.cylinders import BrakeCylinders
 from railadhesion.braking.metrics import slide_metrics
+from railadhesion.braking.scenario import polach_set_name, wsp_settings_fields
 from railadhesion.braking.sensors import (
     ExternalSpeedSettings,
     SensorModel,
@@ -62,7 +64,7 @@ from railadhesion.braking.sensors import (
     noisy_sensors,
 )
 from railadhesion.braking.simulator import BrakingSimulator, SimulationError
-from railadhesion.braking.vehicle import GRAVITY, Vehicle, load_vehicle
+from railadhesion.braking.vehicle import GRAVITY, Vehicle, vehicle_from_field
 from railadhesion.braking.wsp import (
     WheelSlideProtection,
     WSPSettings,
@@ -79,19 +81,25 @@ __all__ = [
     "BenchCase",
     "WSPProgramme",
     "WSPProgrammeResult",
+    "ProgrammeResult",
     "WSPControllerError",
     "FmuController",
     "load_wsp_programme",
     "load_controller",
     "adhesion_limited_stop",
     "load_attribute",
+    "load_component",
+    "case_field",
     "programme_from_document",
     "save_figure",
     "write_json",
     "read_cosim_fmu",
+    "fmu_variable_problems",
     "run_wsp_case",
     "run_wsp_programme",
+    "run_programme_cases",
     "write_programme_outputs",
+    "write_bench_outputs",
     "json_safe",
     "read_programme_file",
     "release_fmu",
@@ -241,6 +249,17 @@ _CRITERIA_KEYS = ("max_longest_lock_s", "max_mean_creep", "max_distance_ratio",
                   "max_ratio_no_wsp")
 
 
+def case_field(key, tab, defaults, fallback, where):
+    """A field of a programme's case: ``(value, where it is given)`` from the case's table
+    ``tab`` (at ``where``), else from the programme's ``[defaults]``, else ``fallback[key]``
+    (the default value, reported at ``where``)."""
+    if key in tab:
+        return tab[key], f"{where}.{key}"
+    if key in defaults:
+        return defaults[key], f"defaults.{key}"
+    return fallback[key], f"{where}.{key}"
+
+
 def _criteria(tab, where, base):
     tab = table(tab, where)
     keys(tab, where, (), _CRITERIA_KEYS)
@@ -254,6 +273,15 @@ def _criteria(tab, where, base):
         out[key] = math.inf if ratio == math.inf else number(ratio, f"{where}.{key}", low,
                                                              100.0)
     return out
+
+
+def _named_set(tab, where, values, either: str) -> PolachParameters:
+    """The Polach set named by ``tab["parameters"]``, which excludes the ``values`` (their
+    error: ``either``)."""
+    for k in values:
+        if k in tab:
+            raise FieldError(f"{where}.{k}", either)
+    return POLACH_PARAMETER_SETS[polach_set_name(tab["parameters"], f"{where}.parameters")]
 
 
 def _adhesion_case(tab, where) -> AdhesionCase:
@@ -271,15 +299,9 @@ def _adhesion_case(tab, where) -> AdhesionCase:
         keys(tab, where, ("model",), ("parameters", "mu0", "A", "B", "k_A", "k_S", "start_m",
                                       "end_m"))
         if "parameters" in tab:
-            for k in ("mu0", "A", "B", "k_A", "k_S"):
-                if k in tab:
-                    raise FieldError(f"{where}.{k}", "give either parameters (a named set) or "
-                                     "the values mu0, A, B, k_A, k_S")
-            name = string(tab["parameters"], f"{where}.parameters")
-            if name not in POLACH_PARAMETER_SETS:
-                raise FieldError(f"{where}.parameters", f"unknown Polach set {name!r}; known: "
-                                 f"{', '.join(sorted(POLACH_PARAMETER_SETS))}")
-            params = POLACH_PARAMETER_SETS[name]
+            params = _named_set(tab, where, ("mu0", "A", "B", "k_A", "k_S"),
+                                "give either parameters (a named set) or the values mu0, A, B, "
+                                "k_A, k_S")
         else:
             if "mu0" not in tab:
                 raise FieldError(f"{where}.mu0", "required for model = 'polach' (or give "
@@ -295,15 +317,8 @@ def _adhesion_case(tab, where) -> AdhesionCase:
     if model == "table":
         keys(tab, where, ("model",), ("parameters", "mu0", "A", "B"))
         if "parameters" in tab:
-            for k in ("mu0", "A", "B"):
-                if k in tab:
-                    raise FieldError(f"{where}.{k}", "give either parameters (a named Polach "
-                                     "set: its mu0, A, B) or the values mu0, A, B")
-            name = string(tab["parameters"], f"{where}.parameters")
-            if name not in POLACH_PARAMETER_SETS:
-                raise FieldError(f"{where}.parameters", f"unknown Polach set {name!r}; known: "
-                                 f"{', '.join(sorted(POLACH_PARAMETER_SETS))}")
-            params = POLACH_PARAMETER_SETS[name]
+            params = _named_set(tab, where, ("mu0", "A", "B"), "give either parameters (a "
+                                "named Polach set: its mu0, A, B) or the values mu0, A, B")
         else:
             if "mu0" not in tab:
                 raise FieldError(f"{where}.mu0", "required for model = 'table' (or give "
@@ -336,17 +351,8 @@ def _programme_from_document(doc, base: Path) -> WSPProgramme:
     wsp = {}
     if "wsp" in doc:
         wt = table(doc["wsp"], "wsp")
-        file_keys = settings_file_keys()
-        keys(wt, "wsp", (), tuple(file_keys))
-        for k, (attr, lo, hi) in file_keys.items():
-            if k in wt:
-                wsp[attr] = (integer(wt[k], f"wsp.{k}", int(lo), int(hi))
-                             if attr == "watchdog_cutout_trips" else number(wt[k], f"wsp.{k}",
-                                                                            lo, hi))
-        try:
-            WSPSettings(**wsp)
-        except ValueError as exc:
-            raise FieldError("wsp", str(exc)) from None
+        keys(wt, "wsp", (), tuple(settings_file_keys()))
+        wsp = wsp_settings_fields(wt)[0]
     cases = doc["case"]
     if not isinstance(cases, list) or not cases:
         raise FieldError("case", "expected one or more [[case]] tables")
@@ -365,22 +371,11 @@ def _programme_from_document(doc, base: Path) -> WSPProgramme:
             raise FieldError(f"{where}.name", f"duplicate case name {cname!r}")
         seen.add(cname)
         where = f"case[{k}] ({cname})"
-
-        def get(key, tab=tab, where=where):
-            if key in tab:
-                return tab[key], f"{where}.{key}"
-            if key in defaults:
-                return defaults[key], f"defaults.{key}"
-            return _CASE_KEYS[key], f"{where}.{key}"
-
+        get = partial(case_field, tab=tab, defaults=defaults, fallback=_CASE_KEYS, where=where)
         value, w = get("vehicle")
         vfile = string(value, w)
         if vfile not in vehicles:
-            vpath = Path(vfile) if Path(vfile).is_absolute() else base / vfile
-            try:
-                vehicles[vfile] = load_vehicle(vpath if vpath.exists() else vfile)
-            except ValueError as exc:
-                raise FieldError(w, str(exc)) from None
+            vehicles[vfile] = vehicle_from_field(vfile, w, base)
         vehicle = vehicles[vfile]
         value, w = get("initial_speed_m_s")
         if value is None:
@@ -570,6 +565,30 @@ def load_attribute(text: str, what: str, prefix: str):
     return getattr(module, name)
 
 
+def load_component(text: str, what: str, default: str, prefix: str):
+    """A bench's controller or odometry (``what``) given as a string that is not a ``.fmu``
+    path: the object ``"module:name"`` or ``"file.py:name"`` names (:func:`load_attribute`);
+    ``ValueError`` listing the forms (``default``, a .fmu file, those two) otherwise."""
+    if ":" not in text:
+        raise ValueError(f"{what} {text!r}: give {default!r}, a .fmu file, or "
+                         "'module:name' / 'file.py:name'")
+    return load_attribute(text, what, prefix)
+
+
+def fmu_variable_problems(variables, missing, want) -> str:
+    """What is wrong with the ``variables`` of an FMU (FMPy's, by name) for a bench: it lacks
+    the ``missing`` ones, or has one of ``want`` = [(name, causality)] with another causality;
+    ``""`` if nothing."""
+    wrong = [f"{name} (is {variables[name].causality}, must be {c})" for name, c in want
+             if name in variables and variables[name].causality != c]
+    parts = []
+    if missing:
+        parts.append("lacks the variables " + ", ".join(missing))
+    if wrong:
+        parts.append("has " + ", ".join(wrong))
+    return " and ".join(parts)
+
+
 class FmuController:
     """A WSP unit delivered as an FMI 2.0 co-simulation FMU, run with FMPy.
 
@@ -597,17 +616,11 @@ class FmuController:
     def _check_variables(self, n: int):
         want = [(f"wheel_speed_{i}", "input") for i in range(1, n + 1)] + [
             (f"valve_{i}", "output") for i in range(1, n + 1)]
-        missing = [name for name, _ in want if name not in self.vars]
-        wrong = [f"{name} (is {self.vars[name].causality}, must be {caus})" for name, caus in want
-                 if name in self.vars and self.vars[name].causality != caus]
-        if missing or wrong:
-            parts = []
-            if missing:
-                parts.append("lacks the variables " + ", ".join(missing))
-            if wrong:
-                parts.append("has " + ", ".join(wrong))
+        problems = fmu_variable_problems(
+            self.vars, [name for name, _ in want if name not in self.vars], want)
+        if problems:
             raise WSPControllerError(
-                f"{self.path.name}: the FMU {' and '.join(parts)}; a WSP FMU needs inputs "
+                f"{self.path.name}: the FMU {problems}; a WSP FMU needs inputs "
                 f"wheel_speed_1..{n} [rad/s] and outputs valve_1..{n} (0 apply, 1 hold, 2 vent); "
                 f"optional inputs brake_pressure_1..{n} [Pa], pressure_command [Pa], "
                 "external_speed [m/s]")
@@ -691,10 +704,7 @@ def load_controller(spec=None, *, control_period: float | None = None, wsp_setti
         text = os.fspath(spec)
         if text.lower().endswith(".fmu"):
             return FmuController(text, control_period)
-        if ":" not in text:
-            raise ValueError(f"controller {text!r}: give 'default', a .fmu file, or "
-                             "'module:name' / 'file.py:name'")
-        obj = load_attribute(text, "controller", "wsp_controller_")
+        obj = load_component(text, "controller", "default", "wsp_controller_")
         if isinstance(obj, WheelSlideProtection):
             return _DefaultController(obj)
         return _PythonController(obj, control_period)
@@ -960,31 +970,44 @@ def run_wsp_case(case: BenchCase, controller=None, *, dry_cache: dict | None = N
 
 # -- a programme ----------------------------------------------------------------------------
 @dataclass
-class WSPProgrammeResult:
-    """Results of :func:`run_wsp_programme`: one summary dict per case (failed cases with
-    ``status = "error"`` and the message), and the overall figures."""
+class ProgrammeResult:
+    """What the results of the WSP and the odometry bench share: the programme's name and (a
+    field of each subclass) ``cases``, the summary dict of every case."""
 
     programme: str
-    controller: str
-    cases: list
-    overall: dict
 
     @property
     def failed(self) -> list:
         """Names of the cases that did not run to the end or failed a check."""
         return [c["name"] for c in self.cases if not c.get("passed", False)]
 
+    @staticmethod
+    def table_row(summary: dict) -> dict:
+        """The scalar figures of a case's (or a fit's) ``summary``, a row of the tables."""
+        return {k: v for k, v in summary.items() if not isinstance(v, dict | list)}
+
+    @staticmethod
+    def add_checks(row: dict, summary: dict) -> dict:
+        """``row`` with a column ``check_<name>`` (passed or not) per check of ``summary``."""
+        for name, check in summary.get("checks", {}).items():
+            row[f"check_{name}"] = check["passed"]
+        return row
+
+
+@dataclass
+class WSPProgrammeResult(ProgrammeResult):
+    """Results of :func:`run_wsp_programme`: one summary dict per case (failed cases with
+    ``status = "error"`` and the message), and the overall figures."""
+
+    controller: str
+    cases: list
+    overall: dict
+
     def frame(self):
         """One row per case (the scalar figures) as a pandas DataFrame."""
         import pandas as pd
 
-        rows = []
-        for c in self.cases:
-            row = {k: v for k, v in c.items() if not isinstance(v, dict | list)}
-            for name, check in c.get("checks", {}).items():
-                row[f"check_{name}"] = check["passed"]
-            rows.append(row)
-        return pd.DataFrame(rows)
+        return pd.DataFrame([self.add_checks(self.table_row(c), c) for c in self.cases])
 
     def axle_frame(self):
         """One row per case and axle (lock, slide, creep and air figures)."""
@@ -1060,6 +1083,33 @@ def run_wsp_programme(programme="default", controller=None, *, out=None,
     ctrl = load_controller(controller, control_period=control_period,
                            wsp_settings=prog.wsp or None)
     dry_cache: dict = {}
+
+    def failed(case, message, seconds):
+        return {**case.describe(), "controller": getattr(ctrl, "label", "?"), "status": "error",
+                "message": message, "passed": False, "wall_time_s": seconds}
+
+    def result(results):
+        return WSPProgrammeResult(prog.name, getattr(ctrl, "label", "?"), results,
+                                  _overall(results))
+
+    return run_programme_cases(
+        prog, lambda case: run_wsp_case(case, ctrl, dry_cache=dry_cache), (None, None),
+        (WSPControllerError, SimulationError, ValueError, ArithmeticError), failed, result,
+        write_programme_outputs, getattr(ctrl, "close", None), out=out, figures=figures,
+        histories=histories, progress=progress)
+
+
+def run_programme_cases(prog, run_case, no_records: tuple, errors, failed, make_result,
+                        write_outputs, close=None, *, out=None, figures: bool = True,
+                        histories: bool = False, progress=None):
+    """The loop of a bench over the cases of the programme ``prog`` (the WSP and the odometry
+    bench): ``run_case(case)`` gives ``(summary, *records)``; an exception of the types
+    ``errors`` records the case as ``failed(case, "Type: message", wall time [s])`` with the
+    records ``no_records``. With ``out``, after every case ``write_outputs(result, out,
+    case=(case, summary, *records), figures=figures, histories=histories)`` rewrites the
+    outputs, ``result = make_result(summaries so far)``; at the end (``figures``) with
+    ``summary_figure=True``. ``progress(index, number of cases, case name)`` is called before
+    each case, ``close()`` after the last, also on an error. Returns the result."""
     results = []
     outdir = Path(out) if out is not None else None
     try:
@@ -1067,27 +1117,22 @@ def run_wsp_programme(programme="default", controller=None, *, out=None,
             if progress is not None:
                 progress(k, len(prog.cases), case.name)
             started = _time.perf_counter()
-            h = trace = None
             try:
-                summary, h, trace = run_wsp_case(case, ctrl, dry_cache=dry_cache)
-            except (WSPControllerError, SimulationError, ValueError, ArithmeticError) as exc:
-                summary = {**case.describe(), "controller": getattr(ctrl, "label", "?"),
-                           "status": "error", "message": f"{type(exc).__name__}: {exc}",
-                           "passed": False, "wall_time_s": _time.perf_counter() - started}
+                summary, *records = run_case(case)
+            except errors as exc:
+                summary = failed(case, f"{type(exc).__name__}: {exc}",
+                                 _time.perf_counter() - started)
+                records = no_records
             results.append(summary)
             if outdir is not None:
-                result = WSPProgrammeResult(prog.name, getattr(ctrl, "label", "?"),
-                                            results, _overall(results))
-                write_programme_outputs(result, outdir, case=(case, summary, h, trace),
-                                        figures=figures, histories=histories)
+                write_outputs(make_result(results), outdir, case=(case, summary, *records),
+                              figures=figures, histories=histories)
     finally:
-        close = getattr(ctrl, "close", None)
         if close is not None:
             close()
-    result = WSPProgrammeResult(prog.name, getattr(ctrl, "label", "?"), results,
-                                _overall(results))
+    result = make_result(results)
     if outdir is not None and figures and results:
-        write_programme_outputs(result, outdir, summary_figure=True)
+        write_outputs(result, outdir, summary_figure=True)
     return result
 
 
@@ -1131,35 +1176,56 @@ def write_programme_outputs(result: WSPProgrammeResult, out, *, case=None,
     ``case = (case, summary, histories, trace)``, that case's ``cases/<name>.json``, figure
     ``figures/<name>.png`` and (``histories``) ``histories/<name>.parquet``; with
     ``summary_figure`` the figure across cases ``figures/summary.png``. Returns the paths."""
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    written = []
-    doc = {"format": "railadhesion-wsp-results", "programme": result.programme,
-           "controller": result.controller, "overall": result.overall, "cases": result.cases}
-    written.append(write_json(out / "summary.json", doc))
-    result.frame().to_csv(out / "cases.csv", index=False, float_format="%.6g")
-    written.append(out / "cases.csv")
-    axles = result.axle_frame()
-    axles.to_csv(out / "axles.csv", index=False, float_format="%.6g")
-    written.append(out / "axles.csv")
-    if case is not None:
-        bench_case, summary, h, trace = case
-        (out / "cases").mkdir(exist_ok=True)
-        written.append(write_json(out / "cases" / f"{bench_case.name}.json", summary))
-        if h is not None and figures:
-            from railadhesion.braking.figures import wsp_case_figure
+    def tables(out):
+        result.frame().to_csv(out / "cases.csv", index=False, float_format="%.6g")
+        axles = result.axle_frame()
+        axles.to_csv(out / "axles.csv", index=False, float_format="%.6g")
+        return [out / "cases.csv", out / "axles.csv"]
 
-            fig = wsp_case_figure(h, trace, bench_case.vehicle.wheel_radius,
-                                  title=f"{bench_case.name}: {bench_case.adhesion.describe()}")
-            written.append(save_figure(fig, out, bench_case.name, 90))
-        if h is not None and histories:
-            (out / "histories").mkdir(exist_ok=True)
-            path = out / "histories" / f"{bench_case.name}.parquet"
-            h.to_parquet(path, index=False)
-            written.append(path)
-    if summary_figure:
+    def case_figure():
+        from railadhesion.braking.figures import wsp_case_figure
+
+        return wsp_case_figure(h, trace, bench_case.vehicle.wheel_radius,
+                               title=f"{bench_case.name}: {bench_case.adhesion.describe()}")
+
+    def across_cases():
         from railadhesion.braking.figures import wsp_summary_figure
 
-        written.append(save_figure(wsp_summary_figure(result.cases), out, "summary", 90))
+        return wsp_summary_figure(result.cases)
+
+    doc = {"format": "railadhesion-wsp-results", "programme": result.programme,
+           "controller": result.controller, "overall": result.overall, "cases": result.cases}
+    bench_case, summary, h, trace = case or (None,) * 4
+    return write_bench_outputs(out, doc, tables, case and (bench_case.name, summary),
+                               case_figure if h is not None and figures else None,
+                               (lambda: h) if h is not None and histories else None,
+                               across_cases if summary_figure else None, dpi=90)
+
+
+def write_bench_outputs(out, doc, tables, case=None, figure=None, history=None,
+                        summary_figure=None, *, dpi: int) -> list:
+    """The outputs of a bench (the WSP and the odometry bench) in the folder ``out`` (made if
+    needed), in this order: ``summary.json`` (``doc``), the tables ``tables(out)`` writes (it
+    returns their paths); for ``case = (name, summary)`` ``cases/<name>.json``, the figure
+    ``figure()`` as ``figures/<name>.png`` and the DataFrame ``history()`` as
+    ``histories/<name>.parquet``; the figure ``summary_figure()`` as ``figures/summary.png``
+    (figures at ``dpi``; each callable only if given). Returns the paths written."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    written = [write_json(out / "summary.json", doc)]
+    written += tables(out)
+    if case is not None:
+        name, summary = case
+        (out / "cases").mkdir(exist_ok=True)
+        written.append(write_json(out / "cases" / f"{name}.json", summary))
+        if figure is not None:
+            written.append(save_figure(figure(), out, name, dpi))
+        if history is not None:
+            (out / "histories").mkdir(exist_ok=True)
+            path = out / "histories" / f"{name}.parquet"
+            history().to_parquet(path, index=False)
+            written.append(path)
+    if summary_figure is not None:
+        written.append(save_figure(summary_figure(), out, "summary", dpi))
     return written
 

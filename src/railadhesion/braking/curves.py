@@ -422,6 +422,18 @@ def _builtin_refresh(s, st, tables):
 
 
 @njit(cache=True, error_model="numpy")
+def _sign(x):
+    """The sign of ``x`` as a float: 1, -1, 0, and NaN for NaN (as ``np.sign``)."""
+    if x > 0.0:
+        return 1.0
+    if x < 0.0:
+        return -1.0
+    if x == 0.0:
+        return 0.0
+    return math.nan
+
+
+@njit(cache=True, error_model="numpy")
 def _user_evaluate(s, st, fn, speed):
     """The differences of CallableAdhesion: central in the creepage (step
     ``settings.creep_step``), forward in the speed (1e-6 of it, at least 1e-6 m/s)."""
@@ -436,14 +448,7 @@ def _user_evaluate(s, st, fn, speed):
         m = fn(a, speed, q)
         dmu = (fn(a + h, speed, q) - fn(lo, speed, q)) / (a + h - lo)
         m2 = fn(a, speed + hv, q)
-        if xi > 0.0:
-            sign = 1.0
-        elif xi < 0.0:
-            sign = -1.0
-        elif xi == 0.0:
-            sign = 0.0
-        else:
-            sign = math.nan
+        sign = _sign(xi)
         mu = sign * m
         c.mu[i] = mu
         c.dmu[i] = dmu
@@ -511,14 +516,7 @@ def table_axle_curve(creep, speed, q, a, b, mu0, ratio, decay, g, nu, tab, dims,
         hv = 1e-6 * max(v, 1.0)
         dmv = (_table_mu(x, v + hv, q, a, b, mu0, ratio, decay, g, nu, tab, dims, strides,
                          origin, inv_step) - m) / hv
-    if creep > 0.0:
-        sign = 1.0
-    elif creep < 0.0:
-        sign = -1.0
-    elif creep == 0.0:
-        sign = 0.0
-    else:
-        sign = math.nan
+    sign = _sign(creep)
     return sign * m, dmu, sign * dmv
 
 
@@ -709,50 +707,41 @@ def peak_adhesion(s, st, tables, aux, speed):
     raise NotImplementedError("compiled code only")
 
 
-def _family(aux):
+def _implementations(aux):
+    """The compiled :func:`refresh_adhesion`, :func:`evaluate_adhesion` and
+    :func:`peak_adhesion` of the adhesion family that the numba type of ``aux`` selects: an
+    integer the built-in models, None a model in Python, a float the table model, anything
+    else a user law."""
     if isinstance(aux, types.Integer):
-        return "builtin"
-    if isinstance(aux, types.Float):
-        return "table"
+        return (lambda s, st, tables, aux: _builtin_refresh(s, st, tables),
+                lambda s, st, tables, aux, speed: evaluate_lanes(s.curve, st.n_axles, speed),
+                lambda s, st, tables, aux, speed: peak_lanes(s.curve, st.n_axles, speed))
     if isinstance(aux, types.NoneType):
-        return "python"
-    return "user"
+        return (lambda s, st, tables, aux: _python_refresh(s, st),
+                lambda s, st, tables, aux, speed: _python_evaluate(s, st, speed),
+                lambda s, st, tables, aux, speed: _python_peak(s, st, speed))
+    if isinstance(aux, types.Float):
+        return (lambda s, st, tables, aux: _table_refresh(s, st),
+                lambda s, st, tables, aux, speed: _table_evaluate(s, st, tables, speed),
+                lambda s, st, tables, aux, speed: _table_peak(s, st, tables, speed))
+    return (lambda s, st, tables, aux: None,  # a user law needs only the wheel loads
+            lambda s, st, tables, aux, speed: _user_evaluate(s, st, aux, speed),
+            lambda s, st, tables, aux, speed: _user_peak(s, st, tables, aux, speed))
 
 
 @overload(refresh_adhesion, jit_options={"error_model": "numpy"})
 def _refresh_adhesion(s, st, tables, aux):
-    family = _family(aux)
-    if family == "builtin":
-        return lambda s, st, tables, aux: _builtin_refresh(s, st, tables)
-    if family == "python":
-        return lambda s, st, tables, aux: _python_refresh(s, st)
-    if family == "table":
-        return lambda s, st, tables, aux: _table_refresh(s, st)
-    return lambda s, st, tables, aux: None  # a user law needs only the wheel loads
+    return _implementations(aux)[0]
 
 
 @overload(evaluate_adhesion, jit_options={"error_model": "numpy"})
 def _evaluate_adhesion(s, st, tables, aux, speed):
-    family = _family(aux)
-    if family == "builtin":
-        return lambda s, st, tables, aux, speed: evaluate_lanes(s.curve, st.n_axles, speed)
-    if family == "python":
-        return lambda s, st, tables, aux, speed: _python_evaluate(s, st, speed)
-    if family == "table":
-        return lambda s, st, tables, aux, speed: _table_evaluate(s, st, tables, speed)
-    return lambda s, st, tables, aux, speed: _user_evaluate(s, st, aux, speed)
+    return _implementations(aux)[1]
 
 
 @overload(peak_adhesion, jit_options={"error_model": "numpy"})
 def _peak_adhesion(s, st, tables, aux, speed):
-    family = _family(aux)
-    if family == "builtin":
-        return lambda s, st, tables, aux, speed: peak_lanes(s.curve, st.n_axles, speed)
-    if family == "python":
-        return lambda s, st, tables, aux, speed: _python_peak(s, st, speed)
-    if family == "table":
-        return lambda s, st, tables, aux, speed: _table_peak(s, st, tables, speed)
-    return lambda s, st, tables, aux, speed: _user_peak(s, st, tables, aux, speed)
+    return _implementations(aux)[2]
 
 
 # ---------------------------------------------------------------------------------------------

@@ -14,6 +14,22 @@ def _axle_columns(h, name):
     return [f"{name}_{i}" for i in range(1, n + 1)]
 
 
+def _axle_lines(x, lines, xlabel: str, ylabel: str, title: str, reference=None) -> Figure:
+    """A figure of one curve per axle, ``lines`` = [(values, label)], drawn after the
+    ``reference`` curve (values, style, line width, label) if given."""
+    fig = Figure(figsize=(7, 4.2))
+    ax = fig.subplots()
+    if reference is not None:
+        values, style, width, label = reference
+        ax.plot(x, values, style, lw=width, label=label)
+    for values, label in lines:
+        ax.plot(x, values, lw=0.8, label=label)
+    ax.set(xlabel=xlabel, ylabel=ylabel, title=title)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    return fig
+
+
 def braking_figures(result, x: str = "time") -> dict[str, Figure]:
     """Four figures of a :class:`~railadhesion.braking.BrakingResult`.
 
@@ -29,36 +45,20 @@ def braking_figures(result, x: str = "time") -> dict[str, Figure]:
     xlabel = "time [s]" if x == "time" else "distance [m]"
     wheels = _axle_columns(h, "wheel_speed")
     radius = result.settings.get("wheel_radius_m")
-    figs = {}
-
-    fig = Figure(figsize=(7, 4.2))
-    ax = fig.subplots()
-    ax.plot(xv, h["train_speed"] * 3.6, "k", lw=2, label="train")
-    for i, c in enumerate(wheels, 1):
-        ax.plot(xv, h[c] * radius * 3.6, lw=0.8, label=f"wheel ωR, axle {i}")
-    ax.set(xlabel=xlabel, ylabel="speed [km/h]", title="Train and wheel speeds")
-    ax.legend(fontsize=8)
-    ax.grid(alpha=0.3)
-    figs["speeds"] = fig
-
-    fig = Figure(figsize=(7, 4.2))
-    ax = fig.subplots()
-    for i, c in enumerate(_axle_columns(h, "creep"), 1):
-        ax.plot(xv, h[c] * 100, lw=0.8, label=f"axle {i}")
-    ax.set(xlabel=xlabel, ylabel="creepage (V − ωR)/V [%]", title="Wheel slip")
-    ax.legend(fontsize=8)
-    ax.grid(alpha=0.3)
-    figs["slips"] = fig
-
-    fig = Figure(figsize=(7, 4.2))
-    ax = fig.subplots()
-    ax.plot(xv, h["pressure_command"] / 1e5, "k--", lw=1.2, label="command")
-    for i, c in enumerate(_axle_columns(h, "brake_pressure"), 1):
-        ax.plot(xv, h[c] / 1e5, lw=0.8, label=f"axle {i}")
-    ax.set(xlabel=xlabel, ylabel="brake-cylinder pressure [bar]", title="Brake pressures")
-    ax.legend(fontsize=8)
-    ax.grid(alpha=0.3)
-    figs["pressures"] = fig
+    figs = {
+        "speeds": _axle_lines(
+            xv, [(h[c] * radius * 3.6, f"wheel ωR, axle {i}") for i, c in enumerate(wheels, 1)],
+            xlabel, "speed [km/h]", "Train and wheel speeds",
+            reference=(h["train_speed"] * 3.6, "k", 2, "train")),
+        "slips": _axle_lines(
+            xv, [(h[c] * 100, f"axle {i}") for i, c in enumerate(_axle_columns(h, "creep"), 1)],
+            xlabel, "creepage (V − ωR)/V [%]", "Wheel slip"),
+        "pressures": _axle_lines(
+            xv, [(h[c] / 1e5, f"axle {i}")
+                 for i, c in enumerate(_axle_columns(h, "brake_pressure"), 1)],
+            xlabel, "brake-cylinder pressure [bar]", "Brake pressures",
+            reference=(h["pressure_command"] / 1e5, "k--", 1.2, "command")),
+    }  # fmt: skip
 
     fig = Figure(figsize=(7, 4.2))
     ax = fig.subplots()

@@ -29,6 +29,7 @@ import math
 import os
 import time as _time
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -45,15 +46,18 @@ from railadhesion.braking._fields import (
 )
 from railadhesion.braking.bench import (
     BenchCase,
-    load_attribute,
+    ProgrammeResult,
+    case_field,
+    fmu_variable_problems,
+    load_component,
     load_controller,
     programme_from_document,
     read_cosim_fmu,
     read_programme_file,
     release_fmu,
-    save_figure,
+    run_programme_cases,
     select_cases,
-    write_json,
+    write_bench_outputs,
 )
 from railadhesion.braking.odometry import STATUS_BITS, ReferenceOdometry
 from railadhesion.braking.sensors import (
@@ -360,14 +364,8 @@ def _programme_from_document(doc, base: Path) -> OdometryProgramme:
     out = []
     for k, (run, extra) in enumerate(zip(runs.cases, extras, strict=True)):
         where = f"case[{k}] ({run.name})"
-
-        def get(key, extra=extra, where=where):
-            if key in extra:
-                return extra[key], f"{where}.{key}"
-            if key in odo_defaults:
-                return odo_defaults[key], f"defaults.{key}"
-            return _RUN_KEYS[key], f"{where}.{key}"
-
+        get = partial(case_field, tab=extra, defaults=odo_defaults, fallback=_RUN_KEYS,
+                      where=where)
         n = run.vehicle.n_axles
         coast = number(*get("coast_time_s"), 0.1, 600.0)
         torque = number(*get("traction_torque_N_m"), 0.0, 1e5)
@@ -556,28 +554,22 @@ class FmuOdometry:
 
     def _check(self, axles):
         v = self.vars
-        problems = []
+        missing = []
         for i in axles:
             if f"wheel_speed_{i}" not in v and f"pulse_count_{i}" not in v:
-                problems.append(f"wheel_speed_{i} (or pulse_count_{i})")
+                missing.append(f"wheel_speed_{i} (or pulse_count_{i})")
         for name in _OUTPUTS[:4]:
             if name not in v:
-                problems.append(name)
-        wrong = [f"{name} (is {v[name].causality}, must be {c})" for name, c in
-                 [*((f"wheel_speed_{i}", "input") for i in axles),
-                  *((f"pulse_count_{i}", "input") for i in axles),
-                  *((n, "input") for n in ("radar_speed", "acceleration", "drive")),
-                  *((n, "output") for n in _OUTPUTS)]
-                 if name in v and v[name].causality != c]
-        if problems or wrong:
-            parts = []
-            if problems:
-                parts.append("lacks the variables " + ", ".join(problems))
-            if wrong:
-                parts.append("has " + ", ".join(wrong))
+                missing.append(name)
+        problems = fmu_variable_problems(
+            v, missing, [*((f"wheel_speed_{i}", "input") for i in axles),
+                          *((f"pulse_count_{i}", "input") for i in axles),
+                          *((n, "input") for n in ("radar_speed", "acceleration", "drive")),
+                          *((n, "output") for n in _OUTPUTS)])
+        if problems:
             axl = ", ".join(str(i) for i in axles)
             raise OdometryInterfaceError(
-                f"{self.path.name}: the FMU {' and '.join(parts)}; an odometry FMU reading axles "
+                f"{self.path.name}: the FMU {problems}; an odometry FMU reading axles "
                 f"{axl} needs inputs wheel_speed_i [rad/s] or pulse_count_i for each, outputs "
                 "speed, distance, distance_min, distance_max; optional inputs radar_speed, "
                 "acceleration, drive and output status")
@@ -667,10 +659,8 @@ def load_odometry(spec=None, *, period: float | None = None):
         text = os.fspath(spec)
         if text.lower().endswith(".fmu"):
             return FmuOdometry(text, period)
-        if ":" not in text:
-            raise ValueError(f"odometry {text!r}: give 'reference', a .fmu file, or "
-                             "'module:name' / 'file.py:name'")
-        return _PythonOdometry(load_attribute(text, "odometry", "odometry_"), period)
+        return _PythonOdometry(load_component(text, "odometry", "reference", "odometry_"),
+                               period)
     return _PythonOdometry(spec, period)
 
 
@@ -933,18 +923,13 @@ def run_odometry_case(case: OdometryCase, odometry=None, *, wsp_settings=None):
 
 # -- a programme --------------------------------------------------------------------------------
 @dataclass
-class OdometryProgrammeResult:
+class OdometryProgrammeResult(ProgrammeResult):
     """Results of :func:`run_odometry_programme`: one summary per case (each with its fits;
     failed cases with ``status = "error"``) and the overall figures."""
 
-    programme: str
     odometry: str
     cases: list
     overall: dict = field(default_factory=dict)
-
-    @property
-    def failed(self) -> list:
-        return [c["name"] for c in self.cases if not c.get("passed", False)]
 
     def frame(self):
         """One row per case and fit (the scalar figures and the checks)."""
@@ -956,12 +941,9 @@ class OdometryProgrammeResult:
                     "stopping_distance_m": c.get("stopping_distance_m"),
                     "slide_time_s": c.get("slide_time_s"), "spin_time_s": c.get("spin_time_s")}
             for f in c.get("fits", []):
-                row = {**head, **{k: v for k, v in f.items()
-                                  if not isinstance(v, dict | list)}}
+                row = {**head, **self.table_row(f)}
                 row["flags"] = " ".join(f.get("flags", {}))
-                for name, check in f.get("checks", {}).items():
-                    row[f"check_{name}"] = check["passed"]
-                rows.append(row)
+                rows.append(self.add_checks(row, f))
             if c.get("status") == "error":
                 rows.append({**head, "fit": None, "status": "error", "message": c["message"]})
         return pd.DataFrame(rows)
@@ -1037,31 +1019,17 @@ def run_odometry_programme(programme="default", odometry=None, *, out=None, figu
         prog = prog.select(cases)
     odo = load_odometry(odometry, period=period)
     label = getattr(odo, "label", "?")
-    results = []
-    outdir = Path(out) if out is not None else None
-    try:
-        for k, case in enumerate(prog.cases):
-            if progress is not None:
-                progress(k, len(prog.cases), case.name)
-            started = _time.perf_counter()
-            tr = None
-            try:
-                summary, tr = run_odometry_case(case, odo)
-            except (SimulationError, ValueError, ArithmeticError) as exc:
-                summary = {**case.describe(), "odometry": label, "status": "error",
-                           "message": f"{type(exc).__name__}: {exc}", "passed": False,
-                           "fits": [], "wall_time_s": _time.perf_counter() - started}
-            results.append(summary)
-            if outdir is not None:
-                res = OdometryProgrammeResult(prog.name, label, results, _overall(results))
-                write_odometry_outputs(res, outdir, case=(case, summary, tr), figures=figures,
-                                       histories=histories)
-    finally:
-        odo.close()
-    result = OdometryProgrammeResult(prog.name, label, results, _overall(results))
-    if outdir is not None and figures and results:
-        write_odometry_outputs(result, outdir, summary_figure=True)
-    return result
+
+    def failed(case, message, seconds):
+        return {**case.describe(), "odometry": label, "status": "error", "message": message,
+                "passed": False, "fits": [], "wall_time_s": seconds}
+
+    return run_programme_cases(
+        prog, lambda case: run_odometry_case(case, odo), (None,),
+        (SimulationError, ValueError, ArithmeticError), failed,
+        lambda results: OdometryProgrammeResult(prog.name, label, results, _overall(results)),
+        write_odometry_outputs, odo.close, out=out, figures=figures, histories=histories,
+        progress=progress)
 
 
 def write_odometry_outputs(result: OdometryProgrammeResult, out, *, case=None,
@@ -1071,41 +1039,40 @@ def write_odometry_outputs(result: OdometryProgrammeResult, out, *, case=None,
     fit), ``violations.csv`` (every violation event) and, for ``case = (case, summary,
     traces)``, ``cases/<name>.json``, ``figures/<name>.png`` and (``histories``)
     ``histories/<name>.parquet``; with ``summary_figure``, ``figures/summary.png``."""
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    written = []
-    doc = {"format": "railadhesion-odometry-results", "programme": result.programme,
-           "odometry": result.odometry, "overall": result.overall, "cases": result.cases}
-    written.append(write_json(out / "summary.json", doc))
-    result.frame().to_csv(out / "fits.csv", index=False, float_format="%.6g")
-    result.violation_frame().to_csv(out / "violations.csv", index=False, float_format="%.6g")
-    written += [out / "fits.csv", out / "violations.csv"]
-    if case is not None:
-        ocase, summary, tr = case
-        (out / "cases").mkdir(exist_ok=True)
-        written.append(write_json(out / "cases" / f"{ocase.name}.json", summary))
-        if tr is not None and figures:
-            from railadhesion.braking.figures import odometry_case_figure
 
-            fig = odometry_case_figure(tr, summary, title=f"{ocase.name}: "
-                                       f"{ocase.run.adhesion.describe()}")
-            written.append(save_figure(fig, out, ocase.name, 80))
-        if tr is not None and histories:
-            import pandas as pd
+    def tables(out):
+        result.frame().to_csv(out / "fits.csv", index=False, float_format="%.6g")
+        result.violation_frame().to_csv(out / "violations.csv", index=False,
+                                        float_format="%.6g")
+        return [out / "fits.csv", out / "violations.csv"]
 
-            (out / "histories").mkdir(exist_ok=True)
-            cols = {"time": tr["time"], "train_speed": tr["speed"],
-                    "distance": tr["distance"], "drive": tr["drive"]}
-            for k, a in enumerate(ocase.axles):
-                cols[f"creep_{a}"] = tr["creep"][:, k]
-            for name, rec in tr["outputs"].items():
-                for k, what in enumerate(_OUTPUTS):
-                    cols[f"{name}:{what}"] = rec[:, k]
-            path = out / "histories" / f"{ocase.name}.parquet"
-            pd.DataFrame(cols).to_parquet(path, index=False)
-            written.append(path)
-    if summary_figure:
+    def case_figure():
+        from railadhesion.braking.figures import odometry_case_figure
+
+        return odometry_case_figure(tr, summary, title=f"{ocase.name}: "
+                                    f"{ocase.run.adhesion.describe()}")
+
+    def history():
+        import pandas as pd
+
+        cols = {"time": tr["time"], "train_speed": tr["speed"],
+                "distance": tr["distance"], "drive": tr["drive"]}
+        for k, a in enumerate(ocase.axles):
+            cols[f"creep_{a}"] = tr["creep"][:, k]
+        for name, rec in tr["outputs"].items():
+            for k, what in enumerate(_OUTPUTS):
+                cols[f"{name}:{what}"] = rec[:, k]
+        return pd.DataFrame(cols)
+
+    def across_cases():
         from railadhesion.braking.figures import odometry_summary_figure
 
-        written.append(save_figure(odometry_summary_figure(result.cases), out, "summary", 80))
-    return written
+        return odometry_summary_figure(result.cases)
+
+    doc = {"format": "railadhesion-odometry-results", "programme": result.programme,
+           "odometry": result.odometry, "overall": result.overall, "cases": result.cases}
+    ocase, summary, tr = case or (None,) * 3
+    return write_bench_outputs(out, doc, tables, case and (ocase.name, summary),
+                               case_figure if tr is not None and figures else None,
+                               history if tr is not None and histories else None,
+                               across_cases if summary_figure else None, dpi=80)

@@ -46,12 +46,13 @@ from railadhesion.braking.adhesion import (
 )
 from railadhesion.braking.cylinders import BrakeCylinders
 from railadhesion.braking.run import BrakeDemand, BrakingResult, simulate
-from railadhesion.braking.vehicle import Vehicle, load_vehicle
+from railadhesion.braking.vehicle import Vehicle, vehicle_from_field
 from railadhesion.braking.wsp import WheelSlideProtection, WSPSettings, settings_file_keys
 from railadhesion.models.parameters import POLACH_PARAMETER_SETS
 from railadhesion.plausibility import AlteredResultWarning, check_plausible, warn
 
-__all__ = ["BrakeScenario", "load_scenario", "run_scenario", "SCENARIO_FORMAT"]
+__all__ = ["BrakeScenario", "load_scenario", "run_scenario", "SCENARIO_FORMAT",
+           "polach_set_name", "wsp_settings_fields"]
 
 SCENARIO_FORMAT = "railadhesion-brake-scenario"
 
@@ -92,12 +93,21 @@ class BrakeScenario:
                         refresh_period=self.refresh_period, progress=progress)
 
 
-def _polach_name(value, where):
+def polach_set_name(value, where: str) -> str:
+    """The field ``value`` (at ``where``) as the name of a Polach set of
+    :data:`~railadhesion.models.parameters.POLACH_PARAMETER_SETS`; a ``FieldError`` listing
+    the known sets otherwise."""
     name = string(value, where)
     if name not in POLACH_PARAMETER_SETS:
         raise FieldError(where, f"unknown Polach set {name!r}; known: "
                          f"{', '.join(sorted(POLACH_PARAMETER_SETS))}")
     return name
+
+
+def _dry_set(tab: Mapping) -> str:
+    """The Polach set of the dry reference: ``adhesion.dry_parameters``, by default
+    ``polach2005_dry``."""
+    return polach_set_name(tab.get("dry_parameters", "polach2005_dry"), "adhesion.dry_parameters")
 
 
 def _wilac_parameters(value, where, base: Path):
@@ -152,9 +162,8 @@ def _adhesion(doc: Mapping, base: Path, wheel_radius: float):
         for k in ("water_flow_ul_s", "table", "recovery_energy_J_per_m"):
             if k in tab:
                 raise FieldError(f"adhesion.{k}", "only for model = 'wilac'")
-        base_set = _polach_name(tab.get("parameters", "polach2005_dry"), "adhesion.parameters")
-        dry_set = _polach_name(tab.get("dry_parameters", "polach2005_dry"),
-                               "adhesion.dry_parameters")
+        base_set = polach_set_name(tab.get("parameters", "polach2005_dry"), "adhesion.parameters")
+        dry_set = _dry_set(tab)
         secs = []
         for i, sec in enumerate(sections):
             w = f"adhesion.sections[{i}]"
@@ -162,7 +171,7 @@ def _adhesion(doc: Mapping, base: Path, wheel_radius: float):
             keys(sec, w, (f"start_{unit}", f"end_{unit}", "parameters"))
             start = number(sec[f"start_{unit}"], f"{w}.start_{unit}", 0.0, 1e7)
             end = number(sec[f"end_{unit}"], f"{w}.end_{unit}", start, 1e7, low_open=True)
-            secs.append((start, end, _polach_name(sec["parameters"], f"{w}.parameters")))
+            secs.append((start, end, polach_set_name(sec["parameters"], f"{w}.parameters")))
         if over == "time" and secs:
             raise FieldError("adhesion.over", "Polach sections are along the track: use "
                              "over = 'distance'")
@@ -229,7 +238,7 @@ def _table_model(tab: Mapping, contact: ContactGeometry, sections):
             if k in tab:
                 raise FieldError(f"adhesion.{k}", "give either parameters (a Polach set's "
                                  "mu0, A, B) or mu, friction_ratio, friction_decay_s_per_m")
-        name = _polach_name(tab["parameters"], "adhesion.parameters")
+        name = polach_set_name(tab["parameters"], "adhesion.parameters")
         friction = {"parameters": name}
         p = POLACH_PARAMETER_SETS[name]
         law = (p.mu0, p.A, p.B)
@@ -240,7 +249,7 @@ def _table_model(tab: Mapping, contact: ContactGeometry, sections):
                       0.0, 100.0))
         friction = dict(zip(("mu", "friction_ratio", "friction_decay_s_per_m"), law,
                             strict=True))
-    dry_set = _polach_name(tab.get("dry_parameters", "polach2005_dry"), "adhesion.dry_parameters")
+    dry_set = _dry_set(tab)
     try:  # the contact must be in the table's range: say so when loading
         ExactTableAdhesion(*law, contact=contact)
     except ValueError as exc:
@@ -271,7 +280,7 @@ def _identified_law(tab: Mapping, base: Path, wheel_radius: float):
         law = load_adhesion_law(path)
     except ValueError as exc:
         raise FieldError("adhesion.file", f"cannot load the adhesion law: {exc}") from None
-    dry_set = _polach_name(tab.get("dry_parameters", "polach2005_dry"), "adhesion.dry_parameters")
+    dry_set = _dry_set(tab)
     rail = number(tab.get("rail_lateral_radius_m", 0.3), "adhesion.rail_lateral_radius_m",
                   0.05, 10.0)
     contact = ContactGeometry(wheel_radius=wheel_radius, rail_lateral_radius=rail)
@@ -279,6 +288,25 @@ def _identified_law(tab: Mapping, base: Path, wheel_radius: float):
     return (lambda: CallableAdhesion(law, label=label),
             lambda: PolachAdhesion(dry_set, (), contact),
             {"model": "law", "file": str(path), "slip": law.slip_kind})
+
+
+def wsp_settings_fields(wt: Mapping) -> tuple[dict, WSPSettings]:
+    """The WSP settings of a file's ``[wsp]`` table ``wt`` (its keys already checked): the
+    keyword arguments of :class:`~railadhesion.braking.wsp.WSPSettings` from the TOML keys
+    present (:func:`~railadhesion.braking.wsp.settings_file_keys`, each checked against its
+    range) and the settings they make; errors are a ``FieldError`` naming the field, or
+    ``wsp``."""
+    kwargs = {}
+    for key, (attr, lo, hi) in _WSP_KEYS.items():
+        if key in wt:
+            if attr == "watchdog_cutout_trips":
+                kwargs[attr] = integer(wt[key], f"wsp.{key}", int(lo), int(hi))
+            else:
+                kwargs[attr] = number(wt[key], f"wsp.{key}", lo, hi)
+    try:
+        return kwargs, WSPSettings(**kwargs)
+    except ValueError as exc:
+        raise FieldError("wsp", str(exc)) from None
 
 
 def _plausible_fields(label: str, v0: float, demand: float, max_pressure: float,
@@ -312,12 +340,7 @@ def _scenario_from_document(doc: Mapping, base: Path, label: str = "") -> BrakeS
     # vehicle
     vt = table(doc["vehicle"], "vehicle")
     keys(vt, "vehicle", ("file",))
-    vfile = string(vt["file"], "vehicle.file")
-    vpath = Path(vfile) if Path(vfile).is_absolute() else base / vfile
-    try:
-        vehicle = load_vehicle(vpath if vpath.exists() else vfile)
-    except ValueError as exc:
-        raise FieldError("vehicle.file", str(exc)) from None
+    vehicle = vehicle_from_field(string(vt["file"], "vehicle.file"), "vehicle.file", base)
     # run
     rt = table(doc["run"], "run")
     keys(rt, "run", ("initial_speed_m_s",), ("time_step_s", "max_time_s", "gradient",
@@ -363,17 +386,7 @@ def _scenario_from_document(doc: Mapping, base: Path, label: str = "") -> BrakeS
         wt = table(doc["wsp"], "wsp")
         keys(wt, "wsp", (), ("enabled", *_WSP_KEYS))
         if boolean(wt.get("enabled", True), "wsp.enabled"):
-            kwargs = {}
-            for key, (attr, lo, hi) in _WSP_KEYS.items():
-                if key in wt:
-                    if attr == "watchdog_cutout_trips":
-                        kwargs[attr] = integer(wt[key], f"wsp.{key}", int(lo), int(hi))
-                    else:
-                        kwargs[attr] = number(wt[key], f"wsp.{key}", lo, hi)
-            try:
-                wsp = WSPSettings(**kwargs)
-            except ValueError as exc:
-                raise FieldError("wsp", str(exc)) from None
+            wsp = wsp_settings_fields(wt)[1]
             ratio = wsp.period / dt
             if abs(ratio - round(ratio)) > 1e-9 * ratio or round(ratio) < 1:
                 raise FieldError("wsp.period_s", f"must be a whole multiple of run.time_step_s "

@@ -62,7 +62,8 @@ from railadhesion.braking._fields import (
     table,
 )
 
-__all__ = ["Vehicle", "load_vehicle", "VEHICLE_FORMAT", "GRAVITY", "DEFAULT_VEHICLE"]
+__all__ = ["Vehicle", "load_vehicle", "VEHICLE_FORMAT", "GRAVITY", "DEFAULT_VEHICLE",
+           "vehicle_from_field"]
 
 #: Standard gravity [m/s²].
 GRAVITY = 9.80665
@@ -302,6 +303,17 @@ def load_vehicle(path_or_name=DEFAULT_VEHICLE) -> Vehicle:
         raise BrakingFileError(f"{label}: {exc}") from None
     except ValueError as exc:
         raise BrakingFileError(f"{label}: {exc}") from None
+
+
+def vehicle_from_field(text: str, where: str, base: Path) -> Vehicle:
+    """The vehicle a file's field ``where`` names: a vehicle file (a relative path is relative
+    to ``base``, the folder of that file) or a shipped vehicle's name; its errors become a
+    ``FieldError`` at ``where``."""
+    path = Path(text) if Path(text).is_absolute() else base / text
+    try:
+        return load_vehicle(path if path.exists() else text)
+    except ValueError as exc:
+        raise FieldError(where, str(exc)) from None
 
 
 def vehicle_from_document(doc: Mapping) -> Vehicle:
