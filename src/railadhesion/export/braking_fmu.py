@@ -169,7 +169,7 @@ def build_braking_fmu(out, scenario, *, wsp: bool = False) -> Path:
     Returns
     -------
     pathlib.Path
-        ``out``.
+        The path of the braking FMU written (``out``): FMI 2.0 co-simulation, Python inside.
 
     Notes
     -----

@@ -184,7 +184,7 @@ def build_fmu(
     Returns
     -------
     pathlib.Path
-        ``out``.
+        The path of the FMU written (``out``).
     """
     from pythonfmu import FmuBuilder
 
@@ -575,7 +575,7 @@ def build_creep_force_fmu(
     Returns
     -------
     pathlib.Path
-        ``out``.
+        The path of the creep-force FMU written (``out``): FMI 2.0 co-simulation, Python inside.
 
     Notes
     -----

@@ -102,7 +102,7 @@ def build_monitor_fmu(out, vehicle="coach_default", settings=None, *, pressure=T
     Returns
     -------
     pathlib.Path
-        ``out``.
+        The path of the monitor FMU written (``out``): FMI 2.0 co-simulation, Python inside.
 
     Notes
     -----

@@ -817,7 +817,7 @@ def build_step_fmu(
     Returns
     -------
     pathlib.Path
-        ``out``.
+        The path of the native FMU written (``out``): compiled C, no Python in the host.
 
     Raises
     ------

@@ -179,7 +179,7 @@ def build_native_braking_fmu(out, scenario, *, wsp: bool = False) -> Path:
     Returns
     -------
     pathlib.Path
-        ``out``.
+        The path of the native braking FMU written (``out``): compiled C, no Python in the host.
 
     Notes
     -----

@@ -248,7 +248,7 @@ def build_native_creep_force_fmu(
     Returns
     -------
     pathlib.Path
-        ``out``.
+        The path of the native creep-force FMU written (``out``): compiled C, no Python in the host.
 
     Raises
     ------
