@@ -92,10 +92,9 @@ from numba import njit
 
 from railadhesion.braking.vehicle import GRAVITY
 from railadhesion.io.settings_table import (
-    SourcedSettings,
     check_number,
-    settings_dataclass,
     settings_spec,
+    sourced_settings,
 )
 
 __all__ = [
@@ -157,12 +156,10 @@ STATE_DTYPE = np.dtype([
 ], align=True)
 
 
-@settings_dataclass({name: spec[0] for name, spec in _SPEC.items()})
-class OdometrySettings(SourcedSettings):
+@sourced_settings(_SPEC)
+class OdometrySettings:
     """Settings of :class:`ReferenceOdometry` (SI units); every default with its source or the
     word assumption: :meth:`sources` and ``docs/odometry.md``."""
-
-    _spec = _SPEC
 
     def __post_init__(self):
         for name, (_, low, high, unit, _) in _SPEC.items():

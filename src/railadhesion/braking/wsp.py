@@ -71,10 +71,9 @@ from numba import njit
 
 from railadhesion.braking.cylinders import APPLY, HOLD, VENT
 from railadhesion.io.settings_table import (
-    SourcedSettings,
     check_number,
-    settings_dataclass,
     settings_spec,
+    sourced_settings,
 )
 
 __all__ = ["WSPSettings", "WheelSlideProtection", "as_controller", "call_controller",
@@ -630,9 +629,8 @@ def settings_file_keys() -> dict:
     return keys
 
 
-@settings_dataclass({name: spec[0] for name, spec in _SPEC.items()},
-                    types={"valves": "str | None"})
-class WSPSettings(SourcedSettings):
+@sourced_settings(_SPEC, types={"valves": "str | None"})
+class WSPSettings:
     """Settings of :class:`WheelSlideProtection` (SI units). Every default with its source or
     the word assumption: :func:`WSPSettings.sources` and ``docs/wsp.md``.
 
@@ -641,8 +639,6 @@ class WSPSettings(SourcedSettings):
     :func:`~railadhesion.braking.simulate` and the WSP bench). ``sliding_reference_deceleration``
     of earlier versions is accepted with a ``DeprecationWarning`` and ignored.
     """
-
-    _spec = _SPEC
 
     def __init__(self, **kwargs):
         for name, message in _DEPRECATED.items():

@@ -5,9 +5,10 @@ reference odometry (:class:`~railadhesion.braking.odometry.OdometrySettings`) an
 monitor (:class:`railadhesion.monitor.MonitorSettings`) each read their table from
 ``railadhesion/data/<name>.toml``: one section per setting, in the order of the class's fields,
 with its ``default`` (absent: None), ``range = [low, high]`` (absent: not a number checked by
-range), ``unit`` and ``source`` (the source, or the word *assumption*). The class's dataclass
-fields, its checks and its ``sources()`` come from that table, so each default is written
-once.
+range), ``unit`` and ``source`` (the source, or the word *assumption*; the monitor's table has
+neither, its docstring gives them, and ``open`` names the open ends of a range). The class's
+dataclass fields, the ranges it checks and its ``sources()`` come from that table, so each
+default is written once.
 """
 
 from __future__ import annotations
@@ -17,8 +18,8 @@ import tomllib
 from dataclasses import dataclass, fields
 from importlib import resources
 
-__all__ = ["read_settings_table", "settings_spec", "settings_dataclass", "check_number",
-           "SourcedSettings"]
+__all__ = ["read_settings_table", "settings_spec", "settings_dataclass", "sourced_settings",
+           "check_number"]
 
 
 def read_settings_table(name: str) -> dict:
@@ -70,16 +71,24 @@ def check_number(name: str, value, low, high, unit: str) -> None:
         raise ValueError(f"{name} must be in [{low:g}, {high:g}] {unit}, got {value!r}")
 
 
-class SourcedSettings:
-    """Base of the settings dataclasses made from a table with units and sources: the class
-    sets ``_spec``, its :func:`settings_spec`."""
-
-    _spec: dict = {}
+def sourced_settings(spec: dict, types: dict | None = None):
+    """Class decorator: :func:`settings_dataclass` of a :func:`settings_spec` table, with
+    ``as_dict()`` (the settings by name) and ``sources()`` (each setting's default, unit and
+    source) made from it."""
 
     def as_dict(self) -> dict:
         return {f.name: getattr(self, f.name) for f in fields(self)}
 
-    @classmethod
-    def sources(cls) -> dict:
+    def sources() -> dict:
         """Each setting: ``(default, unit, source or 'assumption')``."""
-        return {k: (v[0], v[3], v[4]) for k, v in cls._spec.items()}
+        return {k: (v[0], v[3], v[4]) for k, v in spec.items()}
+
+    def make(cls):
+        for function in (as_dict, sources):
+            function.__qualname__ = f"{cls.__qualname__}.{function.__name__}"
+            function.__module__ = cls.__module__
+        cls.as_dict = as_dict
+        cls.sources = staticmethod(sources)
+        return settings_dataclass({name: entry[0] for name, entry in spec.items()}, types)(cls)
+
+    return make
