@@ -18,8 +18,13 @@ import tomllib
 from dataclasses import dataclass, fields
 from importlib import resources
 
-__all__ = ["read_settings_table", "settings_spec", "settings_dataclass", "sourced_settings",
-           "check_number"]
+__all__ = [
+    "read_settings_table",
+    "settings_spec",
+    "settings_dataclass",
+    "sourced_settings",
+    "check_number",
+]
 
 
 def read_settings_table(name: str) -> dict:
@@ -53,8 +58,9 @@ def settings_dataclass(defaults: dict, types: dict | None = None):
     types = types or {}
 
     def make(cls):
-        cls.__annotations__ = {name: types.get(name, _annotation(default))
-                               for name, default in defaults.items()}
+        cls.__annotations__ = {
+            name: types.get(name, _annotation(default)) for name, default in defaults.items()
+        }
         for name, default in defaults.items():
             setattr(cls, name, default)
         return dataclass(frozen=True)(cls)
