@@ -86,12 +86,16 @@ interval widens accordingly.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
 
 import numpy as np
 from numba import njit
 
 from railadhesion.braking.vehicle import GRAVITY
+from railadhesion.io.settings_table import (
+    check_number,
+    settings_spec,
+    sourced_settings,
+)
 
 __all__ = [
     "MAX_AXLES",
@@ -113,71 +117,8 @@ STATUS_BITS = {"slide": SLIDE, "spin": SPIN, "dead_reckoning": DEAD_RECKONING,
                "encoder_low": ENCODER_LOW, "radar_lost": RADAR_LOST,
                "accelerometer_fault": ACCEL_FAULT, "conflict": CONFLICT}
 
-# name: (default, low, high, unit, source)
-_SPEC = {
-    "period": (5e-3, 1e-4, 1.0, "s", "assumption (odometry cycles of a few ms)"),
-    "diameter_tolerance": (0.01, 0.0, 0.1, "-", "the ±1 % wheel-diameter differences of the "
-                           "WSP tests (issue 20; EN 15595 §5.1.6 names them, its limits are "
-                           "not public here); a unit calibrated better may lower it"),
-    "speed_tolerance": (0.005, 0.0, 0.1, "-", "assumption: 3-5 times the period-measurement "
-                        "noise of the encoder model (0.1-0.7 %)"),
-    "speed_tolerance_abs": (0.1, 0.0, 5.0, "m/s", "assumption: the lag of one tooth pitch at "
-                            "low speed (80 teeth, 0.5 m/s: 72 ms)"),
-    "micro_slip": (0.005, 0.0, 0.1, "-", "assumption: creepage of a wheel carrying only the "
-                   "running resistance"),
-    "settle_time": (2.0, 0.0, 60.0, "s", "assumption: after a brake or traction command ends, "
-                    "wheels may still slide or spin this long"),
-    "accel_bias_bound": (0.02, 0.0, 1.0, "m/s²", "assumption: 4 times the modelled residual "
-                         "bias of a calibrated MEMS accelerometer (0.5 mg)"),
-    "accel_noise": (0.05, 0.0, 5.0, "m/s²", "the accelerometer model's sample noise "
-                    "(assumption)"),
-    "accel_sigmas": (5.0, 1.0, 20.0, "-", "assumption: standard deviations of the integrated "
-                     "noise in the speed bounds"),
-    "accel_range": (19.6, 0.0, 1000.0, "m/s²", "the accelerometer's full scale (± 2 g, "
-                    "assumption); a reading there is taken as saturated"),
-    "accel_stuck_samples": (4.0, 2.0, 1000.0, "-", "assumption: this many equal readings of a "
-                            "noisy accelerometer mean it is stuck"),
-    "gradient_tolerance": (0.001, 0.0, 0.05, "-", "assumption: accuracy of the gradient in the "
-                           "track data (0.1 %)"),
-    "max_acceleration": (1.5, 0.0, 10.0, "m/s²", "assumption: above the traction acceleration "
-                         "of passenger trains (about 1-1.3 m/s²)"),
-    "max_deceleration": (3.0, 0.0, 20.0, "m/s²", "assumption: above an emergency brake on a "
-                         "dry rail (2.1 m/s² for the shipped coach at 5.5 bar)"),
-    "coast_deceleration": (0.15, 0.0, 5.0, "m/s²", "assumption: running resistance at speed "
-                           "plus margin, without a brake applied"),
-    "radar_noise": (0.13, 0.0, 10.0, "m/s", "twin-radar error of about 0.47 km/h (a 2023 "
-                    "study), as in the radar model"),
-    "radar_sigmas": (5.0, 1.0, 20.0, "-", "assumption"),
-    "radar_scale_tolerance": (0.02, 0.0, 0.2, "-", "assumption: a Doppler radar's scale error "
-                              "(mounting angle, surface)"),
-    "radar_latency": (0.05, 0.0, 5.0, "s", "the radar model's latency (assumption)"),
-    "radar_loss_time": (0.5, 0.0, 60.0, "s", "assumption: a radar silent this long while the "
-                        "train moves is flagged lost"),
-    "max_wheel_acceleration": (150.0, 1.0, 1e4, "m/s²", "assumption: above a wheel locking under "
-                               "a full brake (about 100 m/s² of surface speed for the shipped "
-                               "coach)"),
-    "stuck_time": (1.0, 0.01, 60.0, "s", "assumption"),
-    "low_fraction": (0.1, 0.0, 1.0, "-", "the lock criterion of the slide accounting (10 % of "
-                     "the train speed, docs/braking.md)"),
-    "low_time": (3.0, 0.01, 600.0, "s", "assumption: the WSP's safety timer (3 s)"),
-    "gate_sigmas": (3.0, 0.0, 20.0, "-", "assumption"),
-    "trend_fast": (0.05, 1e-3, 10.0, "s", "assumption: time constant of the fast mean of a "
-                   "wheel's speed against the accelerometer's"),
-    "trend_slow": (0.2, 1e-3, 60.0, "s", "assumption: time constant of the slow mean"),
-    "trend_threshold": (0.05, 0.0, 10.0, "m/s", "assumption: a wheel whose speed against the "
-                        "accelerometer's changes by more between the two means (a relative "
-                        "acceleration of about 0.3 m/s²) is sliding, spinning or recovering"),
-
-    "accel_bias_sigma": (0.005, 0.0, 1.0, "m/s²", "the accelerometer model's bias "
-                         "(assumption): the filter's prior on the bias"),
-    "admit_time": (0.3, 0.0, 60.0, "s", "assumption: a wheel back inside the gate this long "
-                   "rolls again"),
-    "bias_walk": (1e-6, 0.0, 1.0, "m²/s⁵", "assumption: random walk of the accelerometer bias"),
-    "jerk_noise": (1.0, 0.0, 1e3, "m²/s⁵", "assumption: white jerk of the model without an "
-                   "accelerometer"),
-    "slide_speed_noise": (0.03, 0.0, 1.0, "-", "assumption: relative standard deviation of the "
-                          "fastest sliding wheel as a speed measurement"),
-}
+# name: (default, low, high, unit, source), from data/odometry_settings.toml
+_SPEC = settings_spec("odometry_settings")
 
 SETTINGS_DTYPE = np.dtype([(name, "f8") for name in _SPEC]
                           + [("wheel_radius", "f8"), ("gradient", "f8"), ("n_axles", "i8")],
@@ -215,64 +156,18 @@ STATE_DTYPE = np.dtype([
 ], align=True)
 
 
-@dataclass(frozen=True)
+@sourced_settings(_SPEC)
 class OdometrySettings:
     """Settings of :class:`ReferenceOdometry` (SI units); every default with its source or the
     word assumption: :meth:`sources` and ``docs/odometry.md``."""
 
-    period: float = _SPEC["period"][0]
-    diameter_tolerance: float = _SPEC["diameter_tolerance"][0]
-    speed_tolerance: float = _SPEC["speed_tolerance"][0]
-    speed_tolerance_abs: float = _SPEC["speed_tolerance_abs"][0]
-    micro_slip: float = _SPEC["micro_slip"][0]
-    settle_time: float = _SPEC["settle_time"][0]
-    accel_bias_bound: float = _SPEC["accel_bias_bound"][0]
-    accel_noise: float = _SPEC["accel_noise"][0]
-    accel_sigmas: float = _SPEC["accel_sigmas"][0]
-    accel_range: float = _SPEC["accel_range"][0]
-    accel_stuck_samples: float = _SPEC["accel_stuck_samples"][0]
-    gradient_tolerance: float = _SPEC["gradient_tolerance"][0]
-    max_acceleration: float = _SPEC["max_acceleration"][0]
-    max_deceleration: float = _SPEC["max_deceleration"][0]
-    coast_deceleration: float = _SPEC["coast_deceleration"][0]
-    radar_noise: float = _SPEC["radar_noise"][0]
-    radar_sigmas: float = _SPEC["radar_sigmas"][0]
-    radar_scale_tolerance: float = _SPEC["radar_scale_tolerance"][0]
-    radar_latency: float = _SPEC["radar_latency"][0]
-    radar_loss_time: float = _SPEC["radar_loss_time"][0]
-    max_wheel_acceleration: float = _SPEC["max_wheel_acceleration"][0]
-    stuck_time: float = _SPEC["stuck_time"][0]
-    low_fraction: float = _SPEC["low_fraction"][0]
-    low_time: float = _SPEC["low_time"][0]
-    gate_sigmas: float = _SPEC["gate_sigmas"][0]
-    trend_fast: float = _SPEC["trend_fast"][0]
-    trend_slow: float = _SPEC["trend_slow"][0]
-    trend_threshold: float = _SPEC["trend_threshold"][0]
-    accel_bias_sigma: float = _SPEC["accel_bias_sigma"][0]
-    admit_time: float = _SPEC["admit_time"][0]
-    bias_walk: float = _SPEC["bias_walk"][0]
-    jerk_noise: float = _SPEC["jerk_noise"][0]
-    slide_speed_noise: float = _SPEC["slide_speed_noise"][0]
-
     def __post_init__(self):
         for name, (_, low, high, unit, _) in _SPEC.items():
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int | float) or not (
-                    math.isfinite(value)):
-                raise ValueError(f"{name} must be a finite number, got {value!r}")
-            if not low <= value <= high:
-                raise ValueError(f"{name} must be in [{low:g}, {high:g}] {unit}, got {value!r}")
+            check_number(name, value, low, high, unit)
             object.__setattr__(self, name, float(value))
         if self.accel_range <= 0.0:
             raise ValueError(f"accel_range must be in (0, 1000] m/s², got {self.accel_range!r}")
-
-    @staticmethod
-    def sources() -> dict:
-        """Each setting: ``(default, unit, source or 'assumption')``."""
-        return {k: (v[0], v[3], v[4]) for k, v in _SPEC.items()}
-
-    def as_dict(self) -> dict:
-        return {f.name: getattr(self, f.name) for f in fields(self)}
 
     def settings_record(self, n_axles: int, wheel_radius: float,
                         gradient: float = 0.0) -> np.ndarray:

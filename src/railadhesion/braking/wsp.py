@@ -65,12 +65,16 @@ from __future__ import annotations
 import inspect
 import math
 import warnings
-from dataclasses import dataclass, fields
 
 import numpy as np
 from numba import njit
 
 from railadhesion.braking.cylinders import APPLY, HOLD, VENT
+from railadhesion.io.settings_table import (
+    check_number,
+    settings_spec,
+    sourced_settings,
+)
 
 __all__ = ["WSPSettings", "WheelSlideProtection", "as_controller", "call_controller",
            "accepts_measurements",
@@ -85,105 +89,9 @@ NORMAL, ONSET, VENTING, RECOVER, REAPPLY, PROBE, CUTOUT = range(7)
 #: Names of the phases of a valve group (diagnostics).
 PHASES = ("normal", "onset hold", "vent", "recover", "re-apply", "probe", "cut out")
 
-# settings: name -> (default, low, high, unit, source). None defaults are taken from the vehicle.
-_SPEC = {
-    "period": (5e-3, 1e-4, 0.1, "s", "assumption (WSP control cycles of a few ms)"),
-    "reference_deceleration": (2.5, 0.1, 10.0, "m/s²", "assumption: above the full-brake "
-                               "deceleration of a coach on a good rail (2.1 m/s² for the "
-                               "shipped coach at 5.5 bar)"),
-    "deceleration_per_pressure": (None, 0.0, 1e-3, "m/s² per Pa", "the vehicle's nominal "
-                                  "brake rate n c / (R M_eff), seed 002 eq. 8; 0: not used"),
-    "wheel_inertia_pressure": (None, 0.0, 1e7, "Pa per m/s²", "the vehicle's J / (c R): the "
-                               "brake pressure whose torque decelerates a wheelset at 1 m/s², "
-                               "seed 002 eq. 2 (J dω/dt = R T − c p); 0: not used"),
-    "brake_rate_tolerance": (0.25, 0.0, 5.0, "-", "assumption: spread of pad friction and "
-                             "load"),
-    "reference_deceleration_offset": (0.15, 0.0, 5.0, "m/s²", "assumption: 1 % up-gradient "
-                                      "(0.1 m/s²) plus running resistance"),
-    "hold_slip_ratio": (0.05, 0.0, 1.0, "-", "assumption"),
-    "hold_slip_min": (0.15, 0.0, 10.0, "m/s", "assumption"),
-    "vent_slip_ratio": (0.10, 0.0, 1.0, "-", "assumption; on the HAROLD rig WSP units released "
-                        "the brake above about 20 % creep (trade press)"),
-    "vent_slip_min": (0.3, 0.0, 10.0, "m/s", "assumption; drivers' forums quote an axle "
-                      "4 mph (1.8 m/s) slower than the others as sliding (anecdotal)"),
-    "reapply_slip_ratio": (0.03, 0.0, 1.0, "-", "assumption"),
-    "reapply_slip_min": (0.1, 0.0, 10.0, "m/s", "assumption"),
-    "hold_deceleration": (3.0, 0.0, 100.0, "m/s²", "assumption (relative to the reference)"),
-    "vent_deceleration": (6.0, 0.0, 100.0, "m/s²", "assumption (relative to the reference)"),
-    "recovery_acceleration": (2.0, 0.0, 100.0, "m/s²", "assumption (relative to the "
-                              "reference): vent until the wheel re-accelerates this fast"),
-    "recovery_end_acceleration": (0.5, 0.0, 100.0, "m/s²", "assumption (relative to the "
-                                  "reference): below it a wheel no longer re-accelerates"),
-    "speed_filter": (0.02, 0.0, 1.0, "s", "assumption"),
-    "deceleration_filter": (0.05, 0.0, 1.0, "s", "assumption"),
-    "settle_time": (0.1, 0.0, 5.0, "s", "assumption"),
-    "free_pressure": (0.2e5, 0.0, 1e6, "Pa", "assumption: 0.2 bar, a brake torque below the "
-                      "adhesion torque of a wheel at μ = 0.02 on the shipped coach"),
-    "onset_hold_time": (0.2, 0.0, 10.0, "s", "assumption"),
-    "reapply_deceleration": (0.6, 0.0, 100.0, "m/s²", "assumption: no re-application step "
-                             "while the wheel decelerates this much more than the reference"),
-    "reapply_fast_fraction": (0.7, 0.0, 1.0, "-", "assumption"),
-    "reapply_step_fraction": (0.05, 0.0, 1.0, "-", "assumption: a re-application step "
-                              "changes the pressure by this fraction of the slide pressure"),
-    "reapply_pulse": (5e-3, 0.0, 1.0, "s", "assumption: the APPLY pulse of a step when the "
-                      "pressure is not measured"),
-    "release_pulse": (0.01, 0.0, 1.0, "s", "assumption: the VENT pulse of a release step when "
-                      "the pressure is not measured"),
-    "reapply_lookahead": (0.5, 0.0, 10.0, "s", "assumption: a re-application step looks at the "
-                          "slip this far ahead (slip + lookahead x its rate of growth)"),
-    "reapply_step": (0.1, 1e-4, 10.0, "s", "assumption"),
-    "reapply_max_time": (3.0, 0.01, 600.0, "s", "assumption"),
-    "probe_interval": (2.0, 0.05, 600.0, "s", "assumption"),
-    "probe_max_time": (2.0, 0.05, 600.0, "s", "assumption"),
-    "probe_pressure_fraction": (0.7, 0.0, 1.0, "-", "assumption: a probe vents to this "
-                                "fraction of the pressure, and by this factor again until "
-                                "the wheel re-accelerates or its brake is off"),
-    "probe_min_speed": (1.0, 0.0, 100.0, "m/s", "assumption: probes go on down to here; "
-                        "below it the remaining metres are too few to matter"),
-    "probe_refill_fraction": (0.9, 0.0, 1.0, "-", "assumption: after a probe the pressure "
-                              "returns fast (APPLY) to this fraction of the pressure before "
-                              "it, which the wheel held in its band"),
-    "probe_interval_max": (8.0, 0.05, 600.0, "s", "assumption: the probe interval doubles, up "
-                           "to this, while the probes find the reference accurate"),
-    "probe_accuracy": (1.0, 0.0, 10.0, "-", "assumption: a probe that finds the reference "
-                       "within this fraction of the settings' re-apply slip (3 % of the "
-                       "speed, an error a wheel in the band tolerates) doubles the probe "
-                       "interval, else halves it"),
-    "drift_gain": (0.5, 0.0, 1.0, "-", "assumption: the part of the reference's drift that "
-                   "a speed fix finds which is taken off its deceleration limit"),
-    "drift_margin": (0.05, 0.0, 5.0, "-", "assumption: the learnt limit stays this fraction "
-                     "above the deceleration the pressures and wheel accelerations give"),
-    "band_scale_max": (3.0, 1.0, 10.0, "-", "assumption: the slip band may rise to 3x (hold "
-                       "15 %, vent 30 %); WSP units released the brake above about 20 % "
-                       "creep on the HAROLD rig (trade press); the SNCF curve's second "
-                       "maximum lies between 5 % and 25 % slip (seed 002); 1: no adaptation"),
-    "band_scale_min": (0.5, 0.01, 1.0, "-", "assumption: the band may fall to 1/2 (re-apply "
-                       "1.5 %, hold 2.5 %) where adhesion falls with slip from a peak near "
-                       "0.5-1 % (Polach's falling sets), no lower: the re-apply slip stays "
-                       "above the ±1 % wheel-diameter differences a WSP must cope with "
-                       "(EN 15595 §5.1.6), else a wheel read 1 % slow is released to 0"),
-    "band_min_speed": (5.0, 0.0, 100.0, "m/s", "assumption: below this speed the band returns "
-                       "linearly to the settings' band (near standstill a locked wheel is "
-                       "close and no probe checks the reference below probe_min_speed)"),
-    "band_scale_step": (1.5, 1.01, 4.0, "-", "assumption: the band moves by this factor per "
-                        "adaptation step"),
-    "adapt_time": (1.0, 0.05, 60.0, "s", "assumption: the wheel settles at a new slip within "
-                   "about 0.5 s; the adhesion estimate is averaged over this much regulation"),
-    "adapt_tolerance": (0.02, 0.0, 0.5, "-", "assumption: a relative change of the adhesion "
-                        "estimate smaller than this is no change (adhesion rises by < 1 % per "
-                        "second as the train slows; the re-application steps are 5 %)"),
-    "adapt_block_time": (4.0, 0.0, 600.0, "s", "assumption: after a raise that cost adhesion "
-                         "(or a slide at a raised band), no raise for this long"),
-    "watchdog_time": (3.0, 0.01, 600.0, "s", "assumption; EN 15595 §5.1.4 names the safety "
-                      "timer, its value is not public; Open Rails locks out after 7 s"),
-    "watchdog_refill_time": (0.5, 0.0, 60.0, "s", "assumption"),
-    "watchdog_cutout_trips": (3, 1, 1000, "-", "assumption"),
-    "external_latency": (0.0, 0.0, 5.0, "s", "the external sensor's latency, if known"),
-    "external_tolerance": (0.5, 0.0, 100.0, "m/s", "assumption: 3-4 standard deviations of "
-                           "a radar sample (twin-radar error 0.47 km/h, a 2023 study)"),
-    "wheel_radius": (None, 0.1, 1.0, "m", "the vehicle's nominal wheel radius"),
-    "valves": (None, None, None, "", "'axle' or 'bogie': from the brake cylinders' valves"),
-}
+# settings: name -> (default, low, high, unit, source), from data/wsp_settings.toml (each with
+# its source or the word assumption). None defaults are taken from the vehicle.
+_SPEC = settings_spec("wsp_settings")
 
 _DEPRECATED = {
     "sliding_reference_deceleration": (
@@ -721,15 +629,7 @@ def settings_file_keys() -> dict:
     return keys
 
 
-def _number(name, value):
-    default, low, high, unit, _ = _SPEC[name]
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    if not low <= value <= high:
-        raise ValueError(f"{name} must be in [{low:g}, {high:g}] {unit}, got {value!r}")
-
-
-@dataclass(frozen=True)
+@sourced_settings(_SPEC, types={"valves": "str | None"})
 class WSPSettings:
     """Settings of :class:`WheelSlideProtection` (SI units). Every default with its source or
     the word assumption: :func:`WSPSettings.sources` and ``docs/wsp.md``.
@@ -739,59 +639,6 @@ class WSPSettings:
     :func:`~railadhesion.braking.simulate` and the WSP bench). ``sliding_reference_deceleration``
     of earlier versions is accepted with a ``DeprecationWarning`` and ignored.
     """
-
-    period: float = 5e-3
-    reference_deceleration: float = 2.5
-    deceleration_per_pressure: float | None = None
-    wheel_inertia_pressure: float | None = None
-    brake_rate_tolerance: float = 0.25
-    reference_deceleration_offset: float = 0.15
-    hold_slip_ratio: float = 0.05
-    hold_slip_min: float = 0.15
-    vent_slip_ratio: float = 0.10
-    vent_slip_min: float = 0.3
-    reapply_slip_ratio: float = 0.03
-    reapply_slip_min: float = 0.1
-    hold_deceleration: float = 3.0
-    vent_deceleration: float = 6.0
-    recovery_acceleration: float = 2.0
-    recovery_end_acceleration: float = 0.5
-    speed_filter: float = 0.02
-    deceleration_filter: float = 0.05
-    settle_time: float = 0.1
-    free_pressure: float = 0.2e5
-    onset_hold_time: float = 0.2
-    reapply_deceleration: float = 0.6
-    reapply_fast_fraction: float = 0.7
-    reapply_step_fraction: float = 0.05
-    reapply_pulse: float = 5e-3
-    release_pulse: float = 0.01
-    reapply_lookahead: float = 0.5
-    reapply_step: float = 0.1
-    reapply_max_time: float = 3.0
-    probe_interval: float = 2.0
-    probe_max_time: float = 2.0
-    probe_pressure_fraction: float = 0.7
-    probe_min_speed: float = 1.0
-    probe_refill_fraction: float = 0.9
-    probe_interval_max: float = 8.0
-    probe_accuracy: float = 1.0
-    drift_gain: float = 0.5
-    drift_margin: float = 0.05
-    band_scale_max: float = 3.0
-    band_scale_min: float = 0.5
-    band_min_speed: float = 5.0
-    band_scale_step: float = 1.5
-    adapt_time: float = 1.0
-    adapt_tolerance: float = 0.02
-    adapt_block_time: float = 4.0
-    watchdog_time: float = 3.0
-    watchdog_refill_time: float = 0.5
-    watchdog_cutout_trips: int = 3
-    external_latency: float = 0.0
-    external_tolerance: float = 0.5
-    wheel_radius: float | None = None
-    valves: str | None = None
 
     def __init__(self, **kwargs):
         for name, message in _DEPRECATED.items():
@@ -818,7 +665,7 @@ class WSPSettings:
                     raise ValueError(f"watchdog_cutout_trips must be an integer in [1, 1000], "
                                      f"got {value!r}")
             elif value is not None or _SPEC[name][0] is not None:
-                _number(name, value)
+                check_number(name, value, *_SPEC[name][1:4])
         if not self.reapply_slip_ratio <= self.hold_slip_ratio <= self.vent_slip_ratio:
             raise ValueError("slip ratios must satisfy reapply_slip_ratio <= hold_slip_ratio "
                              "<= vent_slip_ratio, got "
@@ -833,14 +680,6 @@ class WSPSettings:
 
     def replace(self, **changes) -> WSPSettings:
         return WSPSettings(**{**self.as_dict(), **changes})
-
-    def as_dict(self) -> dict:
-        return {f.name: getattr(self, f.name) for f in fields(self)}
-
-    @staticmethod
-    def sources() -> dict:
-        """Each setting: ``(default, unit, source or 'assumption')``."""
-        return {k: (v[0], v[3], v[4]) for k, v in _SPEC.items()}
 
 
 class WheelSlideProtection:
@@ -901,7 +740,7 @@ class WheelSlideProtection:
         if radius is None:
             raise ValueError("the WSP needs the nominal wheel radius: give wheel_radius, or "
                              "call configure(vehicle) or reset(n_axles, wheel_radius) first")
-        _number("wheel_radius", float(radius))
+        check_number("wheel_radius", float(radius), *_SPEC["wheel_radius"][1:4])
         rec = np.zeros(1, SETTINGS_DTYPE)
         r = rec[0]
         for name in SETTINGS_DTYPE.names:

@@ -123,6 +123,34 @@ def _finite(x):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def _others_mean(values, flags, use_flags, i, n):
+    """Mean of the finite ``values`` of the axles other than i (only those with
+    ``flags[j] != 0`` if ``use_flags``) and their count; NaN when there are none."""
+    total = 0.0
+    cnt = 0
+    for j in range(n):
+        if j != i and (not use_flags or flags[j] != 0) and _finite(values[j]):
+            total += values[j]
+            cnt += 1
+    return (total / cnt if cnt > 0 else _NAN), cnt
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _stuck(values, since, refs, i, x, t, ref, armed, wait, moved):
+    """Stuck detector of one channel of axle i (its last value, since when, and what its
+    reference was then): a new reading ``x`` restarts it; an unchanged one is stuck when it
+    has held for ``wait`` [s] while its reference ``ref`` moved by more than ``moved``
+    (``armed``: the check applies). Returns how long it has held [s], or -1 if not stuck."""
+    if x != values[i]:
+        values[i] = x
+        since[i] = t
+        refs[i] = ref
+    elif armed and t - since[i] >= wait and abs(ref - refs[i]) > moved:
+        return t - since[i]
+    return -1.0
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def _filt(z, x, b0, b1, a1):
     """One sample of the first-order IIR (direct form II transposed): (y, new state)."""
     y = b0 * x + z
@@ -424,6 +452,13 @@ def _decide(cfg, st, i, w, sd_x, sd_y):
         verdict, code, v1, v2 = _LOW, R_LOW, med, hi
     else:
         verdict, code, v1, v2 = _CAUTION, R_STRADDLE, med, lo
+    _set_verdict(st, i, verdict, code, v1, v2)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _set_verdict(st, i, verdict, code, v1, v2):
+    """Keep the estimator's verdict on axle i: its level, reason code and the reason's values
+    (reported once the level has held, :func:`_report`)."""
     st.verdict[i] = verdict
     st.verdict_code[i] = code
     st.verdict_v1[i] = v1
@@ -599,10 +634,7 @@ def _start(cfg, st, bank, t):
         st.est[i] = _NAN
         st.est_lo[i] = _NAN
         st.est_hi[i] = _NAN
-        st.verdict[i] = _UNKNOWN
-        st.verdict_code[i] = R_STARTING
-        st.verdict_v1[i] = _NAN
-        st.verdict_v2[i] = _NAN
+        _set_verdict(st, i, _UNKNOWN, R_STARTING, _NAN, _NAN)
         st.level[i] = _UNKNOWN
         st.level_since[i] = t
         st.pending[i] = -1
@@ -778,45 +810,25 @@ def step_record(cfg, inp, st, out, bank):
             elif ht and not (abs(tau) <= cfg.max_torque):
                 code, v1, v2 = R_BAD_TORQUE, tau, cfg.max_torque
         if code == 0:  # a wheel speed that does not move while the train speed does
-            if w != st.w_value[i]:
-                st.w_value[i] = w
-                st.w_since[i] = t
-                st.w_vref[i] = v
-            elif (w > 0.0 and t - st.w_since[i] >= cfg.stuck_time
-                  and abs(v - st.w_vref[i]) > max(0.05, 6.0 * cfg.sig_v)):
-                code, v1, v2 = R_STUCK_WHEEL, w, t - st.w_since[i]
+            stuck = _stuck(st.w_value, st.w_since, st.w_vref, i, w, t, v, w > 0.0,
+                           cfg.stuck_time, max(0.05, 6.0 * cfg.sig_v))
+            if stuck >= 0.0:
+                code, v1, v2 = R_STUCK_WHEEL, w, stuck
         if code == 0 and hp and n > 1:  # a pressure that does not move while the others do
-            others = 0.0
-            cnt = 0
-            for j in range(n):
-                if j != i and _finite(inp.brake_pressure[j]):
-                    others += inp.brake_pressure[j]
-                    cnt += 1
-            others = others / cnt if cnt > 0 else _NAN
-            if p != st.p_value[i]:
-                st.p_value[i] = p
-                st.p_since[i] = t
-                st.p_oref[i] = others
-            elif (t - st.p_since[i] >= cfg.stuck_pressure_time and cnt > 0
-                  and abs(others - st.p_oref[i]) > 1e4):
-                code, v1, v2 = R_STUCK_PRESSURE, p, t - st.p_since[i]
+            others, cnt = _others_mean(inp.brake_pressure, cfg.has_torque, False, i, n)
+            stuck = _stuck(st.p_value, st.p_since, st.p_oref, i, p, t, others, cnt > 0,
+                           cfg.stuck_pressure_time, 1e4)
+            if stuck >= 0.0:
+                code, v1, v2 = R_STUCK_PRESSURE, p, stuck
         if code == 0 and ht and n > 1:  # the same for a torque: the others' mean moved by
             # 4 sigma_tau (about 5 standard deviations of a change of a three-axle mean);
             # exactly 0 is an unpowered or idle axle, not a stuck one
-            others = 0.0
-            cnt = 0
-            for j in range(n):
-                if j != i and cfg.has_torque[j] != 0 and _finite(inp.torque[j]):
-                    others += inp.torque[j]
-                    cnt += 1
-            others = others / cnt if cnt > 0 else _NAN
-            if tau != st.tau_value[i]:
-                st.tau_value[i] = tau
-                st.tau_since[i] = t
-                st.tau_oref[i] = others
-            elif (tau != 0.0 and t - st.tau_since[i] >= cfg.stuck_pressure_time and cnt > 0
-                  and abs(others - st.tau_oref[i]) > max(4.0 * cfg.sig_tau, 1.0)):
-                code, v1, v2 = R_STUCK_TORQUE, tau, t - st.tau_since[i]
+            others, cnt = _others_mean(inp.torque, cfg.has_torque, True, i, n)
+            stuck = _stuck(st.tau_value, st.tau_since, st.tau_oref, i, tau, t, others,
+                           tau != 0.0 and cnt > 0, cfg.stuck_pressure_time,
+                           max(4.0 * cfg.sig_tau, 1.0))
+            if stuck >= 0.0:
+                code, v1, v2 = R_STUCK_TORQUE, tau, stuck
         if code == 0 and st.w_ok[i] != 0 and st.filters_on[i] != 0:
             # a step of the wheel speed that no torque can give (wheel diameter or sensor)
             dtw = t - st.tw_last[i]

@@ -85,15 +85,22 @@ def _numbers(col, name, issues):
     return num
 
 
+def _column_names(columns, source):
+    """The log's column names (stripped) and name -> position; two columns of one name are an
+    error naming both."""
+    names = [str(c).strip() for c in columns]
+    index = {}
+    for k, name in enumerate(names):
+        if name in index:
+            raise ValueError(f"{source or 'log'}: columns {index[name] + 1} and {k + 1} are both "
+                             f"named {name!r}: keep one")
+        index[name] = k
+    return names, index
+
+
 def monitor_log_frame(frame, *, source: str = "") -> MonitorLog:
     """A :class:`MonitorLog` from a pandas DataFrame with the log's columns (see the module)."""
-    names = [str(c).strip() for c in frame.columns]
-    seen = {}
-    for k, name in enumerate(names):
-        if name in seen:
-            raise ValueError(f"{source or 'log'}: columns {seen[name] + 1} and {k + 1} are both "
-                             f"named {name!r}: keep one")
-        seen[name] = k
+    names, _ = _column_names(frame.columns, source)
     columns = dict(zip(names, frame.columns, strict=True))
     return _from_columns(names, lambda name: frame[columns[name]], len(frame), source)
 
@@ -174,13 +181,7 @@ def read_monitor_log(path) -> MonitorLog:
             import pyarrow.parquet as pq
 
             table = pq.read_table(p)
-            names = [str(c).strip() for c in table.column_names]
-            index = {}
-            for k, name in enumerate(names):
-                if name in index:
-                    raise ValueError(f"{p}: columns {index[name] + 1} and {k + 1} are both named "
-                                     f"{name!r}: keep one")
-                index[name] = k
+            names, index = _column_names(table.column_names, str(p))
 
             def get(name):
                 col = table.column(index[name])

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass
+
+from railadhesion.io.settings_table import read_settings_table, settings_dataclass
 
 __all__ = ["MonitorSettings", "RSSB_BRAKING_ADHESION", "BRAKE_COEFFICIENT_SOURCES", "SHAPE_CHOICES",
            "POLACH_RATIO"]
@@ -26,50 +27,15 @@ SHAPE_CHOICES = ("both", "fletcher", "polach")
 #: (railadhesion's ``polach2005_wet``); the dry set's 0.4/1.0 is close.
 POLACH_RATIO = 0.1 / 0.3
 
+# The settings' defaults and ranges, in the order of the fields (data/monitor_settings.toml).
+_TABLE = read_settings_table("monitor_settings")
 # name -> (low, high, low_open, high_open): the allowed range of each number
-_RANGES = {
-    "threshold": (0.0, 2.0, True, False),
-    "confidence": (0.5, 1.0, False, True),
-    "sample_period": (1e-5, 1.0, False, False),
-    "block_time": (0.01, 2.0, False, False),
-    "memory": (0.1, 600.0, False, False),
-    "wheel_cutoff": (0.0, math.inf, True, True),
-    "vehicle_cutoff": (0.0, math.inf, True, True),
-    "min_speed": (0.1, 100.0, False, False),
-    "min_creep": (0.0, 0.1, False, False),
-    "min_adhesion": (0.0, 1.0, False, False),
-    "max_fit_creep": (1e-3, 1.0, False, False),
-    "min_variation": (0.0, 1.0, False, False),
-    "speed_noise": (0.0, 10.0, True, False),
-    "wheel_speed_noise": (0.0, 10.0, True, False),
-    "pressure_noise": (0.0, 1e5, True, False),
-    "torque_noise": (0.0, 1e5, True, False),
-    "model_noise": (0.0, 0.1, False, False),
-    "radius_tolerance": (0.0, 0.1, True, False),
-    "radius_precision": (0.0, 0.01, True, False),
-    "radius_change": (0.0, 0.1, True, False),
-    "coast_pressure": (0.0, 5e5, True, False),
-    "coast_torque": (0.0, 1e5, True, False),
-    "coast_time": (0.0, 60.0, True, False),
-    "coast_settle": (0.0, 60.0, False, False),
-    "change_z": (1.0, 100.0, False, False),
-    "change_blocks": (1, 100, False, False),
-    "confirm_time": (0.0, 60.0, False, False),
-    "recovery_time": (0.0, 600.0, False, False),
-    "stuck_time": (0.0, 600.0, True, False),
-    "stuck_pressure_time": (0.0, 600.0, True, False),
-    "gap_factor": (1.0, 1e6, True, False),
-    "max_physical_adhesion": (0.05, 2.0, False, False),
-    "max_pressure": (0.0, 1e8, True, False),
-    "max_torque": (0.0, 1e7, True, False),
-    "lone_window": (0.0, 60.0, False, False),
-    "lone_shift": (0.0, 0.5, False, False),
-    "slope_prior": (1.0, 1e4, False, False),
-    "slope_prior_spread": (0.01, 10.0, False, False),
-}
+_RANGES = {name: (*entry["range"], entry.get("open") in ("low", "both"),
+                  entry.get("open") in ("high", "both"))
+           for name, entry in _TABLE.items() if "range" in entry}
 
 
-@dataclass(frozen=True)
+@settings_dataclass({name: entry.get("default") for name, entry in _TABLE.items()})
 class MonitorSettings:
     """What the monitor assumes and how it decides (SI units; creep and adhesion fractions).
 
@@ -200,49 +166,6 @@ class MonitorSettings:
         estimate, once it rests on 5 s of braking (its running value is an output either
         way).
     """
-
-    threshold: float = RSSB_BRAKING_ADHESION
-    confidence: float = 0.95
-    sample_period: float = 2.4e-3
-    block_time: float = 0.1
-    memory: float = 3.0
-    wheel_cutoff: float = 2.0
-    vehicle_cutoff: float = 0.5
-    min_speed: float = 5.0
-    min_creep: float = 5e-4
-    min_adhesion: float = 0.02
-    min_variation: float = 0.05
-    max_fit_creep: float = 0.03
-    speed_noise: float = 0.01
-    wheel_speed_noise: float = 0.02
-    pressure_noise: float = 1e3
-    torque_noise: float = 50.0
-    model_noise: float = 1e-3
-    learn_radius: bool = True
-    radius_tolerance: float = 0.005
-    radius_precision: float = 1e-4
-    radius_change: float = 3e-4
-    coast_pressure: float = 5e3
-    coast_torque: float = 100.0
-    coast_time: float = 1.0
-    coast_settle: float = 0.5
-    change_z: float = 5.0
-    change_blocks: int = 2
-    confirm_time: float = 0.2
-    recovery_time: float = 0.5
-    stuck_time: float = 0.5
-    stuck_pressure_time: float = 5.0
-    gap_factor: float = 5.0
-    max_physical_adhesion: float = 0.6
-    max_pressure: float = 2e6
-    max_torque: float = 1e5
-    lone_window: float = 0.5
-    lone_shift: float = 1e-3
-    slope_prior: float = 60.0
-    slope_prior_spread: float = 1.2
-    max_slope: float | None = None
-    shapes: str = "both"
-    brake_coefficient: str = "vehicle"
 
     def __post_init__(self):
         for name, (low, high, low_open, high_open) in _RANGES.items():
