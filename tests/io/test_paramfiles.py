@@ -218,7 +218,14 @@ def _set(doc, dotted, value):
         doc[last] = value
 
 
-_DELETE = object()
+class _Delete:
+    """Marks a field to delete; its repr names it, so test ids are the same in every process."""
+
+    def __repr__(self):
+        return "DELETE"
+
+
+_DELETE = _Delete()
 EXP_Q = {"terms": ["exp(Q)"], "coefficients": [1.0]}
 
 # (dotted field to change, new value, substrings the message must contain)
