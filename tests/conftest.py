@@ -15,5 +15,10 @@ settings.register_profile("ci", derandomize=True, database=None, print_blob=True
 if os.environ.get("CI"):
     settings.load_profile("ci")
 
+# The CLI's messages are printed by rich, which wraps them at 80 columns when the output is not
+# a terminal: a long temporary path (pytest-xdist's per-worker directories) would then split a
+# file name that a test looks for. Tests read them unwrapped.
+os.environ.setdefault("COLUMNS", "250")
+
 # the independent oracles of the compiled laws (tests/oracles) import as ``oracles``
 sys.path.insert(0, str(Path(__file__).parent))
