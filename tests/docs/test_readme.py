@@ -10,7 +10,7 @@ README = (ROOT / "README.md").read_text(encoding="utf-8")
 
 COMMANDS = (
     'python3 -m pip install -e ".[dev]" && python3 -m railadhesion demo',
-    'python3 -m pip install -e ".[dev]" && python3 -m pytest -q',
+    'python3 -m pip install -e ".[dev]" && python3 -m pytest -q -n auto',
 )
 
 
