@@ -48,6 +48,7 @@ from pathlib import Path
 
 import numpy as np
 
+from railadhesion.io.axle_log import AxleLog
 from railadhesion.plausibility import (
     AlteredResultWarning,
     check_plausible,
@@ -104,29 +105,6 @@ class LogIssue:
         where = f" rows [{shown}] ({rows.size})" if rows.size else ""
         chan = f" {self.channel}" if self.channel else ""
         return f"{self.kind}{chan}:{where} -> {self.action}"
-
-
-@dataclass(frozen=True, eq=False)
-class AxleLog:
-    """The channels every log of a train's axles holds, SI units (n samples, N axles): time
-    [s] (n,), train speed [m/s] (n,), wheelset angular speeds [rad/s] (n, N) and
-    brake-cylinder pressures [Pa] (n, N). Base of :class:`BrakingLog` (identification) and
-    :class:`railadhesion.monitor.replay.MonitorLog` (the monitor's replay)."""
-
-    time: np.ndarray
-    train_speed: np.ndarray
-    wheel_speed: np.ndarray
-    brake_pressure: np.ndarray
-
-    @property
-    def n_axles(self) -> int:
-        """Number of axles N."""
-        return int(self.wheel_speed.shape[1])
-
-    @property
-    def n_samples(self) -> int:
-        """Number of samples n."""
-        return int(self.time.size)
 
 
 @dataclass(frozen=True, eq=False)

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from railadhesion.identification.logs import AxleLog
+from railadhesion.io.axle_log import AxleLog
 from railadhesion.monitor import layout
 from railadhesion.monitor.estimator import AdhesionMonitor
 from railadhesion.monitor.settings import MonitorSettings
