@@ -36,8 +36,9 @@ class RailadhesionBraking(Fmi2Slave):
             from railadhesion.export.slave import open_slave, register_variables
         except ImportError as exc:
             raise ImportError(
-                "the railadhesion braking FMU needs the Python package 'railadhesion' "
-                f"importable by the Python interpreter that runs the FMU: {exc}"
+                "the railadhesion braking FMU needs the Python package 'railadhesion' (the "
+                "release that built the FMU, or a later one) importable by the Python "
+                f"interpreter that runs the FMU: {exc}"
             ) from exc
         resources, config = open_slave(self)  # the exit work-around, the config
         self._np = np

@@ -25,13 +25,14 @@ from pythonfmu.enums import Fmi2Status
 def _import_railadhesion():
     try:
         import railadhesion
+        from railadhesion.export import slave
     except ImportError as exc:  # the host's Python lacks the package: say what to do
         raise ImportError(
-            "the railadhesion creep-force FMU needs the Python package 'railadhesion' "
-            "importable by the Python interpreter that runs the FMU (pip install "
-            f"railadhesion, or add it to PYTHONPATH): {exc}"
+            "the railadhesion creep-force FMU needs the Python package 'railadhesion' (the "
+            "release that built the FMU, or a later one) importable by the Python interpreter "
+            f"that runs the FMU (pip install railadhesion, or add it to PYTHONPATH): {exc}"
         ) from exc
-    return railadhesion
+    return railadhesion, slave
 
 
 class RailadhesionCreepForce(Fmi2Slave):
@@ -42,11 +43,10 @@ class RailadhesionCreepForce(Fmi2Slave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        ra = _import_railadhesion()
-        from railadhesion.export.slave import open_slave, register_variables
+        ra, slave = _import_railadhesion()
         from railadhesion.io.paramfiles import load_parameter_file
 
-        resources, config = open_slave(self)  # the exit work-around, the config
+        resources, config = slave.open_slave(self)  # the exit work-around, the config
         self._model = config["model"]
         params = load_parameter_file(resources / config["parameter_file"])
         self._params = params
@@ -70,8 +70,8 @@ class RailadhesionCreepForce(Fmi2Slave):
         self.Fy = 0.0
         self.adhesion = 0.0
         self.Mz = 0.0
-        register_variables(self, config["variables"], getter=self._output_getter,
-                           setter=self._input_setter)  # fmt: skip
+        slave.register_variables(self, config["variables"], getter=self._output_getter,
+                                 setter=self._input_setter)  # fmt: skip
 
     # -- variable access --------------------------------------------------------------------
 

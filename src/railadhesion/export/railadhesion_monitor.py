@@ -28,8 +28,9 @@ class RailadhesionMonitor(Fmi2Slave):
             from railadhesion.monitor import AdhesionMonitor, MonitorSettings
         except ImportError as exc:
             raise ImportError(
-                "the railadhesion monitor FMU needs the Python package 'railadhesion' "
-                f"importable by the Python interpreter that runs the FMU: {exc}"
+                "the railadhesion monitor FMU needs the Python package 'railadhesion' (the "
+                "release that built the FMU, or a later one) importable by the Python "
+                f"interpreter that runs the FMU: {exc}"
             ) from exc
         resources, config = open_slave(self)  # the exit work-around, the config
         vehicle = load_vehicle(resources / config["vehicle_file"])
