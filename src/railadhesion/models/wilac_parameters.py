@@ -239,9 +239,10 @@ def wilac_weights(water_flow, transitions=PAPER_TRANSITIONS) -> np.ndarray:
 
     Parameters
     ----------
-    water_flow, transitions
-        Water flow rate w [µl/s] and the transitions' (midpoint, width) pairs [µl/s], as for
-        :func:`wilac_transitions`.
+    water_flow : array_like
+        Water flow rate w to the rail surface [µl/s], finite and >= 0.
+    transitions : sequence of 3 (midpoint, width) pairs, optional
+        Transition positions and widths [µl/s]; default: seed 000, Table 1.
 
     Returns
     -------
