@@ -605,35 +605,40 @@ def advance_buffer_unrecorded(buffer, dt, aux):
     return advance_unrecorded(machine, tables, dt, aux)
 
 
-def _entry_points(family: str, aux, models: str, short: str | None = None):
-    """The two buffer entry points of the stepping API for one adhesion family,
-    ``advance_<family>`` (no recording) and ``advance_<family>_recorded`` (recording into
-    ``rows``): ``aux`` is a compile-time constant whose type selects the family; ``models``
-    and ``short`` name it in their docstrings."""
-
-    def advance(buffer, dt):
-        return advance_buffer_unrecorded(buffer, dt, aux)
-
-    def advance_recorded(buffer, rows, dt):
-        return advance_buffer(buffer, rows, dt, aux)
-
-    advance.__doc__ = f"One call of the stepping API, {models}, no recording."
-    advance_recorded.__doc__ = (f"One call of the stepping API, {short or models}, recording "
-                                "into ``rows``.")
-    entries = []
-    for function, name in ((advance, f"advance_{family}"),
-                           (advance_recorded, f"advance_{family}_recorded")):
-        function.__name__ = function.__qualname__ = name  # also names the numba cache files
-        entries.append(njit(cache=True, error_model="numpy")(function))
-    return tuple(entries)
+@njit(cache=True, error_model="numpy")
+def advance_builtin(buffer, dt):
+    """One call of the stepping API, built-in adhesion models, no recording."""
+    return advance_buffer_unrecorded(buffer, dt, 0)
 
 
-advance_builtin, advance_builtin_recorded = _entry_points("builtin", 0,
-                                                          "built-in adhesion models")
-advance_python, advance_python_recorded = _entry_points("python", None,
-                                                        "an adhesion model in Python")
-advance_table, advance_table_recorded = _entry_points(
-    "table", TABLE_AUX, "the table model (``TABLE_AUX``)", "the table model")
+@njit(cache=True, error_model="numpy")
+def advance_builtin_recorded(buffer, rows, dt):
+    """One call of the stepping API, built-in adhesion models, recording into ``rows``."""
+    return advance_buffer(buffer, rows, dt, 0)
+
+
+@njit(cache=True, error_model="numpy")
+def advance_python(buffer, dt):
+    """One call of the stepping API, an adhesion model in Python, no recording."""
+    return advance_buffer_unrecorded(buffer, dt, None)
+
+
+@njit(cache=True, error_model="numpy")
+def advance_python_recorded(buffer, rows, dt):
+    """One call of the stepping API, an adhesion model in Python, recording into ``rows``."""
+    return advance_buffer(buffer, rows, dt, None)
+
+
+@njit(cache=True, error_model="numpy")
+def advance_table(buffer, dt):
+    """One call of the stepping API, the table model (``TABLE_AUX``), no recording."""
+    return advance_buffer_unrecorded(buffer, dt, TABLE_AUX)
+
+
+@njit(cache=True, error_model="numpy")
+def advance_table_recorded(buffer, rows, dt):
+    """One call of the stepping API, the table model, recording into ``rows``."""
+    return advance_buffer(buffer, rows, dt, TABLE_AUX)
 
 
 @njit(cache=True, error_model="numpy")
