@@ -443,3 +443,16 @@ def test_wsp_update_keeps_its_invariants_on_any_readings(seed, speed, slip, pres
         assert (r["scale"][:ng] <= s.band_scale_max + 1e-12).all()
         assert 0.0 <= r["excess"] <= s.reference_deceleration
         assert s.probe_interval <= r["probe_gap"] <= s.probe_interval_max
+
+
+def test_free_pressure_given_in_bar_is_sniffed():
+    """0.2 (bar meant, the default is 0.2 bar = 2e4 Pa) passes the range [0, 1e6] Pa: it gets a
+    UnitWarning naming bar; the default, 0 (no free pressure) and 0.3 bar in Pa do not."""
+    from railadhesion.plausibility import UnitWarning
+
+    with pytest.warns(UnitWarning, match=r"free_pressure = 0.2 Pa .* given in bar\?"):
+        WSPSettings(free_pressure=0.2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for value in (2e4, 0.0, 3e4):
+            assert WSPSettings(free_pressure=value).free_pressure == value

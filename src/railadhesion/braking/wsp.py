@@ -75,6 +75,7 @@ from railadhesion.io.settings_table import (
     settings_spec,
     sourced_settings,
 )
+from railadhesion.plausibility import check_plausible
 
 __all__ = ["WSPSettings", "WheelSlideProtection", "as_controller", "call_controller",
            "accepts_measurements",
@@ -677,6 +678,9 @@ class WSPSettings:
         if not self.probe_interval <= self.probe_interval_max:
             raise ValueError("probe_interval must not exceed probe_interval_max, got "
                              f"{self.probe_interval} > {self.probe_interval_max}")
+        if self.free_pressure > 0.0:  # 0.2 given in bar would pass the range check as Pa
+            check_plausible(self.free_pressure, "free_pressure", quantity="brake_pressure",
+                            what="WSP free pressure")
 
     def replace(self, **changes) -> WSPSettings:
         return WSPSettings(**{**self.as_dict(), **changes})
