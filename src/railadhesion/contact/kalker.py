@@ -129,10 +129,17 @@ _PI = math.pi
 
 
 @jitable
+def _nu_blend_compliance(w0, w1, w2, i0, i1, i2):
+    """C at nu from the compliances 1/C(0), 1/C(1/4), 1/C(1/2) and the Lagrange weights w0,
+    w1, w2 of the parabola in 1/C through nu = 0, 0.25, 0.5 (CONTACT linrol)."""
+    return 1.0 / (w0 * i0 + w1 * i1 + w2 * i2)
+
+
+@jitable
 def _nu_blend(w0, w1, w2, c0, c1, c2):
-    """C at nu from the columns C(0), C(1/4), C(1/2) and the Lagrange weights w0, w1, w2 of the
-    parabola in 1/C through nu = 0, 0.25, 0.5 (CONTACT linrol)."""
-    return 1.0 / (w0 / c0 + w1 / c1 + w2 / c2)
+    """C at nu from the columns C(0), C(1/4), C(1/2): :func:`_nu_blend_compliance` of their
+    reciprocals."""
+    return _nu_blend_compliance(w0, w1, w2, 1.0 / c0, 1.0 / c1, 1.0 / c2)
 
 
 @jitable
@@ -189,14 +196,19 @@ def kalker_law(a_over_b, nu, compliance=False):
     out0 = out1 = out2 = out3 = 0.0
     for k in range(4):
         if compliance:  # 1/C linear in t between the rows
-            c0 = 1.0 / (_INV_ROWS[i, k, 0] * (1.0 - f) + _INV_ROWS[i + 1, k, 0] * f)
-            c1 = 1.0 / (_INV_ROWS[i, k, 1] * (1.0 - f) + _INV_ROWS[i + 1, k, 1] * f)
-            c2 = 1.0 / (_INV_ROWS[i, k, 2] * (1.0 - f) + _INV_ROWS[i + 1, k, 2] * f)
+            c = _nu_blend_compliance(
+                w0, w1, w2,
+                _INV_ROWS[i, k, 0] * (1.0 - f) + _INV_ROWS[i + 1, k, 0] * f,
+                _INV_ROWS[i, k, 1] * (1.0 - f) + _INV_ROWS[i + 1, k, 1] * f,
+                _INV_ROWS[i, k, 2] * (1.0 - f) + _INV_ROWS[i + 1, k, 2] * f,
+            )  # fmt: skip
         else:  # C linear in t (CONTACT)
-            c0 = _ROWS[i, k, 0] * (1.0 - f) + _ROWS[i + 1, k, 0] * f
-            c1 = _ROWS[i, k, 1] * (1.0 - f) + _ROWS[i + 1, k, 1] * f
-            c2 = _ROWS[i, k, 2] * (1.0 - f) + _ROWS[i + 1, k, 2] * f
-        c = _nu_blend(w0, w1, w2, c0, c1, c2)
+            c = _nu_blend(
+                w0, w1, w2,
+                _ROWS[i, k, 0] * (1.0 - f) + _ROWS[i + 1, k, 0] * f,
+                _ROWS[i, k, 1] * (1.0 - f) + _ROWS[i + 1, k, 1] * f,
+                _ROWS[i, k, 2] * (1.0 - f) + _ROWS[i + 1, k, 2] * f,
+            )  # fmt: skip
         if k == 0:
             out0 = c
         elif k == 1:
