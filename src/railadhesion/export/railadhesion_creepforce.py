@@ -66,10 +66,7 @@ class RailadhesionCreepForce(Fmi2Slave):
                 Fmi2Status.warning,
             )
         self._dirty = True
-        self.Fx = 0.0
-        self.Fy = 0.0
-        self.adhesion = 0.0
-        self.Mz = 0.0
+        self.Mz = 0.0  # an output of the table model only; the outputs start at 0 (below)
         slave.register_variables(self, config["variables"], getter=self._output_getter,
                                  setter=self._input_setter)  # fmt: skip
 
