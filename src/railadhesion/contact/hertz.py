@@ -46,12 +46,6 @@ def _scalar_or_array(x):
     return float(x) if x.ndim == 0 else np.array(x)
 
 
-def _result(cls, *values):
-    """``cls`` (:class:`HertzContact`, :class:`LineContact`) of ``values``, given in the order
-    of its fields, each a float for 0-d results, else an array."""
-    return cls(*map(_scalar_or_array, values))
-
-
 @dataclass(frozen=True)
 class HertzContact:
     """Result of a 3D Hertzian contact (every field a float or an array, SI units).
@@ -356,7 +350,18 @@ def _hertz_core(q, ca, cb, young, poisson, young_rail, poisson_rail) -> HertzCon
     a = np.where(a_le_b_curv, major, minor)
     b = np.where(a_le_b_curv, minor, major)
     p0 = 3.0 * q / (2.0 * np.pi * a * b)
-    return _result(HertzContact, a, b, p0, approach, ca, cb, rho, c, q, e_star)
+    return HertzContact(
+        a=_scalar_or_array(a),
+        b=_scalar_or_array(b),
+        max_pressure=_scalar_or_array(p0),
+        approach=_scalar_or_array(approach),
+        curvature_A=_scalar_or_array(ca),
+        curvature_B=_scalar_or_array(cb),
+        mean_radius=_scalar_or_array(rho),
+        c=_scalar_or_array(c),
+        normal_force=_scalar_or_array(q),
+        effective_modulus=_scalar_or_array(e_star),
+    )
 
 
 def _hertz_scalar(q: float, ca: float, cb: float, e_star: float) -> HertzContact:
@@ -368,8 +373,18 @@ def _hertz_scalar(q: float, ca: float, cb: float, e_star: float) -> HertzContact
     approach = 2.0 * c * c * k * kk / (rho * ee)
     major, minor = c / math.sqrt(k), c * math.sqrt(k)
     a, b = (major, minor) if a_le_b_curv else (minor, major)
-    p0 = 3.0 * q / (2.0 * math.pi * a * b)
-    return HertzContact(a, b, p0, approach, ca, cb, rho, c, q, e_star)  # fields in order
+    return HertzContact(
+        a=a,
+        b=b,
+        max_pressure=3.0 * q / (2.0 * math.pi * a * b),
+        approach=approach,
+        curvature_A=ca,
+        curvature_B=cb,
+        mean_radius=rho,
+        c=c,
+        normal_force=q,
+        effective_modulus=e_star,
+    )
 
 
 def _check_radius_nonzero(value, name: str) -> np.ndarray:
@@ -575,4 +590,11 @@ def line_contact_from_pressure(
 
 
 def _line_result(a, p0, p, r, e_star) -> LineContact:
-    return _result(LineContact, *np.broadcast_arrays(a, p0, p, r, e_star))
+    a, p0, p, r, e_star = np.broadcast_arrays(a, p0, p, r, e_star)
+    return LineContact(
+        half_width=_scalar_or_array(a),
+        max_pressure=_scalar_or_array(p0),
+        load_per_length=_scalar_or_array(p),
+        reduced_radius=_scalar_or_array(r),
+        effective_modulus=_scalar_or_array(e_star),
+    )
