@@ -422,18 +422,6 @@ def _builtin_refresh(s, st, tables):
 
 
 @njit(cache=True, error_model="numpy")
-def _sign(x):
-    """The sign of ``x`` as a float: 1, -1, 0, and NaN for NaN (as ``np.sign``)."""
-    if x > 0.0:
-        return 1.0
-    if x < 0.0:
-        return -1.0
-    if x == 0.0:
-        return 0.0
-    return math.nan
-
-
-@njit(cache=True, error_model="numpy")
 def _user_evaluate(s, st, fn, speed):
     """The differences of CallableAdhesion: central in the creepage (step
     ``settings.creep_step``), forward in the speed (1e-6 of it, at least 1e-6 m/s)."""
@@ -448,7 +436,7 @@ def _user_evaluate(s, st, fn, speed):
         m = fn(a, speed, q)
         dmu = (fn(a + h, speed, q) - fn(lo, speed, q)) / (a + h - lo)
         m2 = fn(a, speed + hv, q)
-        sign = _sign(xi)
+        sign = np.sign(xi)
         mu = sign * m
         c.mu[i] = mu
         c.dmu[i] = dmu
@@ -516,7 +504,7 @@ def table_axle_curve(creep, speed, q, a, b, mu0, ratio, decay, g, nu, tab, dims,
         hv = 1e-6 * max(v, 1.0)
         dmv = (_table_mu(x, v + hv, q, a, b, mu0, ratio, decay, g, nu, tab, dims, strides,
                          origin, inv_step) - m) / hv
-    sign = _sign(creep)
+    sign = np.sign(creep)
     return sign * m, dmu, sign * dmv
 
 
