@@ -50,6 +50,7 @@ from railadhesion._validate import (
 )
 from railadhesion.contact.friction import falling_friction_factor
 from railadhesion.contact.kalker import check_creepages, check_rolling_inputs
+from railadhesion.contact.rolling_newton import RollingOperator, solve_steady_rolling
 from railadhesion.numerics import jit
 from railadhesion.plausibility import input_checker
 
@@ -782,12 +783,96 @@ def _solve_falling_friction(
 
 
 @jit(error_model="python")
+def _grid_shape(mx, my, scale, shape_in):
+    """Element-centre coordinates over the semi-axes ``xh`` (mx), ``yh`` (my), the pressure
+    shape on the grid (``shape_in`` clipped at 0, or Hertz's at the element centres when
+    ``shape_in`` is empty) and its sum."""
+    xh = np.empty(mx)
+    yh = np.empty(my)
+    for i in range(mx):
+        xh[i] = scale * (-1.0 + (2.0 * i + 1.0) / mx)
+    for j in range(my):
+        yh[j] = scale * (-1.0 + (2.0 * j + 1.0) / my)
+    shape = np.zeros((my, mx))
+    ssum = 0.0
+    for j in range(my):
+        for i in range(mx):
+            if shape_in.size > 0:
+                shape[j, i] = max(shape_in[j, i], 0.0)
+            else:
+                q = 1.0 - xh[i] * xh[i] - yh[j] * yh[j]
+                shape[j, i] = math.sqrt(q) if q > 0.0 else 0.0
+            ssum += shape[j, i]
+    return xh, yh, shape, ssum
+
+
+@jit(error_model="python")
+def _case_fields(xi, eta, phi, fz, a, b, mu, gmod, scale, spin_offset, xh, yh, shape, ssum, g,
+                 wx, wy):  # fmt: skip
+    """The traction bound ``g = mu p_n/G`` and the rigid slip ``w`` of one case on its grid
+    (filled in); returns the element size (dx, dy) [m]. ``p_n`` is the shape scaled so that
+    ``sum(p_n dA) = Fz`` exactly; ``w = (xi - phi y, eta + phi (x + spin_offset dx))``
+    (Kalker 1990, eq. 1.1.11; the spin term CONTACT's FACPHI upstream)."""
+    my, mx = shape.shape
+    dx = 2.0 * scale * a / mx
+    dy = 2.0 * scale * b / my
+    pfac = fz / (ssum * dx * dy)
+    for j in range(my):
+        y = b * yh[j]
+        for i in range(mx):
+            x = a * xh[i]
+            g[j, i] = mu * pfac * shape[j, i] / gmod
+            wx[j, i] = xi - phi * y
+            wy[j, i] = eta + phi * (x + spin_offset * dx)
+    return dx, dy
+
+
+@jit(error_model="python")
+def _case_forces(px, py, st, shape, xh, yh, a, b, dx, dy, gmod, out):
+    """``out[:4] = (Fx, Fy, Mz, slip fraction)`` from the tractions (over G) of one case."""
+    my, mx = shape.shape
+    fx = 0.0
+    fy = 0.0
+    mz = 0.0
+    area_slip = 0.0
+    area_c = 0.0
+    for j in range(my):
+        y = b * yh[j]
+        for i in range(mx):
+            if shape[j, i] <= 0.0:
+                continue
+            x = a * xh[i]
+            fx += px[j, i]
+            fy += py[j, i]
+            mz += x * py[j, i] - y * px[j, i]
+            area_c += 1.0
+            if st[j, i] == _SLIP:
+                area_slip += 1.0
+    da = dx * dy * gmod
+    out[0] = fx * da
+    out[1] = fy * da
+    out[2] = mz * da
+    out[3] = area_slip / area_c if area_c > 0 else 0.0
+
+
+@jit(error_model="python")
+def _case_kernel(mx, my, ratio, nu):
+    """Rolling kernel of a grid with dy/dx = ``ratio`` (for dx = 1: K is dimensionless), its
+    column spectra and the Gauss-Seidel diagonal."""
+    kxx, kxy, kyy = _rolling_kernel(mx, my, 1.0, ratio, nu)
+    spec = _kernel_spectra(kxx, kxy, kyy)
+    dgx, dgy = _gs_diagonal(ratio, nu)
+    return kxx, kxy, kyy, spec, dgx, dgy
+
+
+@jit(error_model="python")
 def _solve_hertz_batch(
     xi, eta, phi, fz, a, b, mu, gmod, nu, speed, fratio, decay, mx, my, scale, spin_offset, tol,
     max_iter, tol_outer, max_outer, out_f, out_iter, out_err, out_outer, px_all, py_all, sx_all,
     sy_all, state_all, mu_all, keep_fields, warm, shape_in,
 ):  # fmt: skip
-    """Loop over cases: Hertz pressure on the grid, kernel (reused when unchanged), solve.
+    """Loop over cases by Gauss-Seidel: pressure on the grid, kernel (reused when unchanged),
+    solve.
 
     ``shape_in`` (my, mx): the pressure distribution to use (any scale), or an empty array for
     Hertz's at the element centres."""
@@ -801,54 +886,23 @@ def _solve_hertz_batch(
     g = np.zeros((my, mx))
     wx = np.zeros((my, mx))
     wy = np.zeros((my, mx))
-    shape = np.zeros((my, mx))
-    kxx = np.zeros((1, 1))
-    kxy = np.zeros((1, 1))
-    kyy = np.zeros((1, 1))
-    spec = _kernel_spectra(kxx, kxy, kyy)
-    dgx = 1.0
-    dgy = 1.0
+    kxx, kxy, kyy, spec, dgx, dgy = _case_kernel(1, 1, 1.0, 0.0)
     last_ratio = -1.0
     last_nu = -1.0
-    xh = np.empty(mx)
-    yh = np.empty(my)
-    for i in range(mx):
-        xh[i] = scale * (-1.0 + (2.0 * i + 1.0) / mx)
-    for j in range(my):
-        yh[j] = scale * (-1.0 + (2.0 * j + 1.0) / my)
-    # shape of the pressure (Hertz's at the element centres unless given), and its sum
-    ssum = 0.0
-    for j in range(my):
-        for i in range(mx):
-            if shape_in.size > 0:
-                shape[j, i] = max(shape_in[j, i], 0.0)
-            else:
-                q = 1.0 - xh[i] * xh[i] - yh[j] * yh[j]
-                shape[j, i] = math.sqrt(q) if q > 0.0 else 0.0
-            ssum += shape[j, i]
+    xh, yh, shape, ssum = _grid_shape(mx, my, scale, shape_in)
     for c in range(n):
-        dx = 2.0 * scale * a[c] / mx
-        dy = 2.0 * scale * b[c] / my
+        dx, dy = _case_fields(xi[c], eta[c], phi[c], fz[c], a[c], b[c], mu[c], gmod[c], scale,
+                              spin_offset, xh, yh, shape, ssum, g, wx, wy)  # fmt: skip
         ratio = dy / dx
         restart = True
         if ratio != last_ratio or nu[c] != last_nu:
-            kxx, kxy, kyy = _rolling_kernel(mx, my, 1.0, ratio, nu[c])
-            spec = _kernel_spectra(kxx, kxy, kyy)
-            dgx, dgy = _gs_diagonal(ratio, nu[c])
+            kxx, kxy, kyy, spec, dgx, dgy = _case_kernel(mx, my, ratio, nu[c])
             last_ratio = ratio
             last_nu = nu[c]
         elif warm:
             restart = False  # start from the previous case's tractions (same kernel)
-        # kernel computed for dx = 1: K scales as 1/length * length = dimensionless
-        # p_n scaled so that sum(p_n dA) = Fz exactly
-        pfac = fz[c] / (ssum * dx * dy)
         for j in range(my):
             for i in range(mx):
-                g[j, i] = mu[c] * pfac * shape[j, i] / gmod[c]
-                x = a[c] * xh[i]
-                y = b[c] * yh[j]
-                wx[j, i] = xi[c] - phi[c] * y
-                wy[j, i] = eta[c] + phi[c] * (x + spin_offset * dx)
                 if restart:
                     px[j, i] = 0.0
                     py[j, i] = 0.0
@@ -871,28 +925,7 @@ def _solve_hertz_batch(
                 g, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, tol, max_iter, px, py, sx, sy, st, mu_fac,
                 speed[c], fratio[c], decay[c], tol_outer, max_outer,
             )  # fmt: skip
-        fx = 0.0
-        fy = 0.0
-        mz = 0.0
-        area_slip = 0.0
-        area_c = 0.0
-        for j in range(my):
-            y = b[c] * yh[j]
-            for i in range(mx):
-                if shape[j, i] <= 0.0:
-                    continue
-                x = a[c] * xh[i]
-                fx += px[j, i]
-                fy += py[j, i]
-                mz += x * py[j, i] - y * px[j, i]
-                area_c += 1.0
-                if st[j, i] == _SLIP:
-                    area_slip += 1.0
-        da = dx * dy * gmod[c]
-        out_f[c, 0] = fx * da
-        out_f[c, 1] = fy * da
-        out_f[c, 2] = mz * da
-        out_f[c, 3] = area_slip / area_c if area_c > 0 else 0.0
+        _case_forces(px, py, st, shape, xh, yh, a[c], b[c], dx, dy, gmod[c], out_f[c])
         out_iter[c] = it
         out_err[c] = err
         out_outer[c] = outer
@@ -905,6 +938,141 @@ def _solve_hertz_batch(
                     sy_all[c, j, i] = sy[j, i]
                     state_all[c, j, i] = st[j, i]
                     mu_all[c, j, i] = mu_fac[j, i] * mu[c]
+
+
+# ---------------------------------------------------------------------------------------------
+# Batches: Gauss-Seidel (compiled loop) or semismooth Newton (FFT products, per case)
+# ---------------------------------------------------------------------------------------------
+
+#: ``method="auto"`` solves Coulomb cases by semismooth Newton from this many grid elements
+#: (40 x 40) up; below, the compiled Gauss-Seidel loop is as fast or faster
+#: (``benchmarks/bench_exact.py``).
+NEWTON_MIN_ELEMENTS = 1600
+#: The coarse grids of the Newton start are solved to this tolerance.
+_COARSE_TOL = 1e-2
+#: Coarser grids are not used below this many elements along either axis.
+_COARSE_MIN = 12
+#: Newton steps allowed before a case is handed to Gauss-Seidel (3-6 are typical).
+_NEWTON_MAX_STEPS = 60
+
+
+@dataclass
+class _BatchOutput:
+    forces: np.ndarray  # (n, 4)
+    iterations: np.ndarray
+    residual: np.ndarray
+    outer: np.ndarray
+    fields: list  # px, py, sx, sy: (n, ny, nx) or (1, 1, 1) placeholders
+    state: np.ndarray
+    mu_local: np.ndarray
+    newton: np.ndarray  # bool: case solved by Newton (False: Gauss-Seidel)
+
+
+def _solve_cases(idx, flat, shape_in, opts, out: _BatchOutput, newton: bool) -> None:
+    """Solve the cases ``idx`` of the flat inputs into ``out``: Coulomb cases by Newton when
+    ``newton``, the others (falling friction, or all) by the compiled Gauss-Seidel loop."""
+    nx, ny, scale, spin_offset, tol, max_iter, tol_f, max_f, keep, warm = opts
+    coulomb = (flat[10][idx] == 1.0) | (flat[11][idx] * flat[9][idx] == 0.0)
+    by_newton = idx[coulomb] if newton else idx[:0]
+    by_gs = idx[~coulomb] if newton else idx
+    if by_gs.size:
+        m = by_gs.size
+        o_f, o_it, o_err, o_out = (np.empty((m, 4)), np.empty(m, np.int64), np.empty(m),
+                                   np.empty(m, np.int64))  # fmt: skip
+        if keep:
+            f_sub = [np.empty((m, ny, nx)) for _ in range(4)]
+            st_sub = np.empty((m, ny, nx), np.int8)
+            mu_sub = np.empty((m, ny, nx))
+        else:
+            f_sub, st_sub, mu_sub = out.fields, out.state, out.mu_local
+        _solve_hertz_batch(
+            *[np.ascontiguousarray(v[by_gs]) for v in flat], nx, ny, scale, spin_offset, tol,
+            max_iter, tol_f, max_f, o_f, o_it, o_err, o_out, *f_sub, st_sub, mu_sub, keep, warm,
+            shape_in,
+        )  # fmt: skip
+        out.forces[by_gs], out.iterations[by_gs], out.residual[by_gs] = o_f, o_it, o_err
+        out.outer[by_gs] = o_out
+        if keep:
+            for full, part in zip(out.fields, f_sub, strict=True):
+                full[by_gs] = part
+            out.state[by_gs] = st_sub
+            out.mu_local[by_gs] = mu_sub
+    if by_newton.size:
+        _newton_cases(by_newton, flat, shape_in, opts, out)
+
+
+def _interpolate(field, xc, yc, xf, yf):
+    """Bilinear interpolation of ``field`` (ny_c, nx_c) at centres ``xc, yc`` onto ``xf, yf``
+    (constant beyond the outer centres)."""
+    rows = np.array([np.interp(xf, xc, row) for row in field])
+    return np.array([np.interp(yf, yc, col) for col in rows.T]).T
+
+
+def _coarse_start(case, mx, my, scale, spin_offset, nu, xh, yh, operators):
+    """Start (tractions over G, or None) for the case on the (mx, my) grid with element
+    centres ``xh, yh``: the Newton solution on a grid half as fine, itself started the same
+    way, interpolated. This nested iteration of multigrid practice (Briggs, Henson &
+    McCormick, *A Multigrid Tutorial*, 2000, ch. 3) leaves 3-5 Newton steps on the fine grid."""
+    if min(mx, my) < 2 * _COARSE_MIN:
+        return None, None
+    mc, nc = (mx + 1) // 2, (my + 1) // 2
+    xc, yc, shape, ssum = _grid_shape(mc, nc, scale, np.empty((0, 0)))
+    g, wx, wy = np.empty((nc, mc)), np.empty((nc, mc)), np.empty((nc, mc))
+    dx, dy = _case_fields(*case, scale, spin_offset, xc, yc, shape, ssum, g, wx, wy)
+    px, py = _coarse_start(case, mc, nc, scale, spin_offset, nu, xc, yc, operators)
+    op = _operator(mc, nc, dy / dx, nu, operators)
+    sol = solve_steady_rolling(g, wx, wy, op, tol=_COARSE_TOL, px=px, py=py)
+    return _interpolate(sol.px, xc, yc, xh, yh), _interpolate(sol.py, xc, yc, xh, yh)
+
+
+def _operator(mx, my, ratio, nu, operators):
+    """The rolling operator of a grid, built once per call of :func:`exact_rolling`."""
+    key = (mx, my, ratio, nu)
+    if key not in operators:
+        operators[key] = RollingOperator(*_rolling_kernel(mx, my, 1.0, ratio, nu))
+    return operators[key]
+
+
+def _newton_cases(idx, flat, shape_in, opts, out: _BatchOutput) -> None:
+    """Coulomb cases by semismooth Newton (:mod:`railadhesion.contact.rolling_newton`), each
+    started from a coarser grid's solution (so the result does not depend on the order of
+    the cases; a start from the previous case's tractions saves nothing here); a case Newton
+    does not finish in ``_NEWTON_MAX_STEPS`` steps is finished by Gauss-Seidel from Newton's
+    last iterate."""
+    nx, ny, scale, spin_offset, tol, max_iter, _, _, keep, _ = opts
+    xh, yh, shape, ssum = _grid_shape(nx, ny, scale, shape_in)
+    g, wx, wy = np.empty((ny, nx)), np.empty((ny, nx)), np.empty((ny, nx))
+    operators: dict = {}
+    for c in idx:
+        case = tuple(float(v[c]) for v in flat[:8])
+        nu = float(flat[8][c])
+        dx, dy = _case_fields(*case, scale, spin_offset, xh, yh, shape, ssum, g, wx, wy)
+        op = _operator(nx, ny, dy / dx, nu, operators)
+        px, py = _coarse_start(case, nx, ny, scale, spin_offset, nu, xh, yh, operators)
+        sol = solve_steady_rolling(g, wx, wy, op, tol=tol, px=px, py=py,
+                                   max_steps=_NEWTON_MAX_STEPS)  # fmt: skip
+        steps, err = sol.newton_steps, sol.residual
+        if not sol.converged:  # finish by Gauss-Seidel (always convergent) from Newton's iterate
+            kxx, kxy, kyy, spec, dgx, dgy = _case_kernel(nx, ny, dy / dx, nu)
+            sol.px, sol.py = sol.px.copy(), sol.py.copy()
+            sweeps, err = _gauss_seidel(g, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, tol, max_iter,
+                                        sol.px, sol.py, sol.sx, sol.sy, sol.state)  # fmt: skip
+            steps += sweeps
+        else:
+            out.newton[c] = True
+        _case_forces(sol.px, sol.py, sol.state, shape, xh, yh, case[4], case[5], dx, dy,
+                     case[7], out.forces[c])  # fmt: skip
+        out.iterations[c] = steps
+        out.residual[c] = err
+        out.outer[c] = 0
+        if keep:
+            gmod = case[7]
+            out.fields[0][c] = sol.px * gmod
+            out.fields[1][c] = sol.py * gmod
+            out.fields[2][c] = sol.sx
+            out.fields[3][c] = sol.sy
+            out.state[c] = sol.state
+            out.mu_local[c] = np.where(g > 0.0, case[6], 0.0)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -932,9 +1100,11 @@ class ExactResult:
     slip_fraction: np.ndarray
     """Fraction of the contact elements in slip [-]."""
     iterations: np.ndarray
-    """Gauss-Seidel sweeps used."""
+    """Newton steps (semismooth Newton) or sweeps (Gauss-Seidel) used; a case Newton leaves
+    to Gauss-Seidel counts both."""
     residual: np.ndarray
-    """Largest traction change of the last sweep, relative to the largest traction [-]."""
+    """Largest traction change of the last sweep (Gauss-Seidel), or of a local projection
+    step ``p - P_g(p - r s)`` (Newton), relative to the largest traction [-]."""
     x: np.ndarray | None = None
     """Element-centre x [m], shape (nx,) per case: (*shape, nx)."""
     y: np.ndarray | None = None
@@ -956,6 +1126,9 @@ class ExactResult:
     mu_local: np.ndarray | None = None
     """Local coefficient of friction at the final slip velocity, (*shape, ny, nx) (0 outside
     the contact; the static value in stick)."""
+    method: str = "gauss-seidel"
+    """Solver used: ``"newton"`` (semismooth Newton, every case), ``"gauss-seidel"``, or
+    ``"newton+gauss-seidel"`` (falling-friction cases, or a case Newton did not finish)."""
 
 
 def _check_grid(value, name: str) -> int:
@@ -1051,6 +1224,7 @@ def exact_rolling(
     return_fields: bool = False,
     warm_start: bool = False,
     pressure: str = "hertz",
+    method: str = "auto",
 ) -> ExactResult:
     """Creep forces of steady rolling by Kalker's exact theory (half-space, Coulomb friction).
 
@@ -1103,9 +1277,9 @@ def exact_rolling(
         Also return the grid, tractions, pressure, slip, the stick/slip map and the local
         coefficient of friction.
     warm_start : bool, optional
-        Start each case from the tractions of the previous case when the grid is the same
-        (same a/b and nu): fewer sweeps along creep curves. The results then depend on the
-        order of the cases within the tolerance ``tol``. Default False.
+        Gauss-Seidel only: start each case from the tractions of the previous case when the
+        grid is the same (same a/b and nu): fewer sweeps along creep curves. The results then
+        depend on the order of the cases within the tolerance ``tol``. Default False.
     pressure : {"hertz", "discrete"}, optional
         Normal pressure on the grid: Hertz's ellipse at the element centres (default), or the
         solution of the discrete normal problem on the same grid for the quadratic gap of
@@ -1114,6 +1288,13 @@ def exact_rolling(
         (docs/validation/exact_solver.md). The discrete contact area is slightly larger than
         the ellipse: use ``scale >= 1.1`` (CONTACT's examples do). Costs one dense normal
         solve per distinct (a/b, nu), about 0.3-2 s on grids of 30 x 30 to 44 x 44.
+    method : {"auto", "newton", "gauss-seidel"}, optional
+        Solver of the discrete problem (Notes): semismooth Newton (``"newton"``, Coulomb
+        friction only; falling-friction cases go to Gauss-Seidel), element-wise Gauss-Seidel
+        (``"gauss-seidel"``), or ``"auto"`` (default): Newton on grids of
+        ``NEWTON_MIN_ELEMENTS`` (1600, 40 x 40) elements or more, Gauss-Seidel below. Both
+        stop on the same residual and give the same solution within ``tol``; the result's
+        ``method`` says which was used.
 
     Returns
     -------
@@ -1145,9 +1326,19 @@ def exact_rolling(
 
     Convergence: the discretisation error in the forces decreases about as 1/n; see
     ``docs/validation/exact_solver.md`` for a grid-convergence table and the comparison
-    with CONTACT. The influence sums of the Gauss-Seidel sweeps are done by FFT along the
-    grid's columns (the iteration is the same as with direct sums): the cost per sweep grows
-    as nx ny (nx + ny) (docs/exact-solver.md, "Solver: method and cost").
+    with CONTACT.
+
+    Solvers (docs/exact-solver.md, "Solver: method and cost"). *Gauss-Seidel*: element by
+    element from the trailing to the leading edge with the local solution of Coulomb's law;
+    the influence sums by FFT along the grid's columns (the iteration is the same as with
+    direct sums); the sweeps grow with the grid (about 100-300 at 60 x 60), each costing
+    ``nx ny (nx + ny)``. *Semismooth Newton*
+    (:func:`railadhesion.contact.solve_steady_rolling`): Coulomb's law as a
+    projection equation, linearised on the current stick set and slip directions, each
+    linear system solved by GMRES with 2-D FFT products, preconditioned by the summation
+    along the rolling direction; each case starts from the solution on a grid half as fine
+    (nested iteration down to 12 elements), which leaves 3-6 Newton steps. A case Newton
+    does not finish goes on by Gauss-Seidel from Newton's iterate.
 
     Examples
     --------
@@ -1190,13 +1381,16 @@ def exact_rolling(
         mu_all = np.empty((1, 1, 1))
     if pressure not in ("hertz", "discrete"):
         raise ValueError(f"pressure must be 'hertz' or 'discrete', got {pressure!r}")
+    if method not in ("auto", "newton", "gauss-seidel"):
+        raise ValueError(f"method must be 'auto', 'newton' or 'gauss-seidel', got {method!r}")
+    newton = method == "newton" or (method == "auto" and nx * ny >= NEWTON_MIN_ELEMENTS)
+    out = _BatchOutput(out_f, out_iter, out_err, out_outer, fields, state, mu_all,
+                       np.zeros(n, np.bool_))  # fmt: skip
+    opts = (nx, ny, scale, spin_offset, tol, max_iter, tol_friction, max_friction_iter,
+            bool(return_fields), bool(warm_start))  # fmt: skip
     if pressure == "hertz":
         shapes = None
-        _solve_hertz_batch(
-            *flat, nx, ny, scale, spin_offset, tol, max_iter, tol_friction, max_friction_iter,
-            out_f, out_iter, out_err, out_outer, *fields, state, mu_all, return_fields,
-            bool(warm_start), np.empty((0, 0)),
-        )  # fmt: skip
+        _solve_cases(np.arange(n), flat, np.empty((0, 0)), opts, out, newton)
     else:  # one discrete normal solution per (a/b, nu), the cases solved group by group
         aob_all = flat[4] / flat[5]
         keys = np.stack([aob_all, flat[8]], axis=1)
@@ -1206,28 +1400,15 @@ def exact_rolling(
         for k, (aob_k, nu_k) in enumerate(uniq):
             idx = np.flatnonzero(inverse == k)
             shp = _discrete_shape(float(aob_k), float(nu_k), nx, ny, scale)
-            sub = [np.ascontiguousarray(v[idx]) for v in flat]
-            m = idx.size
-            o_f, o_it, o_err, o_out = np.empty((m, 4)), np.empty(m, np.int64), np.empty(m), \
-                np.empty(m, np.int64)  # fmt: skip
+            _solve_cases(idx, flat, shp, opts, out, newton)
             if return_fields:
-                f_sub = [np.empty((m, ny, nx)) for _ in range(4)]
-                st_sub = np.empty((m, ny, nx), np.int8)
-                mu_sub = np.empty((m, ny, nx))
-            else:
-                f_sub, st_sub, mu_sub = fields, state, mu_all
-            _solve_hertz_batch(
-                *sub, nx, ny, scale, spin_offset, tol, max_iter, tol_friction,
-                max_friction_iter, o_f, o_it, o_err, o_out, *f_sub, st_sub, mu_sub,
-                return_fields, bool(warm_start), shp,
-            )  # fmt: skip
-            out_f[idx], out_iter[idx], out_err[idx], out_outer[idx] = o_f, o_it, o_err, o_out
-            if return_fields:
-                for full, part in zip(fields, f_sub, strict=True):
-                    full[idx] = part
-                state[idx] = st_sub
-                mu_all[idx] = mu_sub
                 shapes[idx] = shp
+    if out.newton.all():
+        used = "newton"
+    elif out.newton.any():
+        used = "newton+gauss-seidel"
+    else:
+        used = "gauss-seidel"
 
     def shaped(v):
         v = v.reshape(shape)
@@ -1266,6 +1447,7 @@ def exact_rolling(
         shaped(out_iter),
         shaped(out_err),
         friction_iterations=shaped(out_outer),
+        method=used,
         **extra,
     )
 
