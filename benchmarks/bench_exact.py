@@ -9,9 +9,9 @@ Prints:
   30 x 30 and 60 x 60 elements, for CONTACT's ``fastsim`` example (a/b = 2, lateral creepage
   and spin, partial slip), a longitudinal creepage on a circular contact, and a long
   (a/b = 0.3) and a wide (a/b = 3) contact with lateral creepage and spin: with Coulomb
-  friction by both solvers (``method="gauss-seidel"`` and ``"newton"``, taken in turns, with
-  the ratio of their times), and with falling friction (Polach's dry law at 30 m/s; the
-  Gauss-Seidel solver), plus the iterations (sweeps or Newton steps, and friction updates).
+  and with falling friction (Polach's dry law at 30 m/s), by both solvers
+  (``method="gauss-seidel"`` and ``"newton"``, taken in turns, with the ratio of their
+  times), plus the iterations (sweeps or Newton steps, and friction updates).
   CONTACT (Fortran) needs about 26 ms and 0.6 s per case at these sizes (issue 12);
 * the table model's cost per contact, vectorised over 100 000 and 1 000 000 contacts with
   spin, beside the package's vectorised Polach on the same inputs in the same run (issue 22
@@ -62,44 +62,34 @@ METHODS = ("gauss-seidel", "newton")
 
 
 def bench_solver(repeat: int) -> None:
-    """Time per case of both solvers, taken in turns (Coulomb), and of Gauss-Seidel with
-    falling friction (Newton does Coulomb only); ratio = Gauss-Seidel / Newton, the median of
-    the per-repeat ratios."""
+    """Time per case of both solvers, taken in turns, with Coulomb and with falling friction;
+    ratio = Gauss-Seidel / Newton, the median of the per-repeat ratios."""
     for m in METHODS:  # compile / load the caches
         exact_rolling(*CASES["circle, xi = 1e-3"], nx=24, ny=24, method=m)
-    exact_rolling(*CASES["circle, xi = 1e-3"], nx=8, ny=8, **FALLING)
+        exact_rolling(*CASES["circle, xi = 1e-3"], nx=24, ny=24, method=m, **FALLING)
     print(f"{'case':<36} {'friction':<9} {'grid':>7} {'method':<13} {'median [s]':>11} "
           f"{'min [s]':>9} {'iter.':>6} {'updates':>8} {'GS/Newton':>10}")  # fmt: skip
     for name, case in CASES.items():
-        for n in (30, 60):
-            times: dict = {m: [] for m in METHODS}
-            res = {}
-            for _ in range(repeat):
-                for m in METHODS:
-                    t0 = time.perf_counter()
-                    res[m] = exact_rolling(*case, nx=n, ny=n, method=m)
-                    times[m].append(time.perf_counter() - t0)
-            ratio = statistics.median(
-                g / w for g, w in zip(times["gauss-seidel"], times["newton"], strict=True)
-            )
-            for m in METHODS:
-                r = res[m]
-                print(
-                    f"{name:<36} {'Coulomb':<9} {n:>3}x{n:<3} {m:<13} "
-                    f"{statistics.median(times[m]):>11.3f} {min(times[m]):>9.3f} "
-                    f"{int(r.iterations):>6} {0:>8} "
-                    + (f"{ratio:>10.1f}" if m == "newton" else "")
+        for law_name, law in (("Coulomb", {}), ("falling", FALLING)):
+            for n in (30, 60):
+                times: dict = {m: [] for m in METHODS}
+                res = {}
+                for _ in range(repeat):
+                    for m in METHODS:
+                        t0 = time.perf_counter()
+                        res[m] = exact_rolling(*case, nx=n, ny=n, method=m, **law)
+                        times[m].append(time.perf_counter() - t0)
+                ratio = statistics.median(
+                    g / w for g, w in zip(times["gauss-seidel"], times["newton"], strict=True)
                 )
-            times_f = []
-            for _ in range(repeat):
-                t0 = time.perf_counter()
-                r = exact_rolling(*case, nx=n, ny=n, **FALLING)
-                times_f.append(time.perf_counter() - t0)
-            print(
-                f"{name:<36} {'falling':<9} {n:>3}x{n:<3} {r.method:<13} "
-                f"{statistics.median(times_f):>11.3f} {min(times_f):>9.3f} "
-                f"{int(r.iterations):>6} {int(r.friction_iterations):>8}"
-            )
+                for m in METHODS:
+                    r = res[m]
+                    print(
+                        f"{name:<36} {law_name:<9} {n:>3}x{n:<3} {m:<13} "
+                        f"{statistics.median(times[m]):>11.3f} {min(times[m]):>9.3f} "
+                        f"{int(r.iterations):>6} {int(r.friction_iterations):>8} "
+                        + (f"{ratio:>10.1f}" if m == "newton" else "")
+                    )
 
 
 #: The cases of ``--before``: (name, case, friction law, grid)

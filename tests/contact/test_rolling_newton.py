@@ -206,18 +206,45 @@ def test_unfinished_newton_is_finished_by_gauss_seidel(monkeypatch):
 
 
 @ANY_INPUT
-def test_auto_method_by_grid_and_friction_law():
+def test_auto_method_by_grid():
     case = HARD["circle"]
     assert exact_rolling(*case, nx=30, ny=30).method == "gauss-seidel"
     assert exact_rolling(*case, nx=40, ny=40).method == "newton"
     falling = dict(speed=20.0, friction_ratio=0.4, friction_decay=0.6)
-    assert exact_rolling(*case, nx=40, ny=40, **falling).method == "gauss-seidel"
-    mixed = exact_rolling(*case, nx=40, ny=40, speed=20.0, friction_ratio=[1.0, 0.4],
-                          friction_decay=0.6)  # fmt: skip
-    assert mixed.method == "newton+gauss-seidel"
-    # the falling case of the batch is the one solved alone
-    alone = exact_rolling(*case, nx=40, ny=40, **falling)
-    assert float(mixed.fx[1]) == float(alone.fx)
+    assert exact_rolling(*case, nx=30, ny=30, **falling).method == "gauss-seidel"
+    assert exact_rolling(*case, nx=40, ny=40, **falling).method == "newton"
+
+
+@ANY_INPUT
+@pytest.mark.parametrize("name", ["fastsim", "wide"])
+def test_falling_friction_same_solution_by_both(name):
+    """The outer iteration on the slip velocity around either solver: same forces, same
+    number of friction updates, the law holding in the solution."""
+    case = HARD[name]
+    law = dict(speed=30.0, friction_ratio=0.4, friction_decay=0.6)
+    gs = exact_rolling(*case, nx=24, ny=24, method="gauss-seidel", return_fields=True, **law)
+    nw = exact_rolling(*case, nx=24, ny=24, method="newton", return_fields=True, **law)
+    assert nw.method == "newton" and gs.method == "gauss-seidel"
+    assert int(nw.friction_iterations) == int(gs.friction_iterations) >= 2
+    for f in ("fx", "fy"):
+        assert abs(float(getattr(gs, f) - getattr(nw, f))) <= 1e-6 * _mu_q(case)
+    slip = nw.state == 2
+    w = 30.0 * np.hypot(nw.sx, nw.sy)
+    mu_w = case[6] * (0.6 * np.exp(-0.6 * w) + 0.4)
+    np.testing.assert_allclose(np.hypot(nw.px, nw.py)[slip], (mu_w * nw.pn)[slip], rtol=2e-3)
+
+
+@ANY_INPUT
+def test_mixed_batch_equals_cases_alone():
+    case = HARD["circle"]
+    falling = dict(speed=20.0, friction_ratio=0.4, friction_decay=0.6)
+    for method in ("gauss-seidel", "newton"):
+        mixed = exact_rolling(*case, nx=24, ny=24, speed=20.0, friction_ratio=[1.0, 0.4],
+                              friction_decay=0.6, method=method)  # fmt: skip
+        alone = exact_rolling(*case, nx=24, ny=24, method=method, **falling)
+        coulomb = exact_rolling(*case, nx=24, ny=24, method=method)
+        assert float(mixed.fx[1]) == float(alone.fx)
+        assert float(mixed.fx[0]) == float(coulomb.fx)
 
 
 def test_bad_method_names_the_argument():

@@ -713,26 +713,23 @@ def _column_update(scx, scy, k0xx, k0xy, k0yy, iy, my, dpx, dpy):
         scy[jy] += k0xy[d] * dpx + k0yy[d] * dpy
 
 
-@jit(error_model="python")
-def _solve_falling_friction(
-    g0, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, tol, max_iter, px, py, sx, sy, state, mu_fac,
-    speed, ratio, decay, tol_outer, max_outer,
-):  # fmt: skip
+def _falling_friction(g0, inner, speed, ratio, decay, tol_outer, max_outer, sx, sy, mu_fac):
     """Steady rolling with slip-velocity dependent friction: outer fixed-point iteration.
 
     ``g0`` is the traction bound at zero slip (mu0 p_n / G). The local coefficient of
     friction ``mu_fac * mu0`` of every element is frozen at the estimate ``v`` of its slip
-    velocity, the Coulomb problem with that bound is solved by :func:`_gauss_seidel` (warm
-    started from the previous tractions), and the estimate is updated from the new slip,
+    velocity, the Coulomb problem with that bound is solved by ``inner(g)`` (either solver,
+    started from the previous tractions; it returns (iterations, residual) and leaves the
+    slip in ``sx, sy``), and the estimate is updated from the new slip,
     ``v <- v + omega (V |s| - v)``, starting from ``v = 0`` (static friction everywhere,
     "slip from below"). The relaxation ``omega`` starts at 1 and is halved whenever the
     update grows (down to 1/16). Stops when ``||V|s| - v||_2 <= tol_outer ||V|s|||_2``.
-    Returns (total sweeps, last inner residual, outer iterations, last outer change).
+    ``mu_fac`` receives the factor at the final slip. Returns (total inner iterations, last
+    inner residual, outer iterations, last outer change).
     """
-    my, mx = g0.shape
-    vel = np.zeros((my, mx))  # slip-velocity estimate [m/s]
-    g = np.empty((my, mx))
-    sweeps = 0
+    vel = np.zeros(g0.shape)  # slip-velocity estimate [m/s]
+    g = np.empty(g0.shape)
+    iterations = 0
     err = 0.0
     omega = 1.0
     last = np.inf
@@ -740,46 +737,61 @@ def _solve_falling_friction(
     outer = 0
     for _ in range(max_outer):
         outer += 1
-        for j in range(my):
-            for i in range(mx):
-                mu_fac[j, i] = falling_friction_factor(vel[j, i], ratio, decay)
-                g[j, i] = g0[j, i] * mu_fac[j, i]
-        it, err = _gauss_seidel(g, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, tol, max_iter, px, py,
-                                sx, sy,
-                                state)  # fmt: skip
-        sweeps += it
-        dnorm = 0.0
-        snorm = 0.0
-        for j in range(my):
-            for i in range(mx):
-                if g0[j, i] <= 0.0:
-                    continue
-                v_new = speed * math.sqrt(sx[j, i] ** 2 + sy[j, i] ** 2)
-                d = v_new - vel[j, i]
-                dnorm += d * d
-                snorm += v_new * v_new
-        dnorm = math.sqrt(dnorm)
-        snorm = math.sqrt(snorm)
+        _friction_factors(g0, vel, ratio, decay, mu_fac, g)
+        it, err = inner(g)
+        iterations += it
+        dnorm, snorm = _slip_velocity_change(g0, sx, sy, speed, vel)
         change = dnorm / snorm if snorm > 0.0 else 0.0
         if dnorm <= tol_outer * snorm:
             break
         if dnorm > last and omega > 1.0 / 16.0:
             omega *= 0.5
         last = dnorm
-        for j in range(my):
-            for i in range(mx):
-                if g0[j, i] > 0.0:
-                    v_new = speed * math.sqrt(sx[j, i] ** 2 + sy[j, i] ** 2)
-                    vel[j, i] += omega * (v_new - vel[j, i])
+        _relax_slip_velocity(g0, sx, sy, speed, omega, vel)
     # the friction coefficient consistent with the final slip
+    vel[:] = speed * np.hypot(sx, sy)
+    _friction_factors(g0, vel, ratio, decay, mu_fac, g)
+    mu_fac[g0 <= 0.0] = 0.0
+    return iterations, err, outer, change
+
+
+@jit(error_model="python")
+def _friction_factors(g0, vel, ratio, decay, mu_fac, g):
+    """``mu_fac = mu(v)/mu0`` (:func:`falling_friction_factor`) and the bound ``g = g0 mu_fac``
+    of every element at the slip velocities ``vel``."""
+    my, mx = g0.shape
+    for j in range(my):
+        for i in range(mx):
+            mu_fac[j, i] = falling_friction_factor(vel[j, i], ratio, decay)
+            g[j, i] = g0[j, i] * mu_fac[j, i]
+
+
+@jit(error_model="python")
+def _slip_velocity_change(g0, sx, sy, speed, vel):
+    """``(||V|s| - v||_2, ||V|s|||_2)`` over the contact elements."""
+    my, mx = g0.shape
+    dnorm = 0.0
+    snorm = 0.0
+    for j in range(my):
+        for i in range(mx):
+            if g0[j, i] <= 0.0:
+                continue
+            v_new = speed * math.sqrt(sx[j, i] ** 2 + sy[j, i] ** 2)
+            d = v_new - vel[j, i]
+            dnorm += d * d
+            snorm += v_new * v_new
+    return math.sqrt(dnorm), math.sqrt(snorm)
+
+
+@jit(error_model="python")
+def _relax_slip_velocity(g0, sx, sy, speed, omega, vel):
+    """``v <- v + omega (V |s| - v)`` on the contact elements."""
+    my, mx = g0.shape
     for j in range(my):
         for i in range(mx):
             if g0[j, i] > 0.0:
-                w = speed * math.hypot(sx[j, i], sy[j, i])
-                mu_fac[j, i] = falling_friction_factor(w, ratio, decay)
-            else:
-                mu_fac[j, i] = 0.0
-    return sweeps, err, outer, change
+                v_new = speed * math.sqrt(sx[j, i] ** 2 + sy[j, i] ** 2)
+                vel[j, i] += omega * (v_new - vel[j, i])
 
 
 @jit(error_model="python")
@@ -866,18 +878,35 @@ def _case_kernel(mx, my, ratio, nu):
 
 
 @jit(error_model="python")
+def _start_tractions(px, py, g, restart):
+    """Start of a case: zero tractions (``restart``), or the previous case's scaled into the
+    new traction bound ``g`` (a warm start)."""
+    my, mx = g.shape
+    for j in range(my):
+        for i in range(mx):
+            if restart:
+                px[j, i] = 0.0
+                py[j, i] = 0.0
+            else:
+                pt = math.sqrt(px[j, i] ** 2 + py[j, i] ** 2)
+                if pt > g[j, i]:
+                    f = g[j, i] / pt
+                    px[j, i] *= f
+                    py[j, i] *= f
+
+
+@jit(error_model="python")
 def _solve_hertz_batch(
-    xi, eta, phi, fz, a, b, mu, gmod, nu, speed, fratio, decay, mx, my, scale, spin_offset, tol,
-    max_iter, tol_outer, max_outer, out_f, out_iter, out_err, out_outer, px_all, py_all, sx_all,
-    sy_all, state_all, mu_all, keep_fields, warm, shape_in,
+    xi, eta, phi, fz, a, b, mu, gmod, nu, mx, my, scale, spin_offset, tol, max_iter, out_f,
+    out_iter, out_err, px_all, py_all, sx_all, sy_all, state_all, mu_all, keep_fields, warm,
+    shape_in,
 ):  # fmt: skip
-    """Loop over cases by Gauss-Seidel: pressure on the grid, kernel (reused when unchanged),
-    solve.
+    """Loop over Coulomb cases by Gauss-Seidel: pressure on the grid, kernel (reused when
+    unchanged), solve.
 
     ``shape_in`` (my, mx): the pressure distribution to use (any scale), or an empty array for
     Hertz's at the element centres."""
     n = xi.size
-    mu_fac = np.ones((my, mx))
     px = np.zeros((my, mx))
     py = np.zeros((my, mx))
     sx = np.zeros((my, mx))
@@ -901,34 +930,13 @@ def _solve_hertz_batch(
             last_nu = nu[c]
         elif warm:
             restart = False  # start from the previous case's tractions (same kernel)
-        for j in range(my):
-            for i in range(mx):
-                if restart:
-                    px[j, i] = 0.0
-                    py[j, i] = 0.0
-                else:  # previous tractions, scaled into the new traction bound
-                    pt = math.sqrt(px[j, i] ** 2 + py[j, i] ** 2)
-                    if pt > g[j, i]:
-                        f = g[j, i] / pt
-                        px[j, i] *= f
-                        py[j, i] *= f
-        if fratio[c] == 1.0 or decay[c] * speed[c] == 0.0:  # Coulomb
-            it, err = _gauss_seidel(
-                g, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, tol, max_iter, px, py, sx, sy, st
-            )
-            outer = 0
-            for j in range(my):
-                for i in range(mx):
-                    mu_fac[j, i] = 1.0 if g[j, i] > 0.0 else 0.0
-        else:
-            it, err, outer, _ = _solve_falling_friction(
-                g, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, tol, max_iter, px, py, sx, sy, st, mu_fac,
-                speed[c], fratio[c], decay[c], tol_outer, max_outer,
-            )  # fmt: skip
+        _start_tractions(px, py, g, restart)
+        it, err = _gauss_seidel(
+            g, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, tol, max_iter, px, py, sx, sy, st
+        )
         _case_forces(px, py, st, shape, xh, yh, a[c], b[c], dx, dy, gmod[c], out_f[c])
         out_iter[c] = it
         out_err[c] = err
-        out_outer[c] = outer
         if keep_fields:
             for j in range(my):
                 for i in range(mx):
@@ -937,7 +945,7 @@ def _solve_hertz_batch(
                     sx_all[c, j, i] = sx[j, i]
                     sy_all[c, j, i] = sy[j, i]
                     state_all[c, j, i] = st[j, i]
-                    mu_all[c, j, i] = mu_fac[j, i] * mu[c]
+                    mu_all[c, j, i] = mu[c] if g[j, i] > 0.0 else 0.0
 
 
 # ---------------------------------------------------------------------------------------------
@@ -952,7 +960,7 @@ NEWTON_MIN_ELEMENTS = 1600
 _COARSE_TOL = 1e-2
 #: Coarser grids are not used below this many elements along either axis.
 _COARSE_MIN = 12
-#: Newton steps allowed before a case is handed to Gauss-Seidel (3-6 are typical).
+#: Newton steps allowed before a solve is handed to Gauss-Seidel (3-6 are typical).
 _NEWTON_MAX_STEPS = 60
 
 
@@ -969,16 +977,15 @@ class _BatchOutput:
 
 
 def _solve_cases(idx, flat, shape_in, opts, out: _BatchOutput, newton: bool) -> None:
-    """Solve the cases ``idx`` of the flat inputs into ``out``: Coulomb cases by Newton when
-    ``newton``, the others (falling friction, or all) by the compiled Gauss-Seidel loop."""
+    """Solve the cases ``idx`` of the flat inputs into ``out``: Coulomb cases by the compiled
+    Gauss-Seidel loop, or by Newton when ``newton``; falling-friction cases one by one, the
+    outer iteration on the slip velocity around either solver."""
     nx, ny, scale, spin_offset, tol, max_iter, tol_f, max_f, keep, warm = opts
     coulomb = (flat[10][idx] == 1.0) | (flat[11][idx] * flat[9][idx] == 0.0)
-    by_newton = idx[coulomb] if newton else idx[:0]
-    by_gs = idx[~coulomb] if newton else idx
-    if by_gs.size:
-        m = by_gs.size
-        o_f, o_it, o_err, o_out = (np.empty((m, 4)), np.empty(m, np.int64), np.empty(m),
-                                   np.empty(m, np.int64))  # fmt: skip
+    by_loop = idx[:0] if newton else idx[coulomb]
+    if by_loop.size:
+        m = by_loop.size
+        o_f, o_it, o_err = np.empty((m, 4)), np.empty(m, np.int64), np.empty(m)
         if keep:
             f_sub = [np.empty((m, ny, nx)) for _ in range(4)]
             st_sub = np.empty((m, ny, nx), np.int8)
@@ -986,19 +993,19 @@ def _solve_cases(idx, flat, shape_in, opts, out: _BatchOutput, newton: bool) -> 
         else:
             f_sub, st_sub, mu_sub = out.fields, out.state, out.mu_local
         _solve_hertz_batch(
-            *[np.ascontiguousarray(v[by_gs]) for v in flat], nx, ny, scale, spin_offset, tol,
-            max_iter, tol_f, max_f, o_f, o_it, o_err, o_out, *f_sub, st_sub, mu_sub, keep, warm,
-            shape_in,
+            *[np.ascontiguousarray(v[by_loop]) for v in flat[:9]], nx, ny, scale, spin_offset,
+            tol, max_iter, o_f, o_it, o_err, *f_sub, st_sub, mu_sub, keep, warm, shape_in,
         )  # fmt: skip
-        out.forces[by_gs], out.iterations[by_gs], out.residual[by_gs] = o_f, o_it, o_err
-        out.outer[by_gs] = o_out
+        out.forces[by_loop], out.iterations[by_loop], out.residual[by_loop] = o_f, o_it, o_err
+        out.outer[by_loop] = 0
         if keep:
             for full, part in zip(out.fields, f_sub, strict=True):
-                full[by_gs] = part
-            out.state[by_gs] = st_sub
-            out.mu_local[by_gs] = mu_sub
-    if by_newton.size:
-        _newton_cases(by_newton, flat, shape_in, opts, out)
+                full[by_loop] = part
+            out.state[by_loop] = st_sub
+            out.mu_local[by_loop] = mu_sub
+    rest = idx[~coulomb] if not newton else idx
+    if rest.size:
+        _solve_one_by_one(rest, flat, shape_in, opts, out, newton)
 
 
 def _interpolate(field, xc, yc, xf, yf):
@@ -1033,46 +1040,77 @@ def _operator(mx, my, ratio, nu, operators):
     return operators[key]
 
 
-def _newton_cases(idx, flat, shape_in, opts, out: _BatchOutput) -> None:
-    """Coulomb cases by semismooth Newton (:mod:`railadhesion.contact.rolling_newton`), each
-    started from a coarser grid's solution (so the result does not depend on the order of
-    the cases; a start from the previous case's tractions saves nothing here); a case Newton
-    does not finish in ``_NEWTON_MAX_STEPS`` steps is finished by Gauss-Seidel from Newton's
-    last iterate."""
-    nx, ny, scale, spin_offset, tol, max_iter, _, _, keep, _ = opts
+def _solve_one_by_one(idx, flat, shape_in, opts, out: _BatchOutput, newton: bool) -> None:
+    """The cases ``idx`` one by one, Coulomb or falling friction
+    (:func:`_falling_friction` around the Coulomb solver), by Gauss-Seidel or by semismooth
+    Newton (:mod:`railadhesion.contact.rolling_newton`).
+
+    Newton starts each case from a coarser grid's solution (:func:`_coarse_start`; so the
+    result does not depend on the order of the cases, and a start from the previous case's
+    tractions saves nothing here), each friction update from the previous tractions; a solve
+    Newton does not finish in ``_NEWTON_MAX_STEPS`` steps is finished by Gauss-Seidel from
+    Newton's last iterate (the case then counts as solved by Gauss-Seidel). Gauss-Seidel
+    starts from zero, or with ``warm`` from the previous case's tractions on the same grid."""
+    nx, ny, scale, spin_offset, tol, max_iter, tol_f, max_f, keep, warm = opts
     xh, yh, shape, ssum = _grid_shape(nx, ny, scale, shape_in)
-    g, wx, wy = np.empty((ny, nx)), np.empty((ny, nx)), np.empty((ny, nx))
+    g0, wx, wy = np.empty((ny, nx)), np.empty((ny, nx)), np.empty((ny, nx))
+    px, py, sx, sy = (np.zeros((ny, nx)) for _ in range(4))
+    st = np.zeros((ny, nx), np.int8)
+    mu_fac = np.ones((ny, nx))
     operators: dict = {}
+    kernels: dict = {}
+    last_key = None
     for c in idx:
         case = tuple(float(v[c]) for v in flat[:8])
-        nu = float(flat[8][c])
-        dx, dy = _case_fields(*case, scale, spin_offset, xh, yh, shape, ssum, g, wx, wy)
-        op = _operator(nx, ny, dy / dx, nu, operators)
-        px, py = _coarse_start(case, nx, ny, scale, spin_offset, nu, xh, yh, operators)
-        sol = solve_steady_rolling(g, wx, wy, op, tol=tol, px=px, py=py,
-                                   max_steps=_NEWTON_MAX_STEPS)  # fmt: skip
-        steps, err = sol.newton_steps, sol.residual
-        if not sol.converged:  # finish by Gauss-Seidel (always convergent) from Newton's iterate
-            kxx, kxy, kyy, spec, dgx, dgy = _case_kernel(nx, ny, dy / dx, nu)
-            sol.px, sol.py = sol.px.copy(), sol.py.copy()
-            sweeps, err = _gauss_seidel(g, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, tol, max_iter,
-                                        sol.px, sol.py, sol.sx, sol.sy, sol.state)  # fmt: skip
-            steps += sweeps
+        nu, speed, ratio, decay = (float(flat[k][c]) for k in (8, 9, 10, 11))
+        dx, dy = _case_fields(*case, scale, spin_offset, xh, yh, shape, ssum, g0, wx, wy)
+        key = (dy / dx, nu)
+        if key not in kernels:
+            kernels[key] = _case_kernel(nx, ny, key[0], nu)
+        kernel = kernels[key]
+        finished_by_newton = newton
+        if newton:
+            op = _operator(nx, ny, key[0], nu, operators)
+            start = _coarse_start(case, nx, ny, scale, spin_offset, nu, xh, yh, operators)
+            _start_tractions(px, py, g0, True)
+            if start[0] is not None:
+                px[:], py[:] = start
         else:
-            out.newton[c] = True
-        _case_forces(sol.px, sol.py, sol.state, shape, xh, yh, case[4], case[5], dx, dy,
-                     case[7], out.forces[c])  # fmt: skip
-        out.iterations[c] = steps
+            _start_tractions(px, py, g0, not (warm and key == last_key))
+        last_key = key
+
+        def inner(g, op=op if newton else None, kernel=kernel):
+            nonlocal finished_by_newton
+            if op is None:
+                return _gauss_seidel(g, wx, wy, *kernel, tol, max_iter, px, py, sx, sy, st)
+            sol = solve_steady_rolling(g, wx, wy, op, tol=tol, px=px, py=py,
+                                       max_steps=_NEWTON_MAX_STEPS)  # fmt: skip
+            px[:], py[:], sx[:], sy[:], st[:] = sol.px, sol.py, sol.sx, sol.sy, sol.state
+            if sol.converged:
+                return sol.newton_steps, sol.residual
+            finished_by_newton = False  # Gauss-Seidel (always convergent) from Newton's iterate
+            sweeps, err = _gauss_seidel(g, wx, wy, *kernel, tol, max_iter, px, py, sx, sy, st)
+            return sol.newton_steps + sweeps, err
+
+        if ratio == 1.0 or decay * speed == 0.0:  # Coulomb
+            it, err = inner(g0)
+            outer = 0
+            mu_fac[:] = g0 > 0.0
+        else:
+            it, err, outer, _ = _falling_friction(g0, inner, speed, ratio, decay, tol_f, max_f,
+                                                  sx, sy, mu_fac)  # fmt: skip
+        out.newton[c] = finished_by_newton
+        _case_forces(px, py, st, shape, xh, yh, case[4], case[5], dx, dy, case[7], out.forces[c])
+        out.iterations[c] = it
         out.residual[c] = err
-        out.outer[c] = 0
+        out.outer[c] = outer
         if keep:
-            gmod = case[7]
-            out.fields[0][c] = sol.px * gmod
-            out.fields[1][c] = sol.py * gmod
-            out.fields[2][c] = sol.sx
-            out.fields[3][c] = sol.sy
-            out.state[c] = sol.state
-            out.mu_local[c] = np.where(g > 0.0, case[6], 0.0)
+            out.fields[0][c] = px * case[7]
+            out.fields[1][c] = py * case[7]
+            out.fields[2][c] = sx
+            out.fields[3][c] = sy
+            out.state[c] = st
+            out.mu_local[c] = mu_fac * case[6]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1128,7 +1166,8 @@ class ExactResult:
     the contact; the static value in stick)."""
     method: str = "gauss-seidel"
     """Solver used: ``"newton"`` (semismooth Newton, every case), ``"gauss-seidel"``, or
-    ``"newton+gauss-seidel"`` (falling-friction cases, or a case Newton did not finish)."""
+    ``"newton+gauss-seidel"`` (some cases by each: a case Newton did not finish counts as
+    Gauss-Seidel's)."""
 
 
 def _check_grid(value, name: str) -> int:
@@ -1289,12 +1328,13 @@ def exact_rolling(
         the ellipse: use ``scale >= 1.1`` (CONTACT's examples do). Costs one dense normal
         solve per distinct (a/b, nu), about 0.3-2 s on grids of 30 x 30 to 44 x 44.
     method : {"auto", "newton", "gauss-seidel"}, optional
-        Solver of the discrete problem (Notes): semismooth Newton (``"newton"``, Coulomb
-        friction only; falling-friction cases go to Gauss-Seidel), element-wise Gauss-Seidel
-        (``"gauss-seidel"``), or ``"auto"`` (default): Newton on grids of
+        Solver of the discrete problem (Notes): semismooth Newton (``"newton"``),
+        element-wise Gauss-Seidel (``"gauss-seidel"``), or ``"auto"`` (default): Newton on
+        grids of
         ``NEWTON_MIN_ELEMENTS`` (1600, 40 x 40) elements or more, Gauss-Seidel below. Both
-        stop on the same residual and give the same solution within ``tol``; the result's
-        ``method`` says which was used.
+        stop on the same residual and give the same solution within ``tol``, with Coulomb or
+        falling friction (the outer iteration on the slip velocity is the same around
+        either); the result's ``method`` says which was used.
 
     Returns
     -------
@@ -1337,8 +1377,9 @@ def exact_rolling(
     projection equation, linearised on the current stick set and slip directions, each
     linear system solved by GMRES with 2-D FFT products, preconditioned by the summation
     along the rolling direction; each case starts from the solution on a grid half as fine
-    (nested iteration down to 12 elements), which leaves 3-6 Newton steps. A case Newton
-    does not finish goes on by Gauss-Seidel from Newton's iterate.
+    (nested iteration down to 12 elements), which leaves 3-6 Newton steps, each friction
+    update from the previous tractions. A solve Newton does not finish goes on by
+    Gauss-Seidel from Newton's iterate.
 
     Examples
     --------
@@ -1529,17 +1570,17 @@ def solve_tangential(
     contact = pn > 0.0
     gb[~contact] = 0.0
     mu_fac = np.ones((ny, nx))
+
+    def inner(bound):
+        return _gauss_seidel(bound, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, float(tol),
+                             int(max_iter), px, py, sx, sy, st)  # fmt: skip
+
     if ratio == 1.0 or decay * v == 0.0:
-        it, err = _gauss_seidel(
-            gb, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, float(tol), int(max_iter), px, py, sx, sy,
-            st,
-        )  # fmt: skip
+        it, err = inner(gb)
         outer = 0
     else:
-        it, err, outer, _ = _solve_falling_friction(
-            gb, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, float(tol), int(max_iter), px, py, sx, sy,
-            st, mu_fac, v, ratio, decay, tol_friction, max_friction_iter,
-        )  # fmt: skip
+        it, err, outer, _ = _falling_friction(gb, inner, v, ratio, decay, tol_friction,
+                                              max_friction_iter, sx, sy, mu_fac)  # fmt: skip
     st[~contact] = _EXTERIOR
     mu_fac[~contact] = 0.0
     da = dx_ * dy_
