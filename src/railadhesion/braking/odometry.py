@@ -90,12 +90,9 @@ import math
 import numpy as np
 from numba import njit
 
+from railadhesion._validate import check_number
 from railadhesion.braking.vehicle import GRAVITY
-from railadhesion.io.settings_table import (
-    check_number,
-    settings_spec,
-    sourced_settings,
-)
+from railadhesion.io.settings_table import settings_spec, sourced_settings
 
 __all__ = [
     "MAX_AXLES",
@@ -164,7 +161,7 @@ class OdometrySettings:
     def __post_init__(self):
         for name, (_, low, high, unit, _) in _SPEC.items():
             value = getattr(self, name)
-            check_number(name, value, low, high, unit)
+            check_number(value, name, low, high, unit=unit)
             object.__setattr__(self, name, float(value))
         if self.accel_range <= 0.0:
             raise ValueError(f"accel_range must be in (0, 1000] m/s², got {self.accel_range!r}")

@@ -69,12 +69,9 @@ import warnings
 import numpy as np
 from numba import njit
 
+from railadhesion._validate import check_number
 from railadhesion.braking.cylinders import APPLY, HOLD, VENT
-from railadhesion.io.settings_table import (
-    check_number,
-    settings_spec,
-    sourced_settings,
-)
+from railadhesion.io.settings_table import settings_spec, sourced_settings
 from railadhesion.plausibility import check_plausible
 
 __all__ = ["WSPSettings", "WheelSlideProtection", "as_controller", "call_controller",
@@ -666,7 +663,8 @@ class WSPSettings:
                     raise ValueError(f"watchdog_cutout_trips must be an integer in [1, 1000], "
                                      f"got {value!r}")
             elif value is not None or _SPEC[name][0] is not None:
-                check_number(name, value, *_SPEC[name][1:4])
+                _, low, high, unit, _ = _SPEC[name]
+                check_number(value, name, low, high, unit=unit)
         if not self.reapply_slip_ratio <= self.hold_slip_ratio <= self.vent_slip_ratio:
             raise ValueError("slip ratios must satisfy reapply_slip_ratio <= hold_slip_ratio "
                              "<= vent_slip_ratio, got "
@@ -744,7 +742,8 @@ class WheelSlideProtection:
         if radius is None:
             raise ValueError("the WSP needs the nominal wheel radius: give wheel_radius, or "
                              "call configure(vehicle) or reset(n_axles, wheel_radius) first")
-        check_number("wheel_radius", float(radius), *_SPEC["wheel_radius"][1:4])
+        _, low, high, unit, _ = _SPEC["wheel_radius"]
+        check_number(float(radius), "wheel_radius", low, high, unit=unit)
         rec = np.zeros(1, SETTINGS_DTYPE)
         r = rec[0]
         for name in SETTINGS_DTYPE.names:

@@ -13,7 +13,6 @@ default is written once.
 
 from __future__ import annotations
 
-import math
 import tomllib
 from dataclasses import dataclass, fields
 from importlib import resources
@@ -23,7 +22,6 @@ __all__ = [
     "settings_spec",
     "settings_dataclass",
     "sourced_settings",
-    "check_number",
 ]
 
 
@@ -66,15 +64,6 @@ def settings_dataclass(defaults: dict, types: dict | None = None):
         return dataclass(frozen=True)(cls)
 
     return make
-
-
-def check_number(name: str, value, low, high, unit: str) -> None:
-    """Raise ``ValueError`` naming the setting unless ``value`` is a finite number (not a
-    bool) in ``[low, high]`` (unit ``unit``)."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    if not low <= value <= high:
-        raise ValueError(f"{name} must be in [{low:g}, {high:g}] {unit}, got {value!r}")
 
 
 def sourced_settings(spec: dict, types: dict | None = None):

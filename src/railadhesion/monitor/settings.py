@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses
 import math
 
+from railadhesion._validate import check_number
 from railadhesion.io.settings_table import read_settings_table, settings_dataclass
 
 __all__ = ["MonitorSettings", "RSSB_BRAKING_ADHESION", "BRAKE_COEFFICIENT_SOURCES", "SHAPE_CHOICES",
@@ -170,14 +171,9 @@ class MonitorSettings:
     def __post_init__(self):
         for name, (low, high, low_open, high_open) in _RANGES.items():
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int | float):
-                raise ValueError(f"{name} must be a number, got {value!r}")
+            check_number(value, name, low, high, low_open=low_open, high_open=high_open,
+                         finite_message=False)
             x = float(value)
-            ok = (x > low if low_open else x >= low) and (x < high if high_open else x <= high)
-            if not (math.isfinite(x) and ok):
-                lb = "(" if low_open else "["
-                rb = ")" if high_open else "]"
-                raise ValueError(f"{name} must be in {lb}{low:g}, {high:g}{rb}, got {value!r}")
             if name == "change_blocks":
                 if int(x) != x:
                     raise ValueError(f"change_blocks must be a whole number, got {value!r}")
