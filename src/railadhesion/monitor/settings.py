@@ -164,7 +164,7 @@ class MonitorSettings:
         way).
     """
 
-    threshold: float = 0.14
+    threshold: float = RSSB_BRAKING_ADHESION
     confidence: float = 0.95
     sample_period: float = 0.0024
     block_time: float = 0.1
