@@ -7,6 +7,8 @@ scalars, for models called inside ODE right-hand sides.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 __all__ = [
@@ -16,6 +18,7 @@ __all__ = [
     "check_nonnegative",
     "check_range",
     "check_choice",
+    "check_number",
 ]
 
 
@@ -79,6 +82,35 @@ def check_choice(value: str, name: str, choices) -> str:
     if value not in choices:
         raise ValueError(f"{name} must be one of {sorted(choices)}, got {value!r}")
     return value
+
+
+def check_number(value, name: str, low: float, high: float, *, unit: str = "",
+                 low_open: bool = False, high_open: bool = False,
+                 finite_message: bool = True) -> None:
+    """Raise ``ValueError`` naming ``name`` unless ``value`` is a finite number (an int or a
+    float, not a bool) from ``low`` to ``high``: the one range check of a scalar setting (the
+    settings of the WSP, the odometry, the monitor and the sensor models).
+
+    Both ends are in the range unless ``low_open`` or ``high_open``. Messages: ``"<name> must
+    be a finite number, got <value>"`` for a value that is not a finite number, and ``"<name>
+    must be in [<low>, <high>] <unit>, got <value>"`` for one outside the range (a parenthesis
+    at an open end; no unit when ``unit`` is empty). With ``finite_message=False`` (the
+    monitor's settings) a value that is not a number is ``"<name> must be a number, got
+    <value>"`` and NaN or an infinity gets the range's message.
+    """
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        kind = "a finite number" if finite_message else "a number"
+        raise ValueError(f"{name} must be {kind}, got {value!r}")
+    finite = math.isfinite(value)
+    if finite_message and not finite:
+        raise ValueError(f"{name} must be a finite number, got {value!r}")
+    above = low < value if low_open else low <= value
+    below = value < high if high_open else value <= high
+    if not (finite and above and below):
+        lb = "(" if low_open else "["
+        rb = ")" if high_open else "]"
+        in_unit = f" {unit}" if unit else ""
+        raise ValueError(f"{name} must be in {lb}{low:g}, {high:g}{rb}{in_unit}, got {value!r}")
 
 
 def _show(arr: np.ndarray) -> str:

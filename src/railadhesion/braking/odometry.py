@@ -86,15 +86,16 @@ interval widens accordingly.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, fields
 
 import numpy as np
 from numba import njit
 
 from railadhesion.braking.vehicle import GRAVITY
 from railadhesion.io.settings_table import (
-    check_number,
-    settings_spec,
-    sourced_settings,
+    read_settings_table,
+    settings_ranges,
+    settings_sources,
 )
 
 __all__ = [
@@ -117,10 +118,12 @@ STATUS_BITS = {"slide": SLIDE, "spin": SPIN, "dead_reckoning": DEAD_RECKONING,
                "encoder_low": ENCODER_LOW, "radar_lost": RADAR_LOST,
                "accelerometer_fault": ACCEL_FAULT, "conflict": CONFLICT}
 
-# name: (default, low, high, unit, source), from data/odometry_settings.toml
-_SPEC = settings_spec("odometry_settings")
+# each setting's allowed range, unit and source (or the word assumption), in the order of the
+# fields of OdometrySettings, which hold the defaults: data/odometry_settings.toml
+_TABLE = read_settings_table("odometry_settings")
+_RANGES = settings_ranges(_TABLE)
 
-SETTINGS_DTYPE = np.dtype([(name, "f8") for name in _SPEC]
+SETTINGS_DTYPE = np.dtype([(name, "f8") for name in _TABLE]
                           + [("wheel_radius", "f8"), ("gradient", "f8"), ("n_axles", "i8")],
                           align=True)
 
@@ -156,15 +159,50 @@ STATE_DTYPE = np.dtype([
 ], align=True)
 
 
-@sourced_settings(_SPEC)
+@dataclass(frozen=True)
 class OdometrySettings:
     """Settings of :class:`ReferenceOdometry` (SI units); every default with its source or the
-    word assumption: :meth:`sources` and ``docs/odometry.md``."""
+    word assumption: :meth:`sources` and ``docs/odometry.md`` (the defaults are the fields
+    below; ranges, units and sources: ``data/odometry_settings.toml``)."""
+
+    period: float = 0.005
+    diameter_tolerance: float = 0.01
+    speed_tolerance: float = 0.005
+    speed_tolerance_abs: float = 0.1
+    micro_slip: float = 0.005
+    settle_time: float = 2.0
+    accel_bias_bound: float = 0.02
+    accel_noise: float = 0.05
+    accel_sigmas: float = 5.0
+    accel_range: float = 19.6
+    accel_stuck_samples: float = 4.0
+    gradient_tolerance: float = 0.001
+    max_acceleration: float = 1.5
+    max_deceleration: float = 3.0
+    coast_deceleration: float = 0.15
+    radar_noise: float = 0.13
+    radar_sigmas: float = 5.0
+    radar_scale_tolerance: float = 0.02
+    radar_latency: float = 0.05
+    radar_loss_time: float = 0.5
+    max_wheel_acceleration: float = 150.0
+    stuck_time: float = 1.0
+    low_fraction: float = 0.1
+    low_time: float = 3.0
+    gate_sigmas: float = 3.0
+    trend_fast: float = 0.05
+    trend_slow: float = 0.2
+    trend_threshold: float = 0.05
+    accel_bias_sigma: float = 0.005
+    admit_time: float = 0.3
+    bias_walk: float = 1e-6
+    jerk_noise: float = 1.0
+    slide_speed_noise: float = 0.03
 
     def __post_init__(self):
-        for name, (_, low, high, unit, _) in _SPEC.items():
+        for name, limits in _RANGES.items():
             value = getattr(self, name)
-            check_number(name, value, low, high, unit)
+            limits.check(name, value)
             object.__setattr__(self, name, float(value))
         if self.accel_range <= 0.0:
             raise ValueError(f"accel_range must be in (0, 1000] m/s², got {self.accel_range!r}")
@@ -181,12 +219,21 @@ class OdometrySettings:
                     low <= value <= high):
                 raise ValueError(f"{name} must be in [{low:g}, {high:g}], got {value!r}")
         rec = np.zeros(1, SETTINGS_DTYPE)
-        for name in _SPEC:
+        for name in _TABLE:
             rec[0][name] = getattr(self, name)
         rec[0]["wheel_radius"] = wheel_radius
         rec[0]["gradient"] = gradient
         rec[0]["n_axles"] = n_axles
         return rec
+
+    def as_dict(self) -> dict:
+        """The settings by name, in the order of the fields."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    @staticmethod
+    def sources() -> dict:
+        """Each setting: ``(default, unit, source or 'assumption')``."""
+        return settings_sources(OdometrySettings, _TABLE)
 
 
 def state_record() -> np.ndarray:

@@ -92,6 +92,7 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 from numba import njit
 
+from railadhesion._validate import check_number
 from railadhesion.braking.vehicle import GRAVITY
 
 __all__ = [
@@ -373,14 +374,6 @@ def accelerometer(state):
 
 
 # -- the Python side ------------------------------------------------------------------------
-def _check(value, name, low, high, *, low_open=False):
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    if value < low or value > high or (low_open and value == low):
-        lo = "(" if low_open else "["
-        raise ValueError(f"{name} must be in {lo}{low:g}, {high:g}], got {value!r}")
-
-
 @dataclass(frozen=True)
 class EncoderSettings:
     """Wheel-speed encoders and pressure transducers (see the module docstring).
@@ -423,17 +416,17 @@ class EncoderSettings:
     diameter_drift: float = 0.0
 
     def __post_init__(self):
-        _check(self.dropout_probability, "dropout_probability", 0.0, 0.5)
-        _check(self.diameter_drift, "diameter_drift", 0.0, 1e-3)
+        check_number(self.dropout_probability, "dropout_probability", 0.0, 0.5)
+        check_number(self.diameter_drift, "diameter_drift", 0.0, 1e-3)
         ppr = self.pulses_per_revolution
-        _check(ppr, "pulses_per_revolution", 0.0, 1e4)
+        check_number(ppr, "pulses_per_revolution", 0.0, 1e4)
         if 0 < ppr < 4:
             raise ValueError(f"pulses_per_revolution must be 0 (ideal) or in [4, 10000], "
                              f"got {ppr!r}")
-        _check(self.edge_jitter, "edge_jitter", 0.0, 0.5)
-        _check(self.clock_resolution, "clock_resolution", 0.0, 1e-3)
-        _check(self.pressure_noise, "pressure_noise", 0.0, 1e5)
-        _check(self.pressure_resolution, "pressure_resolution", 0.0, 1e5)
+        check_number(self.edge_jitter, "edge_jitter", 0.0, 0.5)
+        check_number(self.clock_resolution, "clock_resolution", 0.0, 1e-3)
+        check_number(self.pressure_noise, "pressure_noise", 0.0, 1e5)
+        check_number(self.pressure_resolution, "pressure_resolution", 0.0, 1e5)
         errors = self.diameter_errors
         if isinstance(errors, list | tuple | np.ndarray):
             errors = tuple(float(e) if isinstance(e, int | float) and not isinstance(e, bool)
@@ -442,10 +435,10 @@ class EncoderSettings:
                 raise ValueError(f"diameter_errors must have 1 to {MAX_AXLES} entries, got "
                                  f"{len(errors)}")
             for k, e in enumerate(errors):
-                _check(e, f"diameter_errors[{k}]", -0.05, 0.05)
+                check_number(e, f"diameter_errors[{k}]", -0.05, 0.05)
             object.__setattr__(self, "diameter_errors", errors)
         else:
-            _check(errors, "diameter_errors", -0.05, 0.05)
+            check_number(errors, "diameter_errors", -0.05, 0.05)
 
     def diameter_error_array(self, n_axles: int) -> np.ndarray:
         """Diameter errors of axles 1 … n_axles."""
@@ -494,20 +487,20 @@ class ExternalSpeedSettings:
     outage: tuple | None = None
 
     def __post_init__(self):
-        _check(self.scale_error, "scale_error", -0.2, 0.2)
+        check_number(self.scale_error, "scale_error", -0.2, 0.2)
         if self.outage is not None:
             if not isinstance(self.outage, list | tuple) or len(self.outage) != 2:
                 raise ValueError(f"outage must be (start, end) [s] or None, got {self.outage!r}")
-            _check(self.outage[0], "outage start", 0.0, 1e6)
-            _check(self.outage[1], "outage end", 0.0, 1e6)
+            check_number(self.outage[0], "outage start", 0.0, 1e6)
+            check_number(self.outage[1], "outage end", 0.0, 1e6)
             if self.outage[1] <= self.outage[0]:
                 raise ValueError(f"outage end must be after its start, got {self.outage!r}")
             object.__setattr__(self, "outage", (float(self.outage[0]), float(self.outage[1])))
-        _check(self.noise, "noise", 0.0, 10.0)
-        _check(self.latency, "latency", 0.0, 5.0)
-        _check(self.period, "period", 0.0, 5.0, low_open=True)
-        _check(self.min_speed, "min_speed", 0.0, 10.0)
-        _check(self.dropout_probability, "dropout_probability", 0.0, 1.0)
+        check_number(self.noise, "noise", 0.0, 10.0)
+        check_number(self.latency, "latency", 0.0, 5.0)
+        check_number(self.period, "period", 0.0, 5.0, low_open=True)
+        check_number(self.min_speed, "min_speed", 0.0, 10.0)
+        check_number(self.dropout_probability, "dropout_probability", 0.0, 1.0)
         if self.latency / self.period > EXTERNAL_BUFFER - 4:
             raise ValueError(f"latency / period must be at most {EXTERNAL_BUFFER - 4}, got "
                              f"{self.latency} / {self.period}")
@@ -540,9 +533,9 @@ class AccelerometerSettings:
     range: float = 19.6
 
     def __post_init__(self):
-        _check(self.bias, "bias", -1.0, 1.0)
-        _check(self.noise, "noise", 0.0, 5.0)
-        _check(self.range, "range", 0.0, 1000.0, low_open=True)
+        check_number(self.bias, "bias", -1.0, 1.0)
+        check_number(self.noise, "noise", 0.0, 5.0)
+        check_number(self.range, "range", 0.0, 1000.0, low_open=True)
 
 
 @dataclass(frozen=True)
@@ -565,7 +558,7 @@ class EncoderFault:
             raise ValueError(f"axle must be an integer in [1, {MAX_AXLES}], got {self.axle!r}")
         if self.kind not in FAULT_KINDS:
             raise ValueError(f"kind must be one of {', '.join(FAULT_KINDS)}, got {self.kind!r}")
-        _check(self.start, "start", 0.0, 1e6)
+        check_number(self.start, "start", 0.0, 1e6)
 
 
 @dataclass(frozen=True)
@@ -625,11 +618,11 @@ class SensorModel:
         number); one number applies to every axle. ``gradient`` (rise over run) is the track's,
         for the accelerometer's gravity component; ``wheel_radius`` [m] is needed with a
         ``diameter_drift`` (the distance rolled)."""
-        _check(gradient, "gradient", -0.1, 0.1)
+        check_number(gradient, "gradient", -0.1, 0.1)
         if self.encoders.diameter_drift > 0.0:
             if wheel_radius is None:
                 raise ValueError("wheel_radius is needed with a diameter_drift")
-            _check(wheel_radius, "wheel_radius", 0.0, 10.0, low_open=True)
+            check_number(wheel_radius, "wheel_radius", 0.0, 10.0, low_open=True)
         if n_axles is not None:
             for f in self.faults:
                 if f.axle > n_axles:

@@ -62,18 +62,21 @@ UIC 541-05 as far as public sources describe them, are in ``docs/wsp.md``. In sh
 
 from __future__ import annotations
 
+import functools
 import inspect
 import math
 import warnings
+from dataclasses import dataclass, fields
+from typing import TypeVar
 
 import numpy as np
 from numba import njit
 
 from railadhesion.braking.cylinders import APPLY, HOLD, VENT
 from railadhesion.io.settings_table import (
-    check_number,
-    settings_spec,
-    sourced_settings,
+    read_settings_table,
+    settings_ranges,
+    settings_sources,
 )
 from railadhesion.plausibility import check_plausible
 
@@ -90,9 +93,10 @@ NORMAL, ONSET, VENTING, RECOVER, REAPPLY, PROBE, CUTOUT = range(7)
 #: Names of the phases of a valve group (diagnostics).
 PHASES = ("normal", "onset hold", "vent", "recover", "re-apply", "probe", "cut out")
 
-# settings: name -> (default, low, high, unit, source), from data/wsp_settings.toml (each with
-# its source or the word assumption). None defaults are taken from the vehicle.
-_SPEC = settings_spec("wsp_settings")
+# each setting's allowed range, unit and source (or the word assumption), in the order of the
+# fields of WSPSettings, which hold the defaults: data/wsp_settings.toml
+_TABLE = read_settings_table("wsp_settings")
+_RANGES = settings_ranges(_TABLE)
 
 _DEPRECATED = {
     "sliding_reference_deceleration": (
@@ -103,7 +107,7 @@ _DEPRECATED = {
 }
 
 SETTINGS_DTYPE = np.dtype(
-    [(name, "f8") for name in _SPEC if name not in ("valves", "watchdog_cutout_trips")]
+    [(name, "f8") for name in _TABLE if name not in ("valves", "watchdog_cutout_trips")]
     + [("watchdog_cutout_trips", "i8"), ("per_bogie", "i8")], align=True)
 
 STATE_DTYPE = np.dtype([
@@ -622,41 +626,109 @@ def settings_file_keys() -> dict:
     arrangement come from the vehicle and the brake cylinders, not from the table; the
     deprecated ``sliding_reference_deceleration_m_s2`` maps to its (ignored) field."""
     keys = {}
-    for name, (_, low, high, unit, _) in _SPEC.items():
-        if name in ("wheel_radius", "valves"):
+    for name, limits in _RANGES.items():
+        if name == "wheel_radius":  # (valves has no range)
             continue
-        keys[name + _SUFFIX[unit]] = (name, low, high)
+        keys[name + _SUFFIX[limits.unit]] = (name, limits.low, limits.high)
     keys["sliding_reference_deceleration_m_s2"] = ("sliding_reference_deceleration", 0.0, 10.0)
     return keys
 
 
-@sourced_settings(_SPEC, types={"valves": "str | None"})
-class WSPSettings:
-    """Settings of :class:`WheelSlideProtection` (SI units). Every default with its source or
-    the word assumption: :func:`WSPSettings.sources` and ``docs/wsp.md``.
+_Settings = TypeVar("_Settings")
 
-    ``wheel_radius``, ``deceleration_per_pressure`` and ``valves`` default to None: taken from
-    the vehicle and brake cylinders (:meth:`WheelSlideProtection.configure`, done by
-    :func:`~railadhesion.braking.simulate` and the WSP bench). ``sliding_reference_deceleration``
-    of earlier versions is accepted with a ``DeprecationWarning`` and ignored.
-    """
 
+def _named_keywords(cls: type[_Settings]) -> type[_Settings]:
+    """WSPSettings' ``__init__``: the dataclass's, after the deprecated names are dropped (with
+    a ``DeprecationWarning``) and an unknown name is refused with the known ones listed."""
+    init = cls.__init__
+    names = [f.name for f in fields(cls)]
+
+    @functools.wraps(init)
     def __init__(self, **kwargs):
         for name, message in _DEPRECATED.items():
             if name in kwargs:
                 kwargs.pop(name)
                 warnings.warn(message, DeprecationWarning, stacklevel=3)
-        unknown = set(kwargs) - set(_SPEC)
+        unknown = set(kwargs) - set(names)
         if unknown:
             raise ValueError(f"unknown WSP setting(s) {sorted(unknown)}; known: "
-                             f"{', '.join(_SPEC)}")
-        for name, spec in _SPEC.items():
-            object.__setattr__(self, name, kwargs.get(name, spec[0]))
-        self.__post_init__()
+                             f"{', '.join(names)}")
+        init(self, **kwargs)
+
+    cls.__init__ = __init__
+    return cls
+
+
+@_named_keywords
+@dataclass(frozen=True, kw_only=True)
+class WSPSettings:
+    """Settings of :class:`WheelSlideProtection` (SI units), by keyword. Every default with its
+    source or the word assumption: :func:`WSPSettings.sources` and ``docs/wsp.md`` (the
+    defaults are the fields below; ranges, units and sources: ``data/wsp_settings.toml``).
+
+    ``wheel_radius``, ``deceleration_per_pressure``, ``wheel_inertia_pressure`` and ``valves``
+    default to None: taken from
+    the vehicle and brake cylinders (:meth:`WheelSlideProtection.configure`, done by
+    :func:`~railadhesion.braking.simulate` and the WSP bench). ``sliding_reference_deceleration``
+    of earlier versions is accepted with a ``DeprecationWarning`` and ignored.
+    """
+
+    period: float = 0.005
+    reference_deceleration: float = 2.5
+    deceleration_per_pressure: float | None = None
+    wheel_inertia_pressure: float | None = None
+    brake_rate_tolerance: float = 0.25
+    reference_deceleration_offset: float = 0.15
+    hold_slip_ratio: float = 0.05
+    hold_slip_min: float = 0.15
+    vent_slip_ratio: float = 0.1
+    vent_slip_min: float = 0.3
+    reapply_slip_ratio: float = 0.03
+    reapply_slip_min: float = 0.1
+    hold_deceleration: float = 3.0
+    vent_deceleration: float = 6.0
+    recovery_acceleration: float = 2.0
+    recovery_end_acceleration: float = 0.5
+    speed_filter: float = 0.02
+    deceleration_filter: float = 0.05
+    settle_time: float = 0.1
+    free_pressure: float = 20000.0
+    onset_hold_time: float = 0.2
+    reapply_deceleration: float = 0.6
+    reapply_fast_fraction: float = 0.7
+    reapply_step_fraction: float = 0.05
+    reapply_pulse: float = 0.005
+    release_pulse: float = 0.01
+    reapply_lookahead: float = 0.5
+    reapply_step: float = 0.1
+    reapply_max_time: float = 3.0
+    probe_interval: float = 2.0
+    probe_max_time: float = 2.0
+    probe_pressure_fraction: float = 0.7
+    probe_min_speed: float = 1.0
+    probe_refill_fraction: float = 0.9
+    probe_interval_max: float = 8.0
+    probe_accuracy: float = 1.0
+    drift_gain: float = 0.5
+    drift_margin: float = 0.05
+    band_scale_max: float = 3.0
+    band_scale_min: float = 0.5
+    band_min_speed: float = 5.0
+    band_scale_step: float = 1.5
+    adapt_time: float = 1.0
+    adapt_tolerance: float = 0.02
+    adapt_block_time: float = 4.0
+    watchdog_time: float = 3.0
+    watchdog_refill_time: float = 0.5
+    watchdog_cutout_trips: int = 3
+    external_latency: float = 0.0
+    external_tolerance: float = 0.5
+    wheel_radius: float | None = None
+    valves: str | None = None
 
     def __post_init__(self):
-        for name in _SPEC:
-            value = getattr(self, name)
+        for field in fields(self):
+            name, value = field.name, getattr(self, field.name)
             if name == "valves":
                 if value not in (None, "axle", "bogie"):
                     raise ValueError(f"valves must be None, 'axle' or 'bogie', got {value!r}")
@@ -665,8 +737,8 @@ class WSPSettings:
                         1 <= value <= 1000):
                     raise ValueError(f"watchdog_cutout_trips must be an integer in [1, 1000], "
                                      f"got {value!r}")
-            elif value is not None or _SPEC[name][0] is not None:
-                check_number(name, value, *_SPEC[name][1:4])
+            elif value is not None or field.default is not None:
+                _RANGES[name].check(name, value)
         if not self.reapply_slip_ratio <= self.hold_slip_ratio <= self.vent_slip_ratio:
             raise ValueError("slip ratios must satisfy reapply_slip_ratio <= hold_slip_ratio "
                              "<= vent_slip_ratio, got "
@@ -681,6 +753,15 @@ class WSPSettings:
         if self.free_pressure > 0.0:  # 0.2 given in bar would pass the range check as Pa
             check_plausible(self.free_pressure, "free_pressure", quantity="brake_pressure",
                             what="WSP free pressure")
+
+    def as_dict(self) -> dict:
+        """The settings by name, in the order of the fields."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    @staticmethod
+    def sources() -> dict:
+        """Each setting: ``(default, unit, source or 'assumption')``."""
+        return settings_sources(WSPSettings, _TABLE)
 
     def replace(self, **changes) -> WSPSettings:
         return WSPSettings(**{**self.as_dict(), **changes})
@@ -744,7 +825,7 @@ class WheelSlideProtection:
         if radius is None:
             raise ValueError("the WSP needs the nominal wheel radius: give wheel_radius, or "
                              "call configure(vehicle) or reset(n_axles, wheel_radius) first")
-        check_number("wheel_radius", float(radius), *_SPEC["wheel_radius"][1:4])
+        _RANGES["wheel_radius"].check("wheel_radius", float(radius))
         rec = np.zeros(1, SETTINGS_DTYPE)
         r = rec[0]
         for name in SETTINGS_DTYPE.names:

@@ -1,100 +1,89 @@
-"""Tables of settings: each setting's default, allowed range, unit and source, in one TOML file.
+"""Tables of settings: each setting's allowed range, unit and source, in one TOML file.
 
 The settings classes of the default WSP (:class:`railadhesion.braking.WSPSettings`), the
 reference odometry (:class:`~railadhesion.braking.odometry.OdometrySettings`) and the adhesion
-monitor (:class:`railadhesion.monitor.MonitorSettings`) each read their table from
-``railadhesion/data/<name>.toml``: one section per setting, in the order of the class's fields,
-with its ``default`` (absent: None), ``range = [low, high]`` (absent: not a number checked by
-range), ``unit`` and ``source`` (the source, or the word *assumption*; the monitor's table has
-neither, its docstring gives them, and ``open`` names the open ends of a range). The class's
-dataclass fields, the ranges it checks and its ``sources()`` come from that table, so each
-default is written once.
+monitor (:class:`railadhesion.monitor.MonitorSettings`) are ordinary frozen dataclasses: their
+fields, with their types and defaults, are written in Python, in the class. What is data about
+them is in the class's table ``railadhesion/data/<name>.toml``: one section per field, in the
+order of the fields, with
+
+``range = [low, high]``
+    the allowed range (absent: not a number checked by range);
+``open``
+    the open ends of the range, ``"low"``, ``"high"`` or ``"both"`` (absent: closed);
+``unit`` and ``source``
+    the unit, and the source of the default or the word *assumption* (the monitor's table
+    has neither: its docstring gives them).
+
+No table holds a default: a class's ``sources()`` takes each default from its field
+(:func:`settings_sources`), so each default is written once. ``tests/io/test_settings_table.py``
+holds each table to its class: the same names in the same order, and a range for every
+setting whose default is a number.
 """
 
 from __future__ import annotations
 
-import math
 import tomllib
-from dataclasses import dataclass, fields
+from dataclasses import fields
 from importlib import resources
+from typing import NamedTuple
+
+from railadhesion._validate import check_number
 
 __all__ = [
+    "SettingRange",
     "read_settings_table",
-    "settings_spec",
-    "settings_dataclass",
-    "sourced_settings",
-    "check_number",
+    "settings_ranges",
+    "settings_sources",
 ]
+
+# the ``open`` entry of a range: (low end open, high end open)
+_OPEN_ENDS = {None: (False, False), "low": (True, False), "high": (False, True),
+              "both": (True, True)}
+
+
+class SettingRange(NamedTuple):
+    """The allowed range of a setting, from its table: ``low`` to ``high`` in ``unit`` (the
+    ends included unless ``low_open`` or ``high_open``)."""
+
+    low: float
+    high: float
+    unit: str = ""
+    low_open: bool = False
+    high_open: bool = False
+
+    def check(self, name: str, value, *, finite_message: bool = True) -> None:
+        """Raise ``ValueError`` naming the setting ``name`` unless ``value`` is a finite
+        number in the range (the package's one range check, ``check_number``)."""
+        check_number(value, name, self.low, self.high, unit=self.unit, low_open=self.low_open,
+                     high_open=self.high_open, finite_message=finite_message)
 
 
 def read_settings_table(name: str) -> dict:
     """The table ``railadhesion/data/<name>.toml``: ``{setting: entry}`` in the file's order,
-    each entry the mapping of its section (``default``, ``range``, ``unit``, ``source``, ...)."""
+    each entry the mapping of its section (``range``, ``open``, ``unit``, ``source``)."""
     text = (resources.files("railadhesion.data") / f"{name}.toml").read_text(encoding="utf-8")
     return tomllib.loads(text)
 
 
-def settings_spec(name: str) -> dict:
-    """The table ``name`` as ``{setting: (default, low, high, unit, source)}`` (None where the
-    table has no default or no range)."""
-    spec = {}
-    for key, entry in read_settings_table(name).items():
-        low, high = entry.get("range", (None, None))
-        spec[key] = (entry.get("default"), low, high, entry["unit"], entry["source"])
-    return spec
+def settings_ranges(table: dict) -> dict[str, SettingRange]:
+    """``{setting: SettingRange}`` of the settings of ``table`` (:func:`read_settings_table`)
+    that have a range, in the table's order."""
+    ranges = {}
+    for name, entry in table.items():
+        if "range" not in entry:
+            continue
+        if entry.get("open") not in _OPEN_ENDS:
+            raise ValueError(f"setting {name}: open must be 'low', 'high' or 'both', got "
+                             f"{entry['open']!r}")
+        low, high = entry["range"]
+        ranges[name] = SettingRange(low, high, entry.get("unit", ""),
+                                    *_OPEN_ENDS[entry.get("open")])
+    return ranges
 
 
-def _annotation(default) -> str:
-    if default is None:
-        return "float | None"
-    return type(default).__name__
-
-
-def settings_dataclass(defaults: dict, types: dict | None = None):
-    """Class decorator: a frozen dataclass whose fields are ``defaults``' names, in its order,
-    with those defaults; annotated by the default's type (``float | None`` for None) unless
-    ``types`` names another. The class's own methods (``__init__``, ``__post_init__``, ...)
-    are kept."""
-    types = types or {}
-
-    def make(cls):
-        cls.__annotations__ = {
-            name: types.get(name, _annotation(default)) for name, default in defaults.items()
-        }
-        for name, default in defaults.items():
-            setattr(cls, name, default)
-        return dataclass(frozen=True)(cls)
-
-    return make
-
-
-def check_number(name: str, value, low, high, unit: str) -> None:
-    """Raise ``ValueError`` naming the setting unless ``value`` is a finite number (not a
-    bool) in ``[low, high]`` (unit ``unit``)."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    if not low <= value <= high:
-        raise ValueError(f"{name} must be in [{low:g}, {high:g}] {unit}, got {value!r}")
-
-
-def sourced_settings(spec: dict, types: dict | None = None):
-    """Class decorator: :func:`settings_dataclass` of a :func:`settings_spec` table, with
-    ``as_dict()`` (the settings by name) and ``sources()`` (each setting's default, unit and
-    source) made from it."""
-
-    def as_dict(self) -> dict:
-        return {f.name: getattr(self, f.name) for f in fields(self)}
-
-    def sources() -> dict:
-        """Each setting: ``(default, unit, source or 'assumption')``."""
-        return {k: (v[0], v[3], v[4]) for k, v in spec.items()}
-
-    def make(cls):
-        for function in (as_dict, sources):
-            function.__qualname__ = f"{cls.__qualname__}.{function.__name__}"
-            function.__module__ = cls.__module__
-        cls.as_dict = as_dict
-        cls.sources = staticmethod(sources)
-        return settings_dataclass({name: entry[0] for name, entry in spec.items()}, types)(cls)
-
-    return make
+def settings_sources(cls, table: dict) -> dict:
+    """Each setting of the dataclass ``cls``: ``(default, unit, source or 'assumption')``, the
+    default from its field, the unit and source from ``table``, in the order of the fields."""
+    return {f.name: (f.default, table[f.name]["unit"], table[f.name]["source"])
+            for f in fields(cls)}

@@ -9,7 +9,7 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from railadhesion.io.settings_table import read_settings_table, settings_dataclass
+from railadhesion.io.settings_table import read_settings_table, settings_ranges
 
 __all__ = ["MonitorSettings", "RSSB_BRAKING_ADHESION", "BRAKE_COEFFICIENT_SOURCES", "SHAPE_CHOICES",
            "POLACH_RATIO"]
@@ -27,15 +27,12 @@ SHAPE_CHOICES = ("both", "fletcher", "polach")
 #: (railadhesion's ``polach2005_wet``); the dry set's 0.4/1.0 is close.
 POLACH_RATIO = 0.1 / 0.3
 
-# The settings' defaults and ranges, in the order of the fields (data/monitor_settings.toml).
-_TABLE = read_settings_table("monitor_settings")
-# name -> (low, high, low_open, high_open): the allowed range of each number
-_RANGES = {name: (*entry["range"], entry.get("open") in ("low", "both"),
-                  entry.get("open") in ("high", "both"))
-           for name, entry in _TABLE.items() if "range" in entry}
+# The allowed range of each number, in the order of the fields of MonitorSettings, which hold
+# the defaults: data/monitor_settings.toml
+_RANGES = settings_ranges(read_settings_table("monitor_settings"))
 
 
-@settings_dataclass({name: entry.get("default") for name, entry in _TABLE.items()})
+@dataclasses.dataclass(frozen=True)
 class MonitorSettings:
     """What the monitor assumes and how it decides (SI units; creep and adhesion fractions).
 
@@ -167,17 +164,54 @@ class MonitorSettings:
         way).
     """
 
+    threshold: float = RSSB_BRAKING_ADHESION
+    confidence: float = 0.95
+    sample_period: float = 0.0024
+    block_time: float = 0.1
+    memory: float = 3.0
+    wheel_cutoff: float = 2.0
+    vehicle_cutoff: float = 0.5
+    min_speed: float = 5.0
+    min_creep: float = 0.0005
+    min_adhesion: float = 0.02
+    min_variation: float = 0.05
+    max_fit_creep: float = 0.03
+    speed_noise: float = 0.01
+    wheel_speed_noise: float = 0.02
+    pressure_noise: float = 1000.0
+    torque_noise: float = 50.0
+    model_noise: float = 0.001
+    learn_radius: bool = True
+    radius_tolerance: float = 0.005
+    radius_precision: float = 0.0001
+    radius_change: float = 0.0003
+    coast_pressure: float = 5000.0
+    coast_torque: float = 100.0
+    coast_time: float = 1.0
+    coast_settle: float = 0.5
+    change_z: float = 5.0
+    change_blocks: int = 2
+    confirm_time: float = 0.2
+    recovery_time: float = 0.5
+    stuck_time: float = 0.5
+    stuck_pressure_time: float = 5.0
+    gap_factor: float = 5.0
+    max_physical_adhesion: float = 0.6
+    max_pressure: float = 2e6
+    max_torque: float = 100000.0
+    lone_window: float = 0.5
+    lone_shift: float = 0.001
+    slope_prior: float = 60.0
+    slope_prior_spread: float = 1.2
+    max_slope: float | None = None
+    shapes: str = "both"
+    brake_coefficient: str = "vehicle"
+
     def __post_init__(self):
-        for name, (low, high, low_open, high_open) in _RANGES.items():
+        for name, limits in _RANGES.items():
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int | float):
-                raise ValueError(f"{name} must be a number, got {value!r}")
+            limits.check(name, value, finite_message=False)
             x = float(value)
-            ok = (x > low if low_open else x >= low) and (x < high if high_open else x <= high)
-            if not (math.isfinite(x) and ok):
-                lb = "(" if low_open else "["
-                rb = ")" if high_open else "]"
-                raise ValueError(f"{name} must be in {lb}{low:g}, {high:g}{rb}, got {value!r}")
             if name == "change_blocks":
                 if int(x) != x:
                     raise ValueError(f"change_blocks must be a whole number, got {value!r}")
