@@ -97,7 +97,6 @@ __all__ = [
     "fmu_variable_problems",
     "run_wsp_case",
     "run_wsp_programme",
-    "run_programme_cases",
     "write_programme_outputs",
     "write_bench_outputs",
     "json_safe",
@@ -1082,58 +1081,105 @@ def run_wsp_programme(programme="default", controller=None, *, out=None,
         prog = prog.select(cases)
     ctrl = load_controller(controller, control_period=control_period,
                            wsp_settings=prog.wsp or None)
-    dry_cache: dict = {}
+    return _WSPRun(prog.name, ctrl).run(prog.cases, out=out, figures=figures,
+                                        histories=histories, progress=progress)
 
-    def failed(case, message, seconds):
-        return {**case.describe(), "controller": getattr(ctrl, "label", "?"), "status": "error",
+
+class ProgrammeRun:
+    """The loop of a bench over the cases of a programme (the WSP and the odometry bench).
+
+    :meth:`run` runs the cases in turn. A bench subclasses it with what differs: how a case
+    runs (:meth:`run_case`), what a case that raised records (:meth:`error_summary`), the
+    bench's result (:meth:`result`) and its output writer (:meth:`write_outputs`); and, as
+    data, the exceptions that fail a case but let the others run (:attr:`case_errors`) and
+    what such a case leaves to write beside its summary (:attr:`no_record`).
+    """
+
+    #: Exceptions of a case that record it as failed; the next case still runs.
+    case_errors: tuple[type[Exception], ...] = ()
+    #: What a failed case gives the writer in place of its records (histories, traces).
+    no_record: tuple = ()
+
+    def __init__(self, programme: str, unit):
+        self.programme = programme  # the programme's name
+        self.unit = unit  # the controller or odometry under test
+        self.label = getattr(unit, "label", "?")
+
+    def run_case(self, case) -> tuple:
+        """``(summary, *records)`` of one case; the records are handed to the writer."""
+        raise NotImplementedError
+
+    def error_summary(self, case, message: str, seconds: float) -> dict:
+        """The summary of a case that raised one of :attr:`case_errors`: ``message`` is
+        ``"Type: text"``, ``seconds`` the wall time until then."""
+        raise NotImplementedError
+
+    def result(self, summaries: list):
+        """The bench's result for the case summaries so far."""
+        raise NotImplementedError
+
+    def write_outputs(self, result, out, *, case=None, figures: bool = True,
+                      histories: bool = False, summary_figure: bool = False) -> list:
+        """Write the outputs of ``result`` (and of ``case = (case, summary, *records)``)."""
+        raise NotImplementedError
+
+    def run(self, cases, *, out=None, figures: bool = True, histories: bool = False,
+            progress=None):
+        """Run ``cases`` and return the result. ``progress(index, number of cases, case
+        name)`` is called before each case. With ``out`` the outputs are rewritten after
+        every case, and at the end (``figures``) with the figure across cases. The unit under
+        test is closed (its ``close()``, if it has one) after the last case, also on an
+        error."""
+        summaries = []
+        out = Path(out) if out is not None else None
+        try:
+            for k, case in enumerate(cases):
+                if progress is not None:
+                    progress(k, len(cases), case.name)
+                started = _time.perf_counter()
+                try:
+                    summary, *records = self.run_case(case)
+                except self.case_errors as exc:
+                    summary = self.error_summary(case, f"{type(exc).__name__}: {exc}",
+                                                 _time.perf_counter() - started)
+                    records = self.no_record
+                summaries.append(summary)
+                if out is not None:
+                    self.write_outputs(self.result(summaries), out,
+                                       case=(case, summary, *records), figures=figures,
+                                       histories=histories)
+        finally:
+            close = getattr(self.unit, "close", None)
+            if close is not None:
+                close()
+        result = self.result(summaries)
+        if out is not None and figures and summaries:
+            self.write_outputs(result, out, summary_figure=True)
+        return result
+
+
+class _WSPRun(ProgrammeRun):
+    """:func:`run_wsp_programme`'s loop: the controller under test on every case."""
+
+    case_errors = (WSPControllerError, SimulationError, ValueError, ArithmeticError)
+    no_record = (None, None)  # no histories, no trace
+
+    def __init__(self, programme: str, controller):
+        super().__init__(programme, controller)
+        self.dry_cache: dict = {}  # the dry and no-WSP stops, shared by the cases
+
+    def run_case(self, case):
+        return run_wsp_case(case, self.unit, dry_cache=self.dry_cache)
+
+    def error_summary(self, case, message, seconds):
+        return {**case.describe(), "controller": self.label, "status": "error",
                 "message": message, "passed": False, "wall_time_s": seconds}
 
-    def result(results):
-        return WSPProgrammeResult(prog.name, getattr(ctrl, "label", "?"), results,
-                                  _overall(results))
+    def result(self, summaries):
+        return WSPProgrammeResult(self.programme, self.label, summaries, _overall(summaries))
 
-    return run_programme_cases(
-        prog, lambda case: run_wsp_case(case, ctrl, dry_cache=dry_cache), (None, None),
-        (WSPControllerError, SimulationError, ValueError, ArithmeticError), failed, result,
-        write_programme_outputs, getattr(ctrl, "close", None), out=out, figures=figures,
-        histories=histories, progress=progress)
-
-
-def run_programme_cases(prog, run_case, no_records: tuple, errors, failed, make_result,
-                        write_outputs, close=None, *, out=None, figures: bool = True,
-                        histories: bool = False, progress=None):
-    """The loop of a bench over the cases of the programme ``prog`` (the WSP and the odometry
-    bench): ``run_case(case)`` gives ``(summary, *records)``; an exception of the types
-    ``errors`` records the case as ``failed(case, "Type: message", wall time [s])`` with the
-    records ``no_records``. With ``out``, after every case ``write_outputs(result, out,
-    case=(case, summary, *records), figures=figures, histories=histories)`` rewrites the
-    outputs, ``result = make_result(summaries so far)``; at the end (``figures``) with
-    ``summary_figure=True``. ``progress(index, number of cases, case name)`` is called before
-    each case, ``close()`` after the last, also on an error. Returns the result."""
-    results = []
-    outdir = Path(out) if out is not None else None
-    try:
-        for k, case in enumerate(prog.cases):
-            if progress is not None:
-                progress(k, len(prog.cases), case.name)
-            started = _time.perf_counter()
-            try:
-                summary, *records = run_case(case)
-            except errors as exc:
-                summary = failed(case, f"{type(exc).__name__}: {exc}",
-                                 _time.perf_counter() - started)
-                records = no_records
-            results.append(summary)
-            if outdir is not None:
-                write_outputs(make_result(results), outdir, case=(case, summary, *records),
-                              figures=figures, histories=histories)
-    finally:
-        if close is not None:
-            close()
-    result = make_result(results)
-    if outdir is not None and figures and results:
-        write_outputs(result, outdir, summary_figure=True)
-    return result
+    def write_outputs(self, result, out, **options):
+        return write_programme_outputs(result, out, **options)
 
 
 def json_safe(obj):

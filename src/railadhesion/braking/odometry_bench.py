@@ -47,6 +47,7 @@ from railadhesion.braking._fields import (
 from railadhesion.braking.bench import (
     BenchCase,
     ProgrammeResult,
+    ProgrammeRun,
     case_field,
     fmu_variable_problems,
     load_component,
@@ -55,7 +56,6 @@ from railadhesion.braking.bench import (
     read_cosim_fmu,
     read_programme_file,
     release_fmu,
-    run_programme_cases,
     select_cases,
     write_bench_outputs,
 )
@@ -1018,18 +1018,29 @@ def run_odometry_programme(programme="default", odometry=None, *, out=None, figu
     if cases:
         prog = prog.select(cases)
     odo = load_odometry(odometry, period=period)
-    label = getattr(odo, "label", "?")
+    return _OdometryRun(prog.name, odo).run(prog.cases, out=out, figures=figures,
+                                            histories=histories, progress=progress)
 
-    def failed(case, message, seconds):
-        return {**case.describe(), "odometry": label, "status": "error", "message": message,
-                "passed": False, "fits": [], "wall_time_s": seconds}
 
-    return run_programme_cases(
-        prog, lambda case: run_odometry_case(case, odo), (None,),
-        (SimulationError, ValueError, ArithmeticError), failed,
-        lambda results: OdometryProgrammeResult(prog.name, label, results, _overall(results)),
-        write_odometry_outputs, odo.close, out=out, figures=figures, histories=histories,
-        progress=progress)
+class _OdometryRun(ProgrammeRun):
+    """:func:`run_odometry_programme`'s loop: the odometry under test on every case."""
+
+    case_errors = (SimulationError, ValueError, ArithmeticError)
+    no_record = (None,)  # no traces
+
+    def run_case(self, case):
+        return run_odometry_case(case, self.unit)
+
+    def error_summary(self, case, message, seconds):
+        return {**case.describe(), "odometry": self.label, "status": "error",
+                "message": message, "passed": False, "fits": [], "wall_time_s": seconds}
+
+    def result(self, summaries):
+        return OdometryProgrammeResult(self.programme, self.label, summaries,
+                                       _overall(summaries))
+
+    def write_outputs(self, result, out, **options):
+        return write_odometry_outputs(result, out, **options)
 
 
 def write_odometry_outputs(result: OdometryProgrammeResult, out, *, case=None,
