@@ -98,7 +98,6 @@ __all__ = [
     "run_wsp_case",
     "run_wsp_programme",
     "write_programme_outputs",
-    "write_bench_outputs",
     "json_safe",
     "read_programme_file",
     "release_fmu",
@@ -1222,56 +1221,52 @@ def write_programme_outputs(result: WSPProgrammeResult, out, *, case=None,
     ``case = (case, summary, histories, trace)``, that case's ``cases/<name>.json``, figure
     ``figures/<name>.png`` and (``histories``) ``histories/<name>.parquet``; with
     ``summary_figure`` the figure across cases ``figures/summary.png``. Returns the paths."""
-    def tables(out):
-        result.frame().to_csv(out / "cases.csv", index=False, float_format="%.6g")
-        axles = result.axle_frame()
-        axles.to_csv(out / "axles.csv", index=False, float_format="%.6g")
-        return [out / "cases.csv", out / "axles.csv"]
-
-    def case_figure():
-        from railadhesion.braking.figures import wsp_case_figure
-
-        return wsp_case_figure(h, trace, bench_case.vehicle.wheel_radius,
-                               title=f"{bench_case.name}: {bench_case.adhesion.describe()}")
-
-    def across_cases():
-        from railadhesion.braking.figures import wsp_summary_figure
-
-        return wsp_summary_figure(result.cases)
-
+    out = Path(out)
     doc = {"format": "railadhesion-wsp-results", "programme": result.programme,
            "controller": result.controller, "overall": result.overall, "cases": result.cases}
-    bench_case, summary, h, trace = case or (None,) * 4
-    return write_bench_outputs(out, doc, tables, case and (bench_case.name, summary),
-                               case_figure if h is not None and figures else None,
-                               (lambda: h) if h is not None and histories else None,
-                               across_cases if summary_figure else None, dpi=90)
-
-
-def write_bench_outputs(out, doc, tables, case=None, figure=None, history=None,
-                        summary_figure=None, *, dpi: int) -> list:
-    """The outputs of a bench (the WSP and the odometry bench) in the folder ``out`` (made if
-    needed), in this order: ``summary.json`` (``doc``), the tables ``tables(out)`` writes (it
-    returns their paths); for ``case = (name, summary)`` ``cases/<name>.json``, the figure
-    ``figure()`` as ``figures/<name>.png`` and the DataFrame ``history()`` as
-    ``histories/<name>.parquet``; the figure ``summary_figure()`` as ``figures/summary.png``
-    (figures at ``dpi``; each callable only if given). Returns the paths written."""
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    written = [write_json(out / "summary.json", doc)]
-    written += tables(out)
+    written = write_summary(out, doc, {"cases.csv": result.frame(),
+                                       "axles.csv": result.axle_frame()})
     if case is not None:
-        name, summary = case
-        (out / "cases").mkdir(exist_ok=True)
-        written.append(write_json(out / "cases" / f"{name}.json", summary))
-        if figure is not None:
-            written.append(save_figure(figure(), out, name, dpi))
-        if history is not None:
-            (out / "histories").mkdir(exist_ok=True)
-            path = out / "histories" / f"{name}.parquet"
-            history().to_parquet(path, index=False)
-            written.append(path)
-    if summary_figure is not None:
-        written.append(save_figure(summary_figure(), out, "summary", dpi))
+        bench_case, summary, h, trace = case
+        figure = None
+        if h is not None and figures:
+            from railadhesion.braking.figures import wsp_case_figure
+
+            figure = wsp_case_figure(h, trace, bench_case.vehicle.wheel_radius,
+                                     title=f"{bench_case.name}: {bench_case.adhesion.describe()}")
+        written += write_case(out, bench_case.name, summary, figure,
+                              h if histories else None, dpi=90)
+    if summary_figure:
+        from railadhesion.braking.figures import wsp_summary_figure
+
+        written.append(save_figure(wsp_summary_figure(result.cases), out, "summary", 90))
     return written
 
+
+def write_summary(out: Path, doc: dict, tables: dict) -> list:
+    """A bench's files across its cases, in the folder ``out`` (made if needed):
+    ``summary.json`` (``doc``), then every table of ``tables`` (file name: DataFrame) as CSV.
+    Returns the paths."""
+    out.mkdir(parents=True, exist_ok=True)
+    written = [write_json(out / "summary.json", doc)]
+    for name, frame in tables.items():
+        frame.to_csv(out / name, index=False, float_format="%.6g")
+        written.append(out / name)
+    return written
+
+
+def write_case(out: Path, name: str, summary: dict, figure=None, history=None, *,
+               dpi: int) -> list:
+    """One case's files in the folder ``out``: ``cases/<name>.json`` (``summary``), then, if
+    given, the matplotlib ``figure`` as ``figures/<name>.png`` (at ``dpi``) and the DataFrame
+    ``history`` as ``histories/<name>.parquet``. Returns the paths."""
+    (out / "cases").mkdir(exist_ok=True)
+    written = [write_json(out / "cases" / f"{name}.json", summary)]
+    if figure is not None:
+        written.append(save_figure(figure, out, name, dpi))
+    if history is not None:
+        (out / "histories").mkdir(exist_ok=True)
+        path = out / "histories" / f"{name}.parquet"
+        history.to_parquet(path, index=False)
+        written.append(path)
+    return written

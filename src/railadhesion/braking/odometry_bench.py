@@ -56,8 +56,10 @@ from railadhesion.braking.bench import (
     read_cosim_fmu,
     read_programme_file,
     release_fmu,
+    save_figure,
     select_cases,
-    write_bench_outputs,
+    write_case,
+    write_summary,
 )
 from railadhesion.braking.odometry import STATUS_BITS, ReferenceOdometry
 from railadhesion.braking.sensors import (
@@ -1050,40 +1052,39 @@ def write_odometry_outputs(result: OdometryProgrammeResult, out, *, case=None,
     fit), ``violations.csv`` (every violation event) and, for ``case = (case, summary,
     traces)``, ``cases/<name>.json``, ``figures/<name>.png`` and (``histories``)
     ``histories/<name>.parquet``; with ``summary_figure``, ``figures/summary.png``."""
-
-    def tables(out):
-        result.frame().to_csv(out / "fits.csv", index=False, float_format="%.6g")
-        result.violation_frame().to_csv(out / "violations.csv", index=False,
-                                        float_format="%.6g")
-        return [out / "fits.csv", out / "violations.csv"]
-
-    def case_figure():
-        from railadhesion.braking.figures import odometry_case_figure
-
-        return odometry_case_figure(tr, summary, title=f"{ocase.name}: "
-                                    f"{ocase.run.adhesion.describe()}")
-
-    def history():
-        import pandas as pd
-
-        cols = {"time": tr["time"], "train_speed": tr["speed"],
-                "distance": tr["distance"], "drive": tr["drive"]}
-        for k, a in enumerate(ocase.axles):
-            cols[f"creep_{a}"] = tr["creep"][:, k]
-        for name, rec in tr["outputs"].items():
-            for k, what in enumerate(_OUTPUTS):
-                cols[f"{name}:{what}"] = rec[:, k]
-        return pd.DataFrame(cols)
-
-    def across_cases():
-        from railadhesion.braking.figures import odometry_summary_figure
-
-        return odometry_summary_figure(result.cases)
-
+    out = Path(out)
     doc = {"format": "railadhesion-odometry-results", "programme": result.programme,
            "odometry": result.odometry, "overall": result.overall, "cases": result.cases}
-    ocase, summary, tr = case or (None,) * 3
-    return write_bench_outputs(out, doc, tables, case and (ocase.name, summary),
-                               case_figure if tr is not None and figures else None,
-                               history if tr is not None and histories else None,
-                               across_cases if summary_figure else None, dpi=80)
+    written = write_summary(out, doc, {"fits.csv": result.frame(),
+                                       "violations.csv": result.violation_frame()})
+    if case is not None:
+        ocase, summary, tr = case
+        figure = history = None
+        if tr is not None and figures:
+            from railadhesion.braking.figures import odometry_case_figure
+
+            figure = odometry_case_figure(tr, summary, title=f"{ocase.name}: "
+                                          f"{ocase.run.adhesion.describe()}")
+        if tr is not None and histories:
+            history = _samples_frame(ocase, tr)
+        written += write_case(out, ocase.name, summary, figure, history, dpi=80)
+    if summary_figure:
+        from railadhesion.braking.figures import odometry_summary_figure
+
+        written.append(save_figure(odometry_summary_figure(result.cases), out, "summary", 80))
+    return written
+
+
+def _samples_frame(case: OdometryCase, tr: dict):
+    """A case's samples (the traces of :func:`run_odometry_case`) as a DataFrame: the truth,
+    the creepage of the odometry axles and every fit's outputs (``<fit>:<output>``)."""
+    import pandas as pd
+
+    cols = {"time": tr["time"], "train_speed": tr["speed"],
+            "distance": tr["distance"], "drive": tr["drive"]}
+    for k, a in enumerate(case.axles):
+        cols[f"creep_{a}"] = tr["creep"][:, k]
+    for name, rec in tr["outputs"].items():
+        for k, what in enumerate(_OUTPUTS):
+            cols[f"{name}:{what}"] = rec[:, k]
+    return pd.DataFrame(cols)
