@@ -34,6 +34,20 @@ from pathlib import Path
 
 import numpy as np
 
+from railadhesion.braking._bench_common import (
+    ProgrammeResult,
+    ProgrammeRun,
+    case_field,
+    fmu_variable_problems,
+    load_component,
+    read_cosim_fmu,
+    read_programme_file,
+    release_fmu,
+    save_figure,
+    select_cases,
+    write_case,
+    write_summary,
+)
 from railadhesion.braking._fields import (
     BrakingFileError,
     FieldError,
@@ -46,20 +60,8 @@ from railadhesion.braking._fields import (
 )
 from railadhesion.braking.bench import (
     BenchCase,
-    ProgrammeResult,
-    ProgrammeRun,
-    case_field,
-    fmu_variable_problems,
-    load_component,
     load_controller,
     programme_from_document,
-    read_cosim_fmu,
-    read_programme_file,
-    release_fmu,
-    save_figure,
-    select_cases,
-    write_case,
-    write_summary,
 )
 from railadhesion.braking.odometry import STATUS_BITS, ReferenceOdometry
 from railadhesion.braking.sensors import (
