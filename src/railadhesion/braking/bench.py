@@ -24,18 +24,30 @@ results so far are written after every case, so nothing is lost.
 
 from __future__ import annotations
 
-import importlib
-import importlib.util
-import json
 import math
 import os
 import time as _time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
 
 import numpy as np
 
+from railadhesion.braking._bench_common import (
+    ProgrammeResult,
+    ProgrammeRun,
+    case_field,
+    fmu_variable_problems,
+    json_safe,
+    load_component,
+    read_cosim_fmu,
+    read_programme_file,
+    release_fmu,
+    save_figure,
+    select_cases,
+    write_case,
+    write_summary,
+)
 from railadhesion.braking._fields import (
     BrakingFileError,
     FieldError,
@@ -43,7 +55,6 @@ from railadhesion.braking._fields import (
     integer,
     keys,
     number,
-    read_toml,
     string,
     table,
 )
@@ -81,36 +92,21 @@ __all__ = [
     "BenchCase",
     "WSPProgramme",
     "WSPProgrammeResult",
-    "ProgrammeResult",
     "WSPControllerError",
     "FmuController",
     "load_wsp_programme",
     "load_controller",
     "adhesion_limited_stop",
-    "load_attribute",
-    "load_component",
-    "case_field",
-    "programme_from_document",
-    "save_figure",
-    "write_json",
-    "read_cosim_fmu",
-    "fmu_variable_problems",
     "run_wsp_case",
     "run_wsp_programme",
-    "run_programme_cases",
     "write_programme_outputs",
-    "write_bench_outputs",
     "json_safe",
-    "read_programme_file",
-    "release_fmu",
-    "select_cases",
 ]
 
 PROGRAMME_FORMAT = "railadhesion-wsp-programme"
 #: The criteria of a case and their defaults (the issue-20 targets).
 DEFAULT_CRITERIA = {"max_longest_lock_s": 1.0, "max_mean_creep": 0.3,
                     "max_distance_ratio": math.inf, "max_ratio_no_wsp": math.inf}
-_DATA = Path(__file__).resolve().parent.parent / "data"
 
 
 class WSPControllerError(ValueError):
@@ -217,19 +213,6 @@ class WSPProgramme:
         return select_cases(self, names)
 
 
-def select_cases(programme, names):
-    """A copy of ``programme`` (a dataclass with a list ``cases`` of named cases) with the
-    cases named in ``names`` only, in the programme's order; ``ValueError`` for an unknown
-    name."""
-    wanted = list(names)
-    known = {c.name for c in programme.cases}
-    missing = [n for n in wanted if n not in known]
-    if missing:
-        raise ValueError(f"unknown case(s) {missing}; the programme has "
-                         f"{', '.join(c.name for c in programme.cases)}")
-    return replace(programme, cases=[c for c in programme.cases if c.name in wanted])
-
-
 _CASE_KEYS = {
     # key: (default, parser)
     "vehicle": "coach_default",
@@ -247,17 +230,6 @@ _CASE_KEYS = {
 }
 _CRITERIA_KEYS = ("max_longest_lock_s", "max_mean_creep", "max_distance_ratio",
                   "max_ratio_no_wsp")
-
-
-def case_field(key, tab, defaults, fallback, where):
-    """A field of a programme's case: ``(value, where it is given)`` from the case's table
-    ``tab`` (at ``where``), else from the programme's ``[defaults]``, else ``fallback[key]``
-    (the default value, reported at ``where``)."""
-    if key in tab:
-        return tab[key], f"{where}.{key}"
-    if key in defaults:
-        return defaults[key], f"defaults.{key}"
-    return fallback[key], f"{where}.{key}"
 
 
 def _criteria(tab, where, base):
@@ -422,22 +394,6 @@ def load_wsp_programme(path="default") -> WSPProgramme:
     return read_programme_file(path, "wsp_programme_default.toml", _programme_from_document)
 
 
-def read_programme_file(path, default: str, build):
-    """Read a programme file: ``path``, or the package's data file ``default`` for
-    ``"default"``; ``build(document, folder of the file)`` makes the programme, whose
-    ``source`` is set to the file's label. Its errors (a field's, or ``ValueError``) become a
-    :class:`~railadhesion.braking.BrakingFileError` naming the file."""
-    if os.fspath(path) == "default":
-        path = _DATA / default
-    doc, label = read_toml(path)
-    try:
-        prog = build(doc, Path(os.fspath(path)).resolve().parent)
-    except (FieldError, ValueError) as exc:
-        raise BrakingFileError(f"{label}: {exc}") from None
-    prog.source = label
-    return prog
-
-
 # -- controllers ----------------------------------------------------------------------------
 class _DefaultController:
     """The default WSP through its compiled records (no Python per call but the dispatch)."""
@@ -509,84 +465,6 @@ class _PythonController:
     def diagnostics(self):
         d = getattr(self.obj, "diagnostics", None)
         return d() if callable(d) else {}
-
-
-def release_fmu(fmu) -> None:
-    """Terminate and free an FMPy FMU instance; an FMU already broken is let go silently."""
-    try:
-        fmu.terminate()
-        fmu.freeInstance()
-    except Exception:  # pragma: no cover - the FMU is already broken
-        pass
-
-
-def read_cosim_fmu(path, period: float | None = None, what: str = "FMU"):
-    """Open an FMI 2.0 co-simulation FMU with FMPy: ``(path, model description, variables by
-    name, period)``; the period is ``period``, else the FMU's DefaultExperiment step size, else
-    5 ms. ``what`` names the FMU in the ImportError without FMPy."""
-    try:
-        from fmpy import read_model_description
-    except ImportError as exc:  # pragma: no cover - fmpy is in the fmu extra
-        raise ImportError(f"{what} needs FMPy: pip install 'railadhesion[fmu]'") from exc
-    path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"FMU file not found: {path}")
-    try:
-        md = read_model_description(str(path))
-    except Exception as exc:  # FMPy raises several kinds for a broken archive
-        raise ValueError(f"{path}: not a readable FMU: {exc}") from None
-    if md.coSimulation is None:
-        raise ValueError(f"{path}: not a co-simulation FMU (FMI 2.0 CS needed)")
-    variables = {v.name: v for v in md.modelVariables}
-    step = getattr(md.defaultExperiment, "stepSize", None) if (
-        md.defaultExperiment is not None) else None
-    if period is None:
-        period = float(step) if step else 5e-3
-    if not (math.isfinite(period) and period > 0):
-        raise ValueError(f"period must be in (0, inf) s, got {period!r}")
-    return path, md, variables, float(period)
-
-
-def load_attribute(text: str, what: str, prefix: str):
-    """The object ``"module:name"`` or ``"file.py:name"`` names (a file is imported as module
-    ``prefix + its stem``); errors name ``what`` and the specification."""
-    where, name = text.rsplit(":", 1)
-    if where.endswith(".py"):
-        path = Path(where)
-        if not path.is_file():
-            raise ValueError(f"{what} file not found: {path}")
-        mspec = importlib.util.spec_from_file_location(f"{prefix}{path.stem}", path)
-        module = importlib.util.module_from_spec(mspec)
-        mspec.loader.exec_module(module)
-    else:
-        module = importlib.import_module(where)
-    if not hasattr(module, name):
-        raise ValueError(f"{what} {text!r}: {where} has no attribute {name!r}")
-    return getattr(module, name)
-
-
-def load_component(text: str, what: str, default: str, prefix: str):
-    """A bench's controller or odometry (``what``) given as a string that is not a ``.fmu``
-    path: the object ``"module:name"`` or ``"file.py:name"`` names (:func:`load_attribute`);
-    ``ValueError`` listing the forms (``default``, a .fmu file, those two) otherwise."""
-    if ":" not in text:
-        raise ValueError(f"{what} {text!r}: give {default!r}, a .fmu file, or "
-                         "'module:name' / 'file.py:name'")
-    return load_attribute(text, what, prefix)
-
-
-def fmu_variable_problems(variables, missing, want) -> str:
-    """What is wrong with the ``variables`` of an FMU (FMPy's, by name) for a bench: it lacks
-    the ``missing`` ones, or has one of ``want`` = [(name, causality)] with another causality;
-    ``""`` if nothing."""
-    wrong = [f"{name} (is {variables[name].causality}, must be {c})" for name, c in want
-             if name in variables and variables[name].causality != c]
-    parts = []
-    if missing:
-        parts.append("lacks the variables " + ", ".join(missing))
-    if wrong:
-        parts.append("has " + ", ".join(wrong))
-    return " and ".join(parts)
 
 
 class FmuController:
@@ -970,31 +848,6 @@ def run_wsp_case(case: BenchCase, controller=None, *, dry_cache: dict | None = N
 
 # -- a programme ----------------------------------------------------------------------------
 @dataclass
-class ProgrammeResult:
-    """What the results of the WSP and the odometry bench share: the programme's name and (a
-    field of each subclass) ``cases``, the summary dict of every case."""
-
-    programme: str
-
-    @property
-    def failed(self) -> list:
-        """Names of the cases that did not run to the end or failed a check."""
-        return [c["name"] for c in self.cases if not c.get("passed", False)]
-
-    @staticmethod
-    def table_row(summary: dict) -> dict:
-        """The scalar figures of a case's (or a fit's) ``summary``, a row of the tables."""
-        return {k: v for k, v in summary.items() if not isinstance(v, dict | list)}
-
-    @staticmethod
-    def add_checks(row: dict, summary: dict) -> dict:
-        """``row`` with a column ``check_<name>`` (passed or not) per check of ``summary``."""
-        for name, check in summary.get("checks", {}).items():
-            row[f"check_{name}"] = check["passed"]
-        return row
-
-
-@dataclass
 class WSPProgrammeResult(ProgrammeResult):
     """Results of :func:`run_wsp_programme`: one summary dict per case (failed cases with
     ``status = "error"`` and the message), and the overall figures."""
@@ -1082,91 +935,32 @@ def run_wsp_programme(programme="default", controller=None, *, out=None,
         prog = prog.select(cases)
     ctrl = load_controller(controller, control_period=control_period,
                            wsp_settings=prog.wsp or None)
-    dry_cache: dict = {}
+    return _WSPRun(prog.name, ctrl).run(prog.cases, out=out, figures=figures,
+                                        histories=histories, progress=progress)
 
-    def failed(case, message, seconds):
-        return {**case.describe(), "controller": getattr(ctrl, "label", "?"), "status": "error",
+
+class _WSPRun(ProgrammeRun):
+    """:func:`run_wsp_programme`'s loop: the controller under test on every case."""
+
+    case_errors = (WSPControllerError, SimulationError, ValueError, ArithmeticError)
+    no_record = (None, None)  # no histories, no trace
+
+    def __init__(self, programme: str, controller):
+        super().__init__(programme, controller)
+        self.dry_cache: dict = {}  # the dry and no-WSP stops, shared by the cases
+
+    def run_case(self, case):
+        return run_wsp_case(case, self.unit, dry_cache=self.dry_cache)
+
+    def error_summary(self, case, message, seconds):
+        return {**case.describe(), "controller": self.label, "status": "error",
                 "message": message, "passed": False, "wall_time_s": seconds}
 
-    def result(results):
-        return WSPProgrammeResult(prog.name, getattr(ctrl, "label", "?"), results,
-                                  _overall(results))
+    def result(self, summaries):
+        return WSPProgrammeResult(self.programme, self.label, summaries, _overall(summaries))
 
-    return run_programme_cases(
-        prog, lambda case: run_wsp_case(case, ctrl, dry_cache=dry_cache), (None, None),
-        (WSPControllerError, SimulationError, ValueError, ArithmeticError), failed, result,
-        write_programme_outputs, getattr(ctrl, "close", None), out=out, figures=figures,
-        histories=histories, progress=progress)
-
-
-def run_programme_cases(prog, run_case, no_records: tuple, errors, failed, make_result,
-                        write_outputs, close=None, *, out=None, figures: bool = True,
-                        histories: bool = False, progress=None):
-    """The loop of a bench over the cases of the programme ``prog`` (the WSP and the odometry
-    bench): ``run_case(case)`` gives ``(summary, *records)``; an exception of the types
-    ``errors`` records the case as ``failed(case, "Type: message", wall time [s])`` with the
-    records ``no_records``. With ``out``, after every case ``write_outputs(result, out,
-    case=(case, summary, *records), figures=figures, histories=histories)`` rewrites the
-    outputs, ``result = make_result(summaries so far)``; at the end (``figures``) with
-    ``summary_figure=True``. ``progress(index, number of cases, case name)`` is called before
-    each case, ``close()`` after the last, also on an error. Returns the result."""
-    results = []
-    outdir = Path(out) if out is not None else None
-    try:
-        for k, case in enumerate(prog.cases):
-            if progress is not None:
-                progress(k, len(prog.cases), case.name)
-            started = _time.perf_counter()
-            try:
-                summary, *records = run_case(case)
-            except errors as exc:
-                summary = failed(case, f"{type(exc).__name__}: {exc}",
-                                 _time.perf_counter() - started)
-                records = no_records
-            results.append(summary)
-            if outdir is not None:
-                write_outputs(make_result(results), outdir, case=(case, summary, *records),
-                              figures=figures, histories=histories)
-    finally:
-        if close is not None:
-            close()
-    result = make_result(results)
-    if outdir is not None and figures and results:
-        write_outputs(result, outdir, summary_figure=True)
-    return result
-
-
-def json_safe(obj):
-    """A JSON-safe copy of nested dicts and lists: NaN and inf become null, NumPy scalars
-    Python numbers."""
-    if isinstance(obj, dict):
-        return {str(k): json_safe(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [json_safe(v) for v in obj]
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    if hasattr(obj, "item") and not isinstance(obj, str | bytes):
-        return json_safe(obj.item())
-    return obj
-
-
-def write_json(path: Path, doc) -> Path:
-    """Write ``doc`` (made :func:`json_safe`) as indented UTF-8 JSON, through a temporary file
-    so that a reader never sees half a file (the benches rewrite their summary after every
-    case). Returns ``path``."""
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(json.dumps(json_safe(doc), indent=2, ensure_ascii=False) + "\n",
-                   encoding="utf-8")
-    tmp.replace(path)
-    return path
-
-
-def save_figure(fig, out: Path, name: str, dpi: int) -> Path:
-    """Save a bench figure as ``out/figures/<name>.png`` and return its path."""
-    (out / "figures").mkdir(exist_ok=True)
-    path = out / "figures" / f"{name}.png"
-    fig.savefig(path, dpi=dpi)
-    return path
+    def write_outputs(self, result, out, **options):
+        return write_programme_outputs(result, out, **options)
 
 
 def write_programme_outputs(result: WSPProgrammeResult, out, *, case=None,
@@ -1176,56 +970,23 @@ def write_programme_outputs(result: WSPProgrammeResult, out, *, case=None,
     ``case = (case, summary, histories, trace)``, that case's ``cases/<name>.json``, figure
     ``figures/<name>.png`` and (``histories``) ``histories/<name>.parquet``; with
     ``summary_figure`` the figure across cases ``figures/summary.png``. Returns the paths."""
-    def tables(out):
-        result.frame().to_csv(out / "cases.csv", index=False, float_format="%.6g")
-        axles = result.axle_frame()
-        axles.to_csv(out / "axles.csv", index=False, float_format="%.6g")
-        return [out / "cases.csv", out / "axles.csv"]
-
-    def case_figure():
-        from railadhesion.braking.figures import wsp_case_figure
-
-        return wsp_case_figure(h, trace, bench_case.vehicle.wheel_radius,
-                               title=f"{bench_case.name}: {bench_case.adhesion.describe()}")
-
-    def across_cases():
-        from railadhesion.braking.figures import wsp_summary_figure
-
-        return wsp_summary_figure(result.cases)
-
+    out = Path(out)
     doc = {"format": "railadhesion-wsp-results", "programme": result.programme,
            "controller": result.controller, "overall": result.overall, "cases": result.cases}
-    bench_case, summary, h, trace = case or (None,) * 4
-    return write_bench_outputs(out, doc, tables, case and (bench_case.name, summary),
-                               case_figure if h is not None and figures else None,
-                               (lambda: h) if h is not None and histories else None,
-                               across_cases if summary_figure else None, dpi=90)
-
-
-def write_bench_outputs(out, doc, tables, case=None, figure=None, history=None,
-                        summary_figure=None, *, dpi: int) -> list:
-    """The outputs of a bench (the WSP and the odometry bench) in the folder ``out`` (made if
-    needed), in this order: ``summary.json`` (``doc``), the tables ``tables(out)`` writes (it
-    returns their paths); for ``case = (name, summary)`` ``cases/<name>.json``, the figure
-    ``figure()`` as ``figures/<name>.png`` and the DataFrame ``history()`` as
-    ``histories/<name>.parquet``; the figure ``summary_figure()`` as ``figures/summary.png``
-    (figures at ``dpi``; each callable only if given). Returns the paths written."""
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    written = [write_json(out / "summary.json", doc)]
-    written += tables(out)
+    written = write_summary(out, doc, {"cases.csv": result.frame(),
+                                       "axles.csv": result.axle_frame()})
     if case is not None:
-        name, summary = case
-        (out / "cases").mkdir(exist_ok=True)
-        written.append(write_json(out / "cases" / f"{name}.json", summary))
-        if figure is not None:
-            written.append(save_figure(figure(), out, name, dpi))
-        if history is not None:
-            (out / "histories").mkdir(exist_ok=True)
-            path = out / "histories" / f"{name}.parquet"
-            history().to_parquet(path, index=False)
-            written.append(path)
-    if summary_figure is not None:
-        written.append(save_figure(summary_figure(), out, "summary", dpi))
-    return written
+        bench_case, summary, h, trace = case
+        figure = None
+        if h is not None and figures:
+            from railadhesion.braking.figures import wsp_case_figure
 
+            figure = wsp_case_figure(h, trace, bench_case.vehicle.wheel_radius,
+                                     title=f"{bench_case.name}: {bench_case.adhesion.describe()}")
+        written += write_case(out, bench_case.name, summary, figure,
+                              h if histories else None, dpi=90)
+    if summary_figure:
+        from railadhesion.braking.figures import wsp_summary_figure
+
+        written.append(save_figure(wsp_summary_figure(result.cases), out, "summary", 90))
+    return written

@@ -34,6 +34,20 @@ from pathlib import Path
 
 import numpy as np
 
+from railadhesion.braking._bench_common import (
+    ProgrammeResult,
+    ProgrammeRun,
+    case_field,
+    fmu_variable_problems,
+    load_component,
+    read_cosim_fmu,
+    read_programme_file,
+    release_fmu,
+    save_figure,
+    select_cases,
+    write_case,
+    write_summary,
+)
 from railadhesion.braking._fields import (
     BrakingFileError,
     FieldError,
@@ -46,18 +60,8 @@ from railadhesion.braking._fields import (
 )
 from railadhesion.braking.bench import (
     BenchCase,
-    ProgrammeResult,
-    case_field,
-    fmu_variable_problems,
-    load_component,
     load_controller,
     programme_from_document,
-    read_cosim_fmu,
-    read_programme_file,
-    release_fmu,
-    run_programme_cases,
-    select_cases,
-    write_bench_outputs,
 )
 from railadhesion.braking.odometry import STATUS_BITS, ReferenceOdometry
 from railadhesion.braking.sensors import (
@@ -1018,18 +1022,29 @@ def run_odometry_programme(programme="default", odometry=None, *, out=None, figu
     if cases:
         prog = prog.select(cases)
     odo = load_odometry(odometry, period=period)
-    label = getattr(odo, "label", "?")
+    return _OdometryRun(prog.name, odo).run(prog.cases, out=out, figures=figures,
+                                            histories=histories, progress=progress)
 
-    def failed(case, message, seconds):
-        return {**case.describe(), "odometry": label, "status": "error", "message": message,
-                "passed": False, "fits": [], "wall_time_s": seconds}
 
-    return run_programme_cases(
-        prog, lambda case: run_odometry_case(case, odo), (None,),
-        (SimulationError, ValueError, ArithmeticError), failed,
-        lambda results: OdometryProgrammeResult(prog.name, label, results, _overall(results)),
-        write_odometry_outputs, odo.close, out=out, figures=figures, histories=histories,
-        progress=progress)
+class _OdometryRun(ProgrammeRun):
+    """:func:`run_odometry_programme`'s loop: the odometry under test on every case."""
+
+    case_errors = (SimulationError, ValueError, ArithmeticError)
+    no_record = (None,)  # no traces
+
+    def run_case(self, case):
+        return run_odometry_case(case, self.unit)
+
+    def error_summary(self, case, message, seconds):
+        return {**case.describe(), "odometry": self.label, "status": "error",
+                "message": message, "passed": False, "fits": [], "wall_time_s": seconds}
+
+    def result(self, summaries):
+        return OdometryProgrammeResult(self.programme, self.label, summaries,
+                                       _overall(summaries))
+
+    def write_outputs(self, result, out, **options):
+        return write_odometry_outputs(result, out, **options)
 
 
 def write_odometry_outputs(result: OdometryProgrammeResult, out, *, case=None,
@@ -1039,40 +1054,39 @@ def write_odometry_outputs(result: OdometryProgrammeResult, out, *, case=None,
     fit), ``violations.csv`` (every violation event) and, for ``case = (case, summary,
     traces)``, ``cases/<name>.json``, ``figures/<name>.png`` and (``histories``)
     ``histories/<name>.parquet``; with ``summary_figure``, ``figures/summary.png``."""
-
-    def tables(out):
-        result.frame().to_csv(out / "fits.csv", index=False, float_format="%.6g")
-        result.violation_frame().to_csv(out / "violations.csv", index=False,
-                                        float_format="%.6g")
-        return [out / "fits.csv", out / "violations.csv"]
-
-    def case_figure():
-        from railadhesion.braking.figures import odometry_case_figure
-
-        return odometry_case_figure(tr, summary, title=f"{ocase.name}: "
-                                    f"{ocase.run.adhesion.describe()}")
-
-    def history():
-        import pandas as pd
-
-        cols = {"time": tr["time"], "train_speed": tr["speed"],
-                "distance": tr["distance"], "drive": tr["drive"]}
-        for k, a in enumerate(ocase.axles):
-            cols[f"creep_{a}"] = tr["creep"][:, k]
-        for name, rec in tr["outputs"].items():
-            for k, what in enumerate(_OUTPUTS):
-                cols[f"{name}:{what}"] = rec[:, k]
-        return pd.DataFrame(cols)
-
-    def across_cases():
-        from railadhesion.braking.figures import odometry_summary_figure
-
-        return odometry_summary_figure(result.cases)
-
+    out = Path(out)
     doc = {"format": "railadhesion-odometry-results", "programme": result.programme,
            "odometry": result.odometry, "overall": result.overall, "cases": result.cases}
-    ocase, summary, tr = case or (None,) * 3
-    return write_bench_outputs(out, doc, tables, case and (ocase.name, summary),
-                               case_figure if tr is not None and figures else None,
-                               history if tr is not None and histories else None,
-                               across_cases if summary_figure else None, dpi=80)
+    written = write_summary(out, doc, {"fits.csv": result.frame(),
+                                       "violations.csv": result.violation_frame()})
+    if case is not None:
+        ocase, summary, tr = case
+        figure = history = None
+        if tr is not None and figures:
+            from railadhesion.braking.figures import odometry_case_figure
+
+            figure = odometry_case_figure(tr, summary, title=f"{ocase.name}: "
+                                          f"{ocase.run.adhesion.describe()}")
+        if tr is not None and histories:
+            history = _samples_frame(ocase, tr)
+        written += write_case(out, ocase.name, summary, figure, history, dpi=80)
+    if summary_figure:
+        from railadhesion.braking.figures import odometry_summary_figure
+
+        written.append(save_figure(odometry_summary_figure(result.cases), out, "summary", 80))
+    return written
+
+
+def _samples_frame(case: OdometryCase, tr: dict):
+    """A case's samples (the traces of :func:`run_odometry_case`) as a DataFrame: the truth,
+    the creepage of the odometry axles and every fit's outputs (``<fit>:<output>``)."""
+    import pandas as pd
+
+    cols = {"time": tr["time"], "train_speed": tr["speed"],
+            "distance": tr["distance"], "drive": tr["drive"]}
+    for k, a in enumerate(case.axles):
+        cols[f"creep_{a}"] = tr["creep"][:, k]
+    for name, rec in tr["outputs"].items():
+        for k, what in enumerate(_OUTPUTS):
+            cols[f"{name}:{what}"] = rec[:, k]
+    return pd.DataFrame(cols)
