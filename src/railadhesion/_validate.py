@@ -16,6 +16,7 @@ __all__ = [
     "check_nonnegative",
     "check_range",
     "check_choice",
+    "instance_or_default",
 ]
 
 
@@ -78,6 +79,19 @@ def check_choice(value: str, name: str, choices) -> str:
     """``value`` if it is one of ``choices``, else ``ValueError`` listing them."""
     if value not in choices:
         raise ValueError(f"{name} must be one of {sorted(choices)}, got {value!r}")
+    return value
+
+
+def instance_or_default(value, cls: type, name: str, default, *, expected: str | None = None):
+    """An optional argument that must be a ``cls`` (a parameter set, settings): ``default()``
+    when ``value`` is None, else ``value``; a ValueError names the argument ``name`` and the
+    type given otherwise. ``expected`` words what is allowed in that message (default
+    ``"a <cls name>"``)."""
+    if value is None:
+        value = default()
+    if not isinstance(value, cls):
+        expected = f"a {cls.__name__}" if expected is None else expected
+        raise ValueError(f"{name} must be {expected}, got {type(value).__name__}")
     return value
 
 
