@@ -28,7 +28,7 @@ PACKAGE = "railadhesion"
 #: Floors from the ground up: a top-level unit (a subpackage or a module of the package; ``""``
 #: is the package's ``__init__``) imports only from its own unit or from lower floors.
 FLOORS: tuple[tuple[str, ...], ...] = (
-    ("_validate", "_labelled", "_jit", "plausibility", "numerics", "simd"),
+    ("_validate", "_docstrings", "_labelled", "_jit", "plausibility", "numerics", "simd"),
     ("contact",),
     ("models",),
     ("", "io"),

@@ -19,6 +19,7 @@ __all__ = [
     "check_range",
     "check_choice",
     "check_number",
+    "instance_or_default",
 ]
 
 
@@ -111,6 +112,19 @@ def check_number(value, name: str, low: float, high: float, *, unit: str = "",
         rb = ")" if high_open else "]"
         in_unit = f" {unit}" if unit else ""
         raise ValueError(f"{name} must be in {lb}{low:g}, {high:g}{rb}{in_unit}, got {value!r}")
+
+
+def instance_or_default(value, cls: type, name: str, default, *, expected: str | None = None):
+    """An optional argument that must be a ``cls`` (a parameter set, settings): ``default()``
+    when ``value`` is None, else ``value``; a ValueError names the argument ``name`` and the
+    type given otherwise. ``expected`` words what is allowed in that message (default
+    ``"a <cls name>"``)."""
+    if value is None:
+        value = default()
+    if not isinstance(value, cls):
+        expected = f"a {cls.__name__}" if expected is None else expected
+        raise ValueError(f"{name} must be {expected}, got {type(value).__name__}")
+    return value
 
 
 def _show(arr: np.ndarray) -> str:

@@ -18,7 +18,12 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from railadhesion._validate import check_finite, check_nonnegative, check_positive
+from railadhesion._validate import (
+    check_finite,
+    check_nonnegative,
+    check_positive,
+    instance_or_default,
+)
 
 # The named contact geometries live in railadhesion.contact (re-exported here, where they
 # were first defined, for compatibility).
@@ -42,11 +47,8 @@ _WATER_LABEL = "water flow rate $w$ [µl/s]"
 def _params(params):
     from railadhesion.models.wilac import WilacParameters, default_wilac_parameters
 
-    if params is None:
-        return default_wilac_parameters()
-    if not isinstance(params, WilacParameters):
-        raise ValueError(f"params must be a WilacParameters or None, got {type(params).__name__}")
-    return params
+    return instance_or_default(params, WilacParameters, "params", default_wilac_parameters,
+                               expected="a WilacParameters or None")
 
 
 def _axes(ax, figsize=(6.4, 4.4)):

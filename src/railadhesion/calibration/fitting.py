@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares
 
+from railadhesion._docstrings import docstring_entries
 from railadhesion._validate import check_finite, check_nonnegative, check_positive, check_range
 from railadhesion.plausibility import UntrustedResultWarning, fit_warnings, noise_rms, warn
 
@@ -442,12 +443,8 @@ _WARN_UNTRUSTED_DOC = """warn_untrusted : bool, default True
         gate flags the fit (its findings are in ``warnings`` either way)."""
 
 
-def _fit_docs(func):
-    """``func`` with :data:`_WARN_UNTRUSTED_DOC` in place of ``{warn_untrusted}`` in its
-    docstring."""
-    if func.__doc__:  # None under python -OO
-        func.__doc__ = func.__doc__.replace("{warn_untrusted}", _WARN_UNTRUSTED_DOC)
-    return func
+#: Puts :data:`_WARN_UNTRUSTED_DOC` in place of ``{warn_untrusted}`` in a fit's docstring.
+_fit_docs = docstring_entries(warn_untrusted=_WARN_UNTRUSTED_DOC)
 
 
 # ---------------------------------------------------------------------------------------------

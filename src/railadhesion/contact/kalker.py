@@ -29,6 +29,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from railadhesion._docstrings import docstring_entries
 from railadhesion._labelled import labelled
 from railadhesion._validate import (
     check_finite,
@@ -434,9 +435,7 @@ CREEPAGE_PARAMETERS = """creep_long : array_like
 def creepage_docs(func):
     """``func`` with :data:`CREEPAGE_PARAMETERS` in place of ``{creepages}`` in its docstring
     (a module-level function: the entries are indented for it)."""
-    if func.__doc__:  # None under python -OO
-        func.__doc__ = func.__doc__.replace("{creepages}", CREEPAGE_PARAMETERS)
-    return func
+    return docstring_entries(creepages=CREEPAGE_PARAMETERS)(func)
 
 
 def check_creepages(creep_long, creep_lat, spin) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -53,7 +53,6 @@ import numpy as np
 
 from railadhesion._validate import (
     as_float_array,
-    check_finite,
     check_nonnegative,
     check_positive,
     check_range,
@@ -61,6 +60,7 @@ from railadhesion._validate import (
 from railadhesion.contact.exact import check_friction_law
 from railadhesion.contact.friction import falling_friction_factor
 from railadhesion.contact.kalker import (
+    check_creepages,
     kalker_coefficients,
     kalker_law,
     kalker_rows,
@@ -799,9 +799,7 @@ def _check_inputs(values):
     """Raise the ValueError naming the first input of :func:`exact_table_forces` out of its
     range (the compiled loop validates in the same pass and calls this to raise)."""
     xi, eta, phi, fz, a, b, mu, g, nu, v, ratio, decay = values
-    check_finite(xi, "creep_long")
-    check_finite(eta, "creep_lat")
-    check_finite(phi, "spin")
+    check_creepages(xi, eta, phi)
     check_nonnegative(fz, "normal_force")
     a_ = check_positive(a, "a")
     b_ = check_positive(b, "b")

@@ -25,6 +25,7 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
+from railadhesion._validate import instance_or_default
 from railadhesion.export.fmu import (
     RUNS_PYTHON,
     FmuVariable,
@@ -116,9 +117,7 @@ def build_monitor_fmu(out, vehicle="coach_default", settings=None, *, pressure=T
 
     if not isinstance(vehicle, Vehicle):
         vehicle = load_vehicle(vehicle)
-    settings = settings if settings is not None else MonitorSettings()
-    if not isinstance(settings, MonitorSettings):
-        raise ValueError(f"settings must be a MonitorSettings, got {type(settings).__name__}")
+    settings = instance_or_default(settings, MonitorSettings, "settings", MonitorSettings)
     if not (pressure or torque):
         raise ValueError("the FMU needs brake-pressure or torque inputs (pressure or torque)")
     with tempfile.TemporaryDirectory() as tmp:
@@ -271,9 +270,7 @@ def build_native_monitor_fmu(out, vehicle="coach_default", settings=None, *, pre
     from railadhesion.export.native import build_step_fmu
     from railadhesion.monitor import MonitorSettings
 
-    settings = settings if settings is not None else MonitorSettings()
-    if not isinstance(settings, MonitorSettings):
-        raise ValueError(f"settings must be a MonitorSettings, got {type(settings).__name__}")
+    settings = instance_or_default(settings, MonitorSettings, "settings", MonitorSettings)
     model = monitor_step_model(vehicle, settings, pressure=pressure, torque=torque)
     variables = [r.variable for r in model.variables]
     description = (f"railadhesion {railadhesion.__version__}: on-board adhesion monitor, "

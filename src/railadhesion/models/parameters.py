@@ -132,17 +132,6 @@ class PolachParameters:
         return dataclasses.replace(self, **changes)
 
 
-def instance_or_default(value, cls: type, name: str, default):
-    """An optional argument that must be a ``cls`` (a parameter set, settings): ``default()``
-    when ``value`` is None, else ``value``; a ValueError names the argument ``name`` and the
-    type given otherwise."""
-    if value is None:
-        value = default()
-    if not isinstance(value, cls):
-        raise ValueError(f"{name} must be a {cls.__name__}, got {type(value).__name__}")
-    return value
-
-
 _POLACH2005_SOURCE = (
     "Polach O., Creep forces in simulations of traction vehicles running on adhesion limit, "
     "Wear 258 (2005) 992-1000, as quoted in third-party codes, labelled typical locomotive "

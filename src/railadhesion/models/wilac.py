@@ -27,10 +27,14 @@ import math
 import numpy as np
 
 from railadhesion._labelled import labelled
-from railadhesion._validate import as_float_array, check_nonnegative, check_positive
+from railadhesion._validate import (
+    as_float_array,
+    check_nonnegative,
+    check_positive,
+    instance_or_default,
+)
 from railadhesion.contact.kalker import kalker_law
 from railadhesion.models import wilac_parameters as _parameters
-from railadhesion.models.parameters import instance_or_default
 from railadhesion.models.polach import (
     CONTACT_ROWS,
     ROW_A,

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from railadhesion.models.parameters import instance_or_default
+from railadhesion._validate import instance_or_default
 from railadhesion.monitor import layout
 from railadhesion.monitor.settings import POLACH_RATIO, MonitorSettings
 

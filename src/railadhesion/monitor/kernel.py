@@ -123,13 +123,25 @@ def _finite(x):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _others_mean(values, flags, use_flags, i, n):
-    """Mean of the finite ``values`` of the axles other than i (only those with
-    ``flags[j] != 0`` if ``use_flags``) and their count; NaN when there are none."""
+def _others_mean(values, i, n):
+    """Mean of the finite ``values`` of the axles other than i and their count; NaN when
+    there are none."""
     total = 0.0
     cnt = 0
     for j in range(n):
-        if j != i and (not use_flags or flags[j] != 0) and _finite(values[j]):
+        if j != i and _finite(values[j]):
+            total += values[j]
+            cnt += 1
+    return (total / cnt if cnt > 0 else _NAN), cnt
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _flagged_others_mean(values, flags, i, n):
+    """:func:`_others_mean` over the axles with ``flags[j] != 0`` only."""
+    total = 0.0
+    cnt = 0
+    for j in range(n):
+        if j != i and flags[j] != 0 and _finite(values[j]):
             total += values[j]
             cnt += 1
     return (total / cnt if cnt > 0 else _NAN), cnt
@@ -815,7 +827,7 @@ def step_record(cfg, inp, st, out, bank):
             if stuck >= 0.0:
                 code, v1, v2 = R_STUCK_WHEEL, w, stuck
         if code == 0 and hp and n > 1:  # a pressure that does not move while the others do
-            others, cnt = _others_mean(inp.brake_pressure, cfg.has_torque, False, i, n)
+            others, cnt = _others_mean(inp.brake_pressure, i, n)
             stuck = _stuck(st.p_value, st.p_since, st.p_oref, i, p, t, others, cnt > 0,
                            cfg.stuck_pressure_time, 1e4)
             if stuck >= 0.0:
@@ -823,7 +835,7 @@ def step_record(cfg, inp, st, out, bank):
         if code == 0 and ht and n > 1:  # the same for a torque: the others' mean moved by
             # 4 sigma_tau (about 5 standard deviations of a change of a three-axle mean);
             # exactly 0 is an unpowered or idle axle, not a stuck one
-            others, cnt = _others_mean(inp.torque, cfg.has_torque, True, i, n)
+            others, cnt = _flagged_others_mean(inp.torque, cfg.has_torque, i, n)
             stuck = _stuck(st.tau_value, st.tau_since, st.tau_oref, i, tau, t, others,
                            tau != 0.0 and cnt > 0, cfg.stuck_pressure_time,
                            max(4.0 * cfg.sig_tau, 1.0))
