@@ -250,3 +250,79 @@ def test_mixed_batch_equals_cases_alone():
 def test_bad_method_names_the_argument():
     with pytest.raises(ValueError, match="method must be"):
         exact_rolling(*HARD["circle"], nx=8, ny=8, method="multigrid")
+
+
+# ------------------------------------------------------------------ careless and extreme input
+
+
+def test_solver_inputs_are_checked():
+    g, wx, wy, op = _problem(HARD["circle"], 12)
+    bad = [
+        (dict(g=-g), "g"),
+        (dict(g=np.where(g > 0, np.inf, 0.0)), "g"),
+        (dict(wx=wx * np.nan), "wx"),
+        (dict(g=g[:-1]), "g must have the operator's grid shape"),
+        (dict(tol=2.0), "tol"),
+        (dict(tol=0.0), "tol"),
+        (dict(max_steps=0), "max_steps"),
+        (dict(max_steps=2.5), "max_steps"),
+        (dict(px=np.zeros_like(g)), "px and py"),
+    ]
+    for change, match in bad:
+        kw = dict(g=g, wx=wx, wy=wy, tol=1e-6)
+        kw.update(change)
+        with pytest.raises(ValueError, match=match):
+            solve_steady_rolling(kw.pop("g"), kw.pop("wx"), kw.pop("wy"), op, **kw)
+    with pytest.raises(ValueError, match="restart"):
+        gmres(lambda v: v, np.ones(3), 1e-6, restart=0)
+    with pytest.raises(ValueError, match="kxx, kxy, kyy"):
+        RollingOperator(np.zeros((4, 4)), np.zeros((4, 4)), np.zeros((4, 4)))
+
+
+def test_integer_bound_and_products_per_solve():
+    g, wx, wy, op = _problem(HARD["fastsim"], 16)
+    first = solve_steady_rolling(g, wx, wy, op)
+    second = solve_steady_rolling(g, wx, wy, op)
+    assert first.products == second.products > 0  # per solve, not cumulative
+    lam = 1e9  # a bound of order 1e3-1e6, as integers
+    as_int = solve_steady_rolling(np.round(g * lam).astype(int), wx * lam, wy * lam, op)
+    assert as_int.converged
+
+
+def test_scale_invariance_down_to_tiny_bounds():
+    """(p, w, g) -> lambda (p, w, g) is a symmetry: bounds of 1e-200 solve as well as of 1."""
+    g, wx, wy, op = _problem(HARD["wide"], 16)
+    ref = solve_steady_rolling(g, wx, wy, op, tol=1e-9)
+    for lam in (1e-200, 1e100):
+        sol = solve_steady_rolling(g * lam, wx * lam, wy * lam, op, tol=1e-9)
+        assert sol.converged
+        atol = 1e-9 * np.abs(ref.px).max()
+        np.testing.assert_allclose(sol.px / lam, ref.px, rtol=1e-7, atol=atol)
+        np.testing.assert_array_equal(sol.state, ref.state)
+
+
+@ANY_INPUT
+def test_friction_falling_to_almost_nothing():
+    """Creepage 1 at 50 m/s with A = 0, B = 10 s/m: the local friction falls by 1e-200; Newton
+    must neither crash nor stall."""
+    r = exact_rolling(1.0, 0.0, 0.0, FZ, 5e-3, 5e-3, MU, nx=12, ny=12, method="newton",
+                      speed=50.0, friction_ratio=0.0, friction_decay=10.0)  # fmt: skip
+    assert np.isfinite(r.fx) and abs(float(r.fx)) < 1e-100 * FZ
+    assert int(r.friction_iterations) < 200
+
+
+def test_empty_batch_names_the_requested_method():
+    for method in ("gauss-seidel", "newton"):
+        r = exact_rolling(np.array([]), 0.0, 0.0, FZ, 5e-3, 5e-3, MU, nx=8, ny=8, method=method)
+        assert r.method == method and r.fx.shape == (0,)
+
+
+@ANY_INPUT
+@pytest.mark.parametrize("name", ["fastsim", "long"])
+def test_coarse_start_grids(name):
+    """Grids from 24 elements up start from a coarser grid's solution (26 x 25 -> 13 x 13)."""
+    case = HARD[name]
+    gs = exact_rolling(*case, nx=26, ny=25, method="gauss-seidel")
+    nw = exact_rolling(*case, nx=26, ny=25, method="newton")
+    assert nw.method == "newton" and int(nw.iterations) <= 8
+    assert abs(float(gs.fy - nw.fy)) <= 1e-6 * _mu_q(case)

@@ -8,24 +8,28 @@ where ``|p| < g``; ``p = -g s/|s|`` where ``s != 0``. ``K`` is the rolling opera
 convolution (its kernel from ``exact._rolling_kernel``).
 
 Coulomb's law is written as the projection equation ``F(p) = p - P_g(p - r s(p)) = 0``
-(``P_g`` the projection on the disc of radius g, any r > 0; Alart & Curnier, Comput. Methods
-Appl. Mech. Eng. 92, 1991, for this form of the friction law), and solved by a semismooth
-Newton method (Qi & Sun, Math. Program. 58, 1993; for frictional contact, Hintermueller,
-Ito & Kunisch, SIAM J. Optim. 13, 2002, as the primal-dual active set): each step fixes the
-stick set and the slip directions of the current iterate and solves the linearised equations.
-The linear systems are solved by restarted GMRES (Saad & Schultz, SIAM J. Sci. Stat. Comput.
-7, 1986) with the products by ``K`` done by 2-D FFT on the zero-padded grid (the
-Toeplitz structure of the influence coefficients, as in CONTACT: Vollebregt, J. Comput.
-Phys. 257, 2014), preconditioned on the right by the summation along the rolling direction
-from the leading edge (the inverse of the rolling difference ``(u_I - u_{I+})/dx`` that
-dominates ``K``; what is left is close to the half-space compliance). The step lengths of
-GMRES follow the forcing terms of Eisenstat & Walker (SIAM J. Sci. Comput. 17, 1996), with a
-backtracking line search on ``|F|``.
+(``P_g`` the projection on the disc of radius g; any r > 0, one scalar for both components, or
+the slip would no longer be parallel to the traction; Alart & Curnier, Comput. Methods Appl.
+Mech. Eng. 92, 1991, for this form of the friction law), and solved by a semismooth Newton
+method (Qi & Sun, Math. Program. 58, 1993; for frictional contact, Christensen, Klarbring, Pang
+& Stroemberg, Int. J. Numer. Methods Eng. 42, 1998): each step fixes the stick set and the slip
+directions of the current iterate and solves the linearised equations. The linear systems are
+solved by restarted GMRES (Saad & Schultz, SIAM J. Sci. Stat. Comput. 7, 1986) with the
+products by ``K`` done by 2-D FFT on the zero-padded grid (the Toeplitz structure of the
+influence coefficients, as in CONTACT: Vollebregt, J. Comput. Phys. 257, 2014), preconditioned
+on the right by the summation along the rolling direction from the leading edge (the inverse
+of the rolling difference ``(u_I - u_{I+})/dx`` that dominates ``K``; what is left is close to
+the half-space compliance). GMRES's tolerance per step is Eisenstat & Walker's choice 2 (SIAM
+J. Sci. Comput. 17, 1996; without their safeguard), never tighter than the stop needs; a
+backtracking line search on ``|F|`` guards each step.
 
-The solution is the same discrete solution as the Gauss-Seidel solver's (both stop on the
-same residual measure); with a start from a coarser grid's solution (done by
-:func:`railadhesion.contact.exact.exact_rolling`) a case takes 3-5 Newton steps. Everything
-here is plain NumPy and :mod:`scipy.fft`; the cost is in the FFTs.
+The solution is the discrete solution the Gauss-Seidel solver finds; the two stop on
+comparable, not identical, measures (here ``max |F|``, a Jacobi step with the true diagonal;
+there the change of a sweep), so the same ``tol`` gives about the same accuracy. With a start
+from a coarser grid's solution (done by :func:`railadhesion.contact.exact.exact_rolling`) a
+case takes 3-6 Newton steps. Everything here is plain NumPy and :mod:`scipy.fft`; the cost is
+in the FFTs. Used by ``exact_rolling``; not a public API (the operator is built from the
+exact solver's kernel).
 """
 
 from __future__ import annotations
@@ -35,7 +39,9 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.fft as sfft
+from scipy.linalg import solve_triangular
 
+from railadhesion._validate import check_finite, check_nonnegative, check_range
 from railadhesion.numerics import jit
 
 __all__ = ["RollingOperator", "SteadySolution", "gmres", "solve_steady_rolling"]
@@ -52,6 +58,14 @@ class RollingOperator:
     """
 
     def __init__(self, kxx, kxy, kyy):
+        shapes = {np.shape(k) for k in (kxx, kxy, kyy)}
+        if len(shapes) != 1 or len(next(iter(shapes))) != 2 or any(
+            v % 2 == 0 for v in next(iter(shapes))
+        ):
+            raise ValueError(
+                "kxx, kxy, kyy must be 2-D arrays of one shape (2 my - 1, 2 mx - 1) (odd "
+                f"lengths), got shapes {[np.shape(k) for k in (kxx, kxy, kyy)]}"
+            )
         ny_off, nx_off = np.shape(kxx)
         self.my = (ny_off + 1) // 2
         self.mx = (nx_off + 1) // 2
@@ -73,7 +87,8 @@ class RollingOperator:
         self._buf32 = np.zeros((2, *self.fft_shape), np.float32)
         #: ``K(0)``, the (x, y) coefficients of an element's traction in its own slip
         self.diagonal = (float(kxx[self.my - 1, self.mx - 1]), float(kyy[self.my - 1, self.mx - 1]))
-        #: products by K done so far (the measure of cost)
+        #: products by K done so far by this operator (the measure of cost); the buffers are
+        #: reused, so one operator serves one thread at a time
         self.products = 0
 
     def __call__(self, px, py, single=False):
@@ -111,6 +126,11 @@ def gmres(matvec, rhs, rtol, restart=40, max_products=400):
     rotations for the least-squares problem. Stops when ``|rhs - A x| <= rtol |rhs|`` or
     after ``max_products`` products. Returns ``(x, products, relative residual)``.
     """
+    if isinstance(restart, bool) or not isinstance(restart, int | np.integer) or restart < 1:
+        raise ValueError(f"restart must be an integer >= 1, got {restart!r}")
+    if isinstance(max_products, bool) or not isinstance(max_products, int | np.integer) or \
+            max_products < 1:  # fmt: skip
+        raise ValueError(f"max_products must be an integer >= 1, got {max_products!r}")
     n = rhs.size
     x = np.zeros(n)
     bnorm = float(np.linalg.norm(rhs))
@@ -149,7 +169,7 @@ def gmres(matvec, rhs, rtol, restart=40, max_products=400):
             if hn == 0.0 or rel <= rtol or products >= max_products:
                 break
             basis[k + 1] = w / hn
-        y = np.linalg.solve(np.triu(hess[:k_used, :k_used]), e[:k_used])
+        y = solve_triangular(hess[:k_used, :k_used], e[:k_used])
         x += y @ basis[:k_used]
         if rel <= rtol or products >= max_products:
             return x, products, rel
@@ -200,7 +220,7 @@ class SteadySolution:
     newton_steps: int
     """Newton steps taken."""
     products: int
-    """Products by the rolling operator (the cost)."""
+    """Products by the rolling operator in this solve (the cost)."""
     residual: float
     """``max |F(p)|`` over the largest traction."""
     converged: bool
@@ -257,34 +277,57 @@ def solve_steady_rolling(
     Parameters
     ----------
     g : ndarray
-        Traction bound ``mu p_n / G`` per element, shape (my, mx); 0 outside the contact.
+        Traction bound ``mu p_n / G`` per element, >= 0 and finite, shape (my, mx) of the
+        operator's grid; 0 outside the contact.
     wx, wy : ndarray
         Rigid slip per element [-], (my, mx).
     operator : RollingOperator
         The rolling operator of the grid.
     tol : float, optional
         Stop when ``max |F(p)| <= tol max |p|`` (F as in the module doc, with
-        ``r = 1/mean(K(0))``: the change a Jacobi step with the local solution would make,
-        the measure of the Gauss-Seidel solver's stop).
+        ``r = 1/mean(K(0))``: the change a Jacobi step with the local solution would make;
+        comparable to the Gauss-Seidel solver's stop, not the same), in [1e-14, 0.1].
     px, py : ndarray, optional
         Start (tractions over G); projected on the bound. Default 0.
     max_steps : int, optional
-        Largest number of Newton steps; ``converged`` is False when they run out.
+        Largest number of Newton steps, >= 1; ``converged`` is False when they run out, or
+        when a step finds no decrease of ``|F|``.
 
     Returns
     -------
     SteadySolution
     """
+    shape = (operator.my, operator.mx)
+    g = check_nonnegative(g, "g")
+    wx, wy = check_finite(wx, "wx"), check_finite(wy, "wy")
+    for name, v in (("g", g), ("wx", wx), ("wy", wy)):
+        if v.shape != shape:
+            raise ValueError(f"{name} must have the operator's grid shape {shape}, got {v.shape}")
+    if not np.all(np.isfinite(g)):
+        raise ValueError("g must be finite (a traction bound >= 0 per element)")
+    tol = float(check_range(tol, "tol", 1e-14, 1e-1))
+    if isinstance(max_steps, bool) or not isinstance(max_steps, int | np.integer) or \
+            max_steps < 1:  # fmt: skip
+        raise ValueError(f"max_steps must be an integer >= 1, got {max_steps!r}")
+    if (px is None) != (py is None):
+        raise ValueError("px and py must be given together (the start), or neither")
+    products0 = operator.products
     inside = g > 0.0
     gmax = float(g.max()) if g.size else 0.0
-    zero = np.zeros_like(g)
+    zero = np.zeros(shape)
     if gmax <= 0.0:
         return SteadySolution(zero.copy(), zero.copy(), wx.copy(), wy.copy(),
-                              np.zeros(g.shape, np.int8), 0, 0, 0.0, True)  # fmt: skip
+                              np.zeros(shape, np.int8), 0, 0, 0.0, True)  # fmt: skip
+    # the problem is invariant under (p, w, g) -> (p, w, g)/gmax: solved at a bound of order 1
+    # whatever mu p_n/G is (no underflow in norms and floors), scaled back at the end
+    g = g / gmax
+    wx, wy = wx / gmax, wy / gmax
     r = 2.0 / (operator.diagonal[0] + operator.diagonal[1])
-    if px is None or py is None:
+    if px is None:
         px, py = zero.copy(), zero.copy()
     else:
+        px = check_finite(px, "px") / gmax
+        py = check_finite(py, "py") / gmax
         pt = np.hypot(px, py)
         f = np.where(pt > g, g / np.where(pt > 0.0, pt, 1.0), 1.0) * inside
         px, py = px * f, py * f
@@ -299,7 +342,7 @@ def solve_steady_rolling(
         f = np.where(slip, g / np.maximum(nz, tiny), 1.0) * inside
         qx, qy = f * zx, f * zy  # P_g(z), the projected traction
         fx, fy = px - qx, py - qy
-        pref = max(float(np.max(np.hypot(qx, qy))), 1e-12 * gmax)
+        pref = max(float(np.max(np.hypot(qx, qy))), 1e-12)  # the bound is scaled to 1
         err = max(float(np.max(np.abs(fx))), float(np.max(np.abs(fy)))) / pref
         return (fx, fy, sx, sy, zx, zy, nz, slip), err
 
@@ -328,24 +371,32 @@ def solve_steady_rolling(
         eta = min(0.1, 0.9 * (err / last_err) ** 2) if steps > 1 else 0.1
         eta = min(max(eta, 0.3 * tol / err), 0.1)
         rhs = -np.concatenate((fx[rows, cols], fy[rows, cols]))
-        y, _, _ = gmres(jac, rhs, eta)
+        try:
+            y, _, _ = gmres(jac, rhs, eta)
+        except np.linalg.LinAlgError:  # a breakdown: leave the case unconverged
+            break
         _sum_from_leading_edge(y, where, dpx, dpy)
-        # backtracking on |F| (2-norm): full step unless it fails to decrease
+        # backtracking on |F| (2-norm): the full step unless it fails to decrease; no step
+        # that decreases it in 5 halvings: stop, unconverged (the caller hands over)
         fnorm = math.sqrt(float(np.sum(fx * fx + fy * fy)))
         lam = 1.0
+        accepted = None
         for _ in range(5):
             cand = (px + lam * dpx, py + lam * dpy)
             res, err_new = evaluate(*cand)
             if math.sqrt(float(np.sum(res[0] ** 2 + res[1] ** 2))) <= (1.0 - 1e-4 * lam) * fnorm:
+                accepted = (cand, res, err_new)
                 break
             lam *= 0.5
+        if accepted is None:
+            break
         last_err = err
-        px, py = cand
-        (fx, fy, sx, sy, zx, zy, nz, slip), err = res, err_new
+        (px, py), (fx, fy, sx, sy, zx, zy, nz, slip), err = accepted
     state = np.where(inside, np.where(slip, 2, 1), 0).astype(np.int8)
     sx = np.where(slip, sx, 0.0)
     sy = np.where(slip, sy, 0.0)
     # the returned tractions satisfy the bound exactly, and lie on it in slip
     pt = np.hypot(px, py)
     f = np.where((pt > g) | (slip & (pt > 0.0)), g / np.where(pt > 0.0, pt, 1.0), 1.0) * inside
-    return SteadySolution(px * f, py * f, sx, sy, state, steps, operator.products, err, err <= tol)
+    return SteadySolution(px * (f * gmax), py * (f * gmax), sx * gmax, sy * gmax, state, steps,
+                          operator.products - products0, err, err <= tol)  # fmt: skip
