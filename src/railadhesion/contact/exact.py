@@ -15,14 +15,16 @@ default mode, for two bodies of identical (quasi-identical) elastic materials:
 * Coulomb's law: ``|p| <= mu p_n``; ``s = 0`` where ``|p| < mu p_n`` (stick), else
   ``p = -mu p_n s/|s|`` (slip).
 
-The contact problem is solved by an element-wise Gauss-Seidel iteration, sweeping from the
+The contact problem is solved by one of two solvers of the same discrete equations
+(``exact_rolling(method=...)``). An element-wise Gauss-Seidel iteration, sweeping from the
 trailing to the leading edge, with the exact local solution of Coulomb's law per element
-(stick trial, else a scalar Newton iteration for the slip direction), in numba-compiled code.
-The influence sums are done by FFT along the columns of the grid (convolution in y, zero
-padded; the Toeplitz structure of the coefficients, as in CONTACT: Vollebregt, J. Comput.
-Phys. 257, 2014), which leaves the iteration unchanged and costs O(nx ny (nx + ny)) per sweep
-instead of O((nx ny)^2) (``_gauss_seidel``). Many cases are solved in one compiled loop
-(:func:`exact_rolling` broadcasts).
+(stick trial, else a scalar Newton iteration for the slip direction), in numba-compiled code;
+its influence sums by FFT along the columns of the grid (convolution in y, zero padded; the
+Toeplitz structure of the coefficients, as in CONTACT: Vollebregt, J. Comput. Phys. 257, 2014),
+which leaves the iteration unchanged and costs O(nx ny (nx + ny)) per sweep instead of
+O((nx ny)^2) (``_gauss_seidel``). Or a semismooth Newton method with GMRES and 2-D FFT
+products (:mod:`railadhesion.contact.rolling_newton`), started from a coarser grid's
+solution: few steps whatever the grid, the default from 40 x 40 elements.
 
 Extensions, as in CONTACT: slip-velocity dependent (falling) friction, solved by an outer
 fixed-point iteration on the slip-velocity field (:func:`exact_rolling`, Notes); and the
@@ -896,7 +898,7 @@ def _start_tractions(px, py, g, restart):
 
 
 @jit(error_model="python")
-def _solve_hertz_batch(
+def _gauss_seidel_batch(
     xi, eta, phi, fz, a, b, mu, gmod, nu, mx, my, scale, spin_offset, tol, max_iter, out_f,
     out_iter, out_err, px_all, py_all, sx_all, sy_all, state_all, mu_all, keep_fields, warm,
     shape_in,
@@ -976,12 +978,17 @@ class _BatchOutput:
     newton: np.ndarray  # bool: case solved by Newton (False: Gauss-Seidel)
 
 
+def _is_coulomb(friction_ratio, friction_decay, speed):
+    """Whether the friction law is Coulomb's: A = 1, or B V = 0 (works on arrays)."""
+    return (friction_ratio == 1.0) | (friction_decay * speed == 0.0)
+
+
 def _solve_cases(idx, flat, shape_in, opts, out: _BatchOutput, newton: bool) -> None:
     """Solve the cases ``idx`` of the flat inputs into ``out``: Coulomb cases by the compiled
     Gauss-Seidel loop, or by Newton when ``newton``; falling-friction cases one by one, the
     outer iteration on the slip velocity around either solver."""
     nx, ny, scale, spin_offset, tol, max_iter, tol_f, max_f, keep, warm = opts
-    coulomb = (flat[10][idx] == 1.0) | (flat[11][idx] * flat[9][idx] == 0.0)
+    coulomb = _is_coulomb(flat[10][idx], flat[11][idx], flat[9][idx])
     by_loop = idx[:0] if newton else idx[coulomb]
     if by_loop.size:
         m = by_loop.size
@@ -992,7 +999,7 @@ def _solve_cases(idx, flat, shape_in, opts, out: _BatchOutput, newton: bool) -> 
             mu_sub = np.empty((m, ny, nx))
         else:
             f_sub, st_sub, mu_sub = out.fields, out.state, out.mu_local
-        _solve_hertz_batch(
+        _gauss_seidel_batch(
             *[np.ascontiguousarray(v[by_loop]) for v in flat[:9]], nx, ny, scale, spin_offset,
             tol, max_iter, o_f, o_it, o_err, *f_sub, st_sub, mu_sub, keep, warm, shape_in,
         )  # fmt: skip
@@ -1019,7 +1026,8 @@ def _coarse_start(case, mx, my, scale, spin_offset, nu, xh, yh, operators):
     """Start (tractions over G, or None) for the case on the (mx, my) grid with element
     centres ``xh, yh``: the Newton solution on a grid half as fine, itself started the same
     way, interpolated. This nested iteration of multigrid practice (Briggs, Henson &
-    McCormick, *A Multigrid Tutorial*, 2000, ch. 3) leaves 3-5 Newton steps on the fine grid."""
+    McCormick, *A Multigrid Tutorial*, 2000, ch. 3) leaves 3-6 Newton steps on the fine grid.
+    The coarse grids carry Hertz's pressure even when the case has another (a start only)."""
     if min(mx, my) < 2 * _COARSE_MIN:
         return None, None
     mc, nc = (mx + 1) // 2, (my + 1) // 2
@@ -1060,14 +1068,18 @@ def _solve_one_by_one(idx, flat, shape_in, opts, out: _BatchOutput, newton: bool
     operators: dict = {}
     kernels: dict = {}
     last_key = None
+    op = None
     for c in idx:
         case = tuple(float(v[c]) for v in flat[:8])
-        nu, speed, ratio, decay = (float(flat[k][c]) for k in (8, 9, 10, 11))
+        nu, speed, fratio, decay = (float(flat[k][c]) for k in (8, 9, 10, 11))
         dx, dy = _case_fields(*case, scale, spin_offset, xh, yh, shape, ssum, g0, wx, wy)
         key = (dy / dx, nu)
-        if key not in kernels:
-            kernels[key] = _case_kernel(nx, ny, key[0], nu)
-        kernel = kernels[key]
+
+        def gs_kernel(key=key):  # the Gauss-Seidel spectra, only when Gauss-Seidel runs
+            if key not in kernels:
+                kernels[key] = _case_kernel(nx, ny, key[0], key[1])
+            return kernels[key]
+
         finished_by_newton = newton
         if newton:
             op = _operator(nx, ny, key[0], nu, operators)
@@ -1079,25 +1091,31 @@ def _solve_one_by_one(idx, flat, shape_in, opts, out: _BatchOutput, newton: bool
             _start_tractions(px, py, g0, not (warm and key == last_key))
         last_key = key
 
-        def inner(g, op=op if newton else None, kernel=kernel):
+        def inner(g, op=op if newton else None, gs_kernel=gs_kernel, label=(int(c), case[:3])):
             nonlocal finished_by_newton
             if op is None:
-                return _gauss_seidel(g, wx, wy, *kernel, tol, max_iter, px, py, sx, sy, st)
+                return _gauss_seidel(g, wx, wy, *gs_kernel(), tol, max_iter, px, py, sx, sy, st)
             sol = solve_steady_rolling(g, wx, wy, op, tol=tol, px=px, py=py,
                                        max_steps=_NEWTON_MAX_STEPS)  # fmt: skip
             px[:], py[:], sx[:], sy[:], st[:] = sol.px, sol.py, sol.sx, sol.sy, sol.state
             if sol.converged:
                 return sol.newton_steps, sol.residual
             finished_by_newton = False  # Gauss-Seidel (always convergent) from Newton's iterate
-            sweeps, err = _gauss_seidel(g, wx, wy, *kernel, tol, max_iter, px, py, sx, sy, st)
+            sweeps, err = _gauss_seidel(g, wx, wy, *gs_kernel(), tol, max_iter, px, py, sx, sy,
+                                        st)  # fmt: skip
+            if not (np.all(np.isfinite(px)) and np.all(np.isfinite(py))):
+                raise FloatingPointError(
+                    f"exact_rolling: no finite solution for case {label[0]} (creepages "
+                    f"{label[1]}, bound max {float(g.max()):.3g}): please report it"
+                )
             return sol.newton_steps + sweeps, err
 
-        if ratio == 1.0 or decay * speed == 0.0:  # Coulomb
+        if _is_coulomb(fratio, decay, speed):
             it, err = inner(g0)
             outer = 0
             mu_fac[:] = g0 > 0.0
         else:
-            it, err, outer, _ = _falling_friction(g0, inner, speed, ratio, decay, tol_f, max_f,
+            it, err, outer, _ = _falling_friction(g0, inner, speed, fratio, decay, tol_f, max_f,
                                                   sx, sy, mu_fac)  # fmt: skip
         out.newton[c] = finished_by_newton
         _case_forces(px, py, st, shape, xh, yh, case[4], case[5], dx, dy, case[7], out.forces[c])
@@ -1142,7 +1160,8 @@ class ExactResult:
     to Gauss-Seidel counts both."""
     residual: np.ndarray
     """Largest traction change of the last sweep (Gauss-Seidel), or of a local projection
-    step ``p - P_g(p - r s)`` (Newton), relative to the largest traction [-]."""
+    step ``p - P_g(p - r s)`` (Newton), relative to the largest traction [-]: comparable
+    measures of convergence, not the same one."""
     x: np.ndarray | None = None
     """Element-centre x [m], shape (nx,) per case: (*shape, nx)."""
     y: np.ndarray | None = None
@@ -1305,9 +1324,13 @@ def exact_rolling(
         ``spin_offset`` elements upstream of the element centre; CONTACT's FACPHI = 1/6
         (default). Vanishes with the grid size.
     tol : float, optional
-        Stop when no traction component changes by more than ``tol max|p|`` in a sweep.
+        Gauss-Seidel: stop when no traction component changes by more than ``tol max|p|``
+        in a sweep. Newton: stop when a local (Jacobi) step would change no traction by more
+        than ``tol max|p|`` (a comparable measure, about the same accuracy).
     max_iter : int, optional
-        Largest number of Gauss-Seidel sweeps (per friction update with falling friction).
+        Largest number of Gauss-Seidel sweeps (per friction update with falling friction);
+        with Newton, of the sweeps that finish a solve Newton left unfinished (after 60
+        Newton steps, or a step that found no decrease).
     tol_friction, max_friction_iter : optional
         Falling friction only: stop the outer iteration when the slip-velocity field changes
         by less than ``tol_friction`` (relative, 2-norm), or after ``max_friction_iter``
@@ -1316,7 +1339,8 @@ def exact_rolling(
         Also return the grid, tractions, pressure, slip, the stick/slip map and the local
         coefficient of friction.
     warm_start : bool, optional
-        Gauss-Seidel only: start each case from the tractions of the previous case when the
+        Gauss-Seidel only (ignored where Newton solves, so with ``method="auto"`` from
+        40 x 40 elements): start each case from the tractions of the previous case when the
         grid is the same (same a/b and nu): fewer sweeps along creep curves. The results then
         depend on the order of the cases within the tolerance ``tol``. Default False.
     pressure : {"hertz", "discrete"}, optional
@@ -1330,11 +1354,10 @@ def exact_rolling(
     method : {"auto", "newton", "gauss-seidel"}, optional
         Solver of the discrete problem (Notes): semismooth Newton (``"newton"``),
         element-wise Gauss-Seidel (``"gauss-seidel"``), or ``"auto"`` (default): Newton on
-        grids of
-        ``NEWTON_MIN_ELEMENTS`` (1600, 40 x 40) elements or more, Gauss-Seidel below. Both
-        stop on the same residual and give the same solution within ``tol``, with Coulomb or
-        falling friction (the outer iteration on the slip velocity is the same around
-        either); the result's ``method`` says which was used.
+        grids of 1600 elements (40 x 40, ``NEWTON_MIN_ELEMENTS``) or more, Gauss-Seidel
+        below. Both give the same solution within about ``tol``, with Coulomb or falling
+        friction (the outer iteration on the slip velocity is the same around either); the
+        result's ``method`` says which was used.
 
     Returns
     -------
@@ -1373,7 +1396,7 @@ def exact_rolling(
     the influence sums by FFT along the grid's columns (the iteration is the same as with
     direct sums); the sweeps grow with the grid (about 100-300 at 60 x 60), each costing
     ``nx ny (nx + ny)``. *Semismooth Newton*
-    (:func:`railadhesion.contact.solve_steady_rolling`): Coulomb's law as a
+    (``railadhesion.contact.rolling_newton.solve_steady_rolling``): Coulomb's law as a
     projection equation, linearised on the current stick set and slip directions, each
     linear system solved by GMRES with 2-D FFT products, preconditioned by the summation
     along the rolling direction; each case starts from the solution on a grid half as fine
@@ -1444,7 +1467,9 @@ def exact_rolling(
             _solve_cases(idx, flat, shp, opts, out, newton)
             if return_fields:
                 shapes[idx] = shp
-    if out.newton.all():
+    if n == 0:
+        used = "newton" if newton else "gauss-seidel"
+    elif out.newton.all():
         used = "newton"
     elif out.newton.any():
         used = "newton+gauss-seidel"
@@ -1575,7 +1600,7 @@ def solve_tangential(
         return _gauss_seidel(bound, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, float(tol),
                              int(max_iter), px, py, sx, sy, st)  # fmt: skip
 
-    if ratio == 1.0 or decay * v == 0.0:
+    if _is_coulomb(ratio, decay, v):
         it, err = inner(gb)
         outer = 0
     else:
