@@ -195,21 +195,15 @@ def kalker_law(a_over_b, nu, compliance=False):
     i = min(int(s), _NROW - 2)
     f = s - i
     out0 = out1 = out2 = out3 = 0.0
+    rows = _INV_ROWS if compliance else _ROWS  # 1/C, or C (CONTACT), linear in t
     for k in range(4):
-        if compliance:  # 1/C linear in t between the rows
-            c = _nu_blend_compliance(
-                w0, w1, w2,
-                _INV_ROWS[i, k, 0] * (1.0 - f) + _INV_ROWS[i + 1, k, 0] * f,
-                _INV_ROWS[i, k, 1] * (1.0 - f) + _INV_ROWS[i + 1, k, 1] * f,
-                _INV_ROWS[i, k, 2] * (1.0 - f) + _INV_ROWS[i + 1, k, 2] * f,
-            )  # fmt: skip
-        else:  # C linear in t (CONTACT)
-            c = _nu_blend(
-                w0, w1, w2,
-                _ROWS[i, k, 0] * (1.0 - f) + _ROWS[i + 1, k, 0] * f,
-                _ROWS[i, k, 1] * (1.0 - f) + _ROWS[i + 1, k, 1] * f,
-                _ROWS[i, k, 2] * (1.0 - f) + _ROWS[i + 1, k, 2] * f,
-            )  # fmt: skip
+        q0 = rows[i, k, 0] * (1.0 - f) + rows[i + 1, k, 0] * f
+        q1 = rows[i, k, 1] * (1.0 - f) + rows[i + 1, k, 1] * f
+        q2 = rows[i, k, 2] * (1.0 - f) + rows[i + 1, k, 2] * f
+        if compliance:
+            c = _nu_blend_compliance(w0, w1, w2, q0, q1, q2)
+        else:
+            c = _nu_blend(w0, w1, w2, q0, q1, q2)
         if k == 0:
             out0 = c
         elif k == 1:
