@@ -326,3 +326,14 @@ def test_coarse_start_grids(name):
     nw = exact_rolling(*case, nx=26, ny=25, method="newton")
     assert nw.method == "newton" and int(nw.iterations) <= 8
     assert abs(float(gs.fy - nw.fy)) <= 1e-6 * _mu_q(case)
+
+
+def test_newton_reproduces_contacts_fastsim_example():
+    """CONTACT's fastsim example (eve70a/CONTACT ``examples/fastsim.ref_out``, rev. 2707) on its
+    own grid (44 x 44 over 1.1 a x 1.1 b) with its discrete normal pressure: CONTACT prints
+    Fy/(mu Fn) = -0.6074 and Mz = -48.21 N m. By Newton explicitly, whatever ``auto`` picks."""
+    r = exact_rolling(0.0, -0.000625, 0.625, 82e3, 8e-3, 4e-3, 0.3, nx=44, ny=44, scale=1.1,
+                      pressure="discrete", method="newton")  # fmt: skip
+    assert r.method == "newton"
+    assert round(float(r.fy / (0.3 * 82e3)), 4) == -0.6074
+    assert round(float(r.mz), 2) == -48.21
