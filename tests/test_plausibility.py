@@ -360,3 +360,19 @@ def test_flat_wet_curve_fitted_by_the_right_model_is_trusted_and_a_wrong_one_is_
                      initial={"k_A": 0.05, "k_S": 0.05, "A": 1.0, "B": 0.0},
                      warn_untrusted=False)  # fmt: skip
     assert any("R^2" in w for w in res.warnings)
+
+
+def test_friction_coefficient_in_percent_is_sniffed():
+    """mu = 30 meant 30 % (0.3): the exact solver, FASTSIM and the table model each say so;
+    0.3 says nothing."""
+    from railadhesion.contact import exact_rolling, exact_table_forces, fastsim
+
+    args = (1e-3, 0.0, 0.0, 8e4, 6e-3, 5e-3)
+    for call in (lambda mu: exact_rolling(*args, mu, nx=8, ny=8),
+                 lambda mu: fastsim(*args, mu, nx=8, ny=8),
+                 lambda mu: exact_table_forces(*args, mu)):  # fmt: skip
+        with pytest.warns(UnitWarning, match="given in percent"):
+            call(30.0)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            call(0.3)

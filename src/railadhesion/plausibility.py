@@ -193,6 +193,12 @@ PLAUSIBLE: dict[str, PlausibleRange] = {
         "Eurosprinter case 6.3 x 12.6 mm); 0.2 mm small rigs, 50 mm conformal contacts",
         (("mm", 1e-3),),
     ),
+    "friction_coefficient": PlausibleRange(
+        "coefficient of friction (a fraction)", "", 0.0, 1.0,
+        "assumption: dry wheel-rail friction is about 0.4-0.6 (Polach's dry set mu0 = 0.55), "
+        "wet and contaminated rails lower; above 1 it is no wheel-rail value",
+        (("percent", 0.01),),
+    ),
     "shear_modulus": PlausibleRange(
         "shear modulus", "Pa", 2e10, 2e11,
         "steels about 80 GPa (CONTACT's examples: 82 GPa); assumption for the margins",
@@ -262,6 +268,7 @@ ARGUMENT_QUANTITY: dict[str, str] = {
     "speed": "speed", "initial_speed": "speed",
     "a": "semi_axis", "b": "semi_axis",
     "shear_modulus": "shear_modulus",
+    "mu": "friction_coefficient",
     "young": "young", "young_rail": "young",
     "poisson": "poisson", "poisson_rail": "poisson",
     "water_flow": "water_flow",

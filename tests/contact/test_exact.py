@@ -164,6 +164,7 @@ def test_contact_carter2d_example():
 # --------------------------------------------------------------------------- limits
 
 
+@ANY_INPUT  # mu = 1000 on purpose: no slip (the plausibility policy warns)
 def test_linear_theory_at_vanishing_creepage():
     # Kalker's coefficients (package table); 24 x 24 grid: discretisation error < 3.5 %
     # (1 % is reached at 60 x 60: docs/validation/exact_solver.md)

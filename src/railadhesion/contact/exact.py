@@ -1253,7 +1253,7 @@ def _discrete_shape(aob: float, nu: float, nx: int, ny: int, scale: float) -> np
 
 
 #: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
-_PLAUSIBLE = input_checker(("creep_long", "creep_lat", "spin", "normal_force", "a", "b",
+_PLAUSIBLE = input_checker(("creep_long", "creep_lat", "spin", "normal_force", "a", "b", "mu",
                             "shear_modulus", "poisson", "speed"))
 
 
@@ -1504,7 +1504,7 @@ def exact_rolling(
             "state": state.reshape(*shape, ny, nx),
             "mu_local": mu_all.reshape(*shape, ny, nx),
         }
-    _PLAUSIBLE((xi, eta, phi, fz, a_, b_, g_mod, nu, speed))  # implausible inputs warn
+    _PLAUSIBLE((xi, eta, phi, fz, a_, b_, mu_, g_mod, nu, speed))  # implausible inputs warn
     return ExactResult(
         shaped(out_f[:, 0]),
         shaped(out_f[:, 1]),

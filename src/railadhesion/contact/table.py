@@ -620,7 +620,7 @@ def _scalar_forces(xi, eta, phi, fz, a, b, mu, g, nu, speed, ratio, decay):
 
 
 #: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
-_PLAUSIBLE = input_checker(("creep_long", "creep_lat", "spin", "normal_force", "a", "b",
+_PLAUSIBLE = input_checker(("creep_long", "creep_lat", "spin", "normal_force", "a", "b", "mu",
                             "speed", "shear_modulus", "poisson"))
 
 
@@ -732,7 +732,7 @@ def exact_table_forces(
         if res is not None:
             # implausible inputs warn (docs/checks.md); no speed: nothing to check (0.0 keeps
             # the checker's fast test for floats)
-            _PLAUSIBLE((creep_long, creep_lat, spin, normal_force, a, b,
+            _PLAUSIBLE((creep_long, creep_lat, spin, normal_force, a, b, mu,
                         0.0 if speed is None else speed, shear_modulus, poisson))  # fmt: skip
             return res
     names = ("creep_long", "creep_lat", "spin", "normal_force", "a", "b", "mu",
@@ -766,7 +766,7 @@ def exact_table_forces(
         _check_inputs(values)
         raise AssertionError("table kernel flagged an input the checks accept")
     # implausible inputs warn (docs/checks.md)
-    _PLAUSIBLE((creep_long, creep_lat, spin, normal_force, a, b, speed, shear_modulus,
+    _PLAUSIBLE((creep_long, creep_lat, spin, normal_force, a, b, mu, speed, shear_modulus,
                 poisson))  # fmt: skip
     if not shape:
         return float(fx[0]), float(fy[0]), float(mz[0])
