@@ -349,19 +349,7 @@ def _hertz_core(q, ca, cb, young, poisson, young_rail, poisson_rail) -> HertzCon
     minor = c * np.sqrt(k)
     a = np.where(a_le_b_curv, major, minor)
     b = np.where(a_le_b_curv, minor, major)
-    p0 = 3.0 * q / (2.0 * np.pi * a * b)
-    return HertzContact(
-        a=_scalar_or_array(a),
-        b=_scalar_or_array(b),
-        max_pressure=_scalar_or_array(p0),
-        approach=_scalar_or_array(approach),
-        curvature_A=_scalar_or_array(ca),
-        curvature_B=_scalar_or_array(cb),
-        mean_radius=_scalar_or_array(rho),
-        c=_scalar_or_array(c),
-        normal_force=_scalar_or_array(q),
-        effective_modulus=_scalar_or_array(e_star),
-    )
+    return _hertz_result(_scalar_or_array, a, b, approach, ca, cb, rho, c, q, e_star)
 
 
 def _hertz_scalar(q: float, ca: float, cb: float, e_star: float) -> HertzContact:
@@ -373,17 +361,23 @@ def _hertz_scalar(q: float, ca: float, cb: float, e_star: float) -> HertzContact
     approach = 2.0 * c * c * k * kk / (rho * ee)
     major, minor = c / math.sqrt(k), c * math.sqrt(k)
     a, b = (major, minor) if a_le_b_curv else (minor, major)
+    return _hertz_result(float, a, b, approach, ca, cb, rho, c, q, e_star)
+
+
+def _hertz_result(convert, a, b, approach, ca, cb, rho, c, q, e_star) -> HertzContact:
+    """The :class:`HertzContact` of a solved problem, p0 = 3Q/(2 pi a b), every field passed
+    through ``convert`` (:func:`_scalar_or_array` for arrays, ``float`` for the scalar path)."""
     return HertzContact(
-        a=a,
-        b=b,
-        max_pressure=3.0 * q / (2.0 * math.pi * a * b),
-        approach=approach,
-        curvature_A=ca,
-        curvature_B=cb,
-        mean_radius=rho,
-        c=c,
-        normal_force=q,
-        effective_modulus=e_star,
+        a=convert(a),
+        b=convert(b),
+        max_pressure=convert(3.0 * q / (2.0 * np.pi * a * b)),
+        approach=convert(approach),
+        curvature_A=convert(ca),
+        curvature_B=convert(cb),
+        mean_radius=convert(rho),
+        c=convert(c),
+        normal_force=convert(q),
+        effective_modulus=convert(e_star),
     )
 
 
