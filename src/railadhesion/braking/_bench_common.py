@@ -140,6 +140,15 @@ def release_fmu(fmu) -> None:
         pass
 
 
+def whole_multiple(period: float, step: float, what: str, of: str) -> int:
+    """``period / step``, a whole number >= 1 (to 1e-9 of ``period``), else ``ValueError``:
+    "``what`` (``period`` s) must be a whole multiple of ``of`` (``step`` s)"."""
+    ratio = int(round(period / step))
+    if ratio < 1 or abs(ratio * step - period) > 1e-9 * period:
+        raise ValueError(f"{what} ({period} s) must be a whole multiple of {of} ({step} s)")
+    return ratio
+
+
 # -- the loop over the cases, the result -----------------------------------------------------
 @dataclass
 class ProgrammeResult:

@@ -45,6 +45,7 @@ from railadhesion.braking._bench_common import (
     release_fmu,
     save_figure,
     select_cases,
+    whole_multiple,
     write_case,
     write_summary,
 )
@@ -757,10 +758,7 @@ def run_wsp_case(case: BenchCase, controller=None, *, dry_cache: dict | None = N
     n = vehicle.n_axles
     cyl = case.cylinders
     period = ctrl.period
-    ratio = int(round(period / case.dt))
-    if ratio < 1 or abs(ratio * case.dt - period) > 1e-9 * period:
-        raise ValueError(f"the control period ({period} s) must be a whole multiple of the "
-                         f"time step ({case.dt} s)")
+    whole_multiple(period, case.dt, "the control period", "the time step")
     adhesion = case.adhesion.build()
     sim = BrakingSimulator(vehicle, adhesion, case.initial_speed, cylinders=cyl,
                            gradient=case.gradient, max_step=case.dt, record=True)

@@ -45,6 +45,7 @@ from railadhesion.braking._bench_common import (
     release_fmu,
     save_figure,
     select_cases,
+    whole_multiple,
     write_case,
     write_summary,
 )
@@ -783,23 +784,16 @@ def run_odometry_case(case: OdometryCase, odometry=None, *, wsp_settings=None):
     run = case.run
     vehicle = run.vehicle
     n = vehicle.n_axles
-    cyl = run.cylinders
-    base = odo.period
     ctrl = None
     if case.wsp:
         ctrl = load_controller(None, wsp_settings=wsp_settings)
         ctrl.prepare(run)
-        base = ctrl.period
-    ratio = int(round(odo.period / base))
-    if ratio < 1 or abs(ratio * base - odo.period) > 1e-9 * odo.period:
-        raise ValueError(f"the odometry period ({odo.period} s) must be a whole multiple of the "
-                         f"WSP's control period ({base} s)")
-    steps = int(round(base / run.dt))
-    if steps < 1 or abs(steps * run.dt - base) > 1e-9 * base:
-        raise ValueError(f"the control period ({base} s) must be a whole multiple of the time "
-                         f"step ({run.dt} s)")
-    sim = BrakingSimulator(vehicle, run.adhesion.build(), run.initial_speed, cylinders=cyl,
-                           gradient=run.gradient, max_step=run.dt, record=False)
+    base = odo.period if ctrl is None else ctrl.period
+    ratio = whole_multiple(odo.period, base, "the odometry period", "the WSP's control period")
+    whole_multiple(base, run.dt, "the control period", "the time step")
+    sim = BrakingSimulator(vehicle, run.adhesion.build(), run.initial_speed,
+                           cylinders=run.cylinders, gradient=run.gradient, max_step=run.dt,
+                           record=False)
     live = sim.live
     inputs = sim.inputs
     w_sens = run.sensor_model()
