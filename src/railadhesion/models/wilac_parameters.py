@@ -22,6 +22,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from railadhesion._docstrings import docstring_entries
 from railadhesion._labelled import labelled
 from railadhesion._validate import check_choice, check_nonnegative, check_positive
 from railadhesion.models.parameters import PARAMETER_RANGES
@@ -197,14 +198,20 @@ def _as_transition_key(transitions) -> tuple:
         raise
 
 
+#: The numpydoc entry of the water flow, shared by :func:`wilac_transitions` and
+#: :func:`wilac_weights` (put in place of ``{water_flow}``).
+_WATER_FLOW_PARAMETER = """water_flow : array_like
+        Water flow rate w to the rail surface [µl/s], finite and >= 0."""
+
+
 @labelled(units="1", leading={"transition": ("e1", "e2", "e3")})
+@docstring_entries(water_flow=_WATER_FLOW_PARAMETER)
 def wilac_transitions(water_flow, transitions=PAPER_TRANSITIONS) -> np.ndarray:
     """Transition functions e_1, e_2, e_3 of the WILAC model.
 
     Parameters
     ----------
-    water_flow : array_like
-        Water flow rate w to the rail surface [µl/s], finite and >= 0.
+    {water_flow}
     transitions : sequence of 3 (midpoint, width) pairs, optional
         Position m_i and width s_i of each transition [µl/s]; default: seed 000, Table 1.
 
@@ -234,13 +241,13 @@ def wilac_transitions(water_flow, transitions=PAPER_TRANSITIONS) -> np.ndarray:
 
 
 @labelled(units="1", leading={"condition": WILAC_CONDITIONS})
+@docstring_entries(water_flow=_WATER_FLOW_PARAMETER)
 def wilac_weights(water_flow, transitions=PAPER_TRANSITIONS) -> np.ndarray:
     """Blending weights f_Dry, f_Damp2, f_Damp1, f_Wet of the WILAC model.
 
     Parameters
     ----------
-    water_flow : array_like
-        Water flow rate w to the rail surface [µl/s], finite and >= 0.
+    {water_flow}
     transitions : sequence of 3 (midpoint, width) pairs, optional
         Transition positions and widths [µl/s]; default: seed 000, Table 1.
 
