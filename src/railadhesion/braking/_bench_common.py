@@ -15,7 +15,7 @@ import time as _time
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from railadhesion.braking._fields import BrakingFileError, FieldError, read_toml
+from railadhesion.braking._fields import read_document
 
 _DATA = Path(__file__).resolve().parent.parent / "data"
 
@@ -52,13 +52,13 @@ def read_programme_file(path, default: str, build):
     :class:`~railadhesion.braking.BrakingFileError` naming the file."""
     if os.fspath(path) == "default":
         path = _DATA / default
-    doc, label = read_toml(path)
-    try:
+
+    def labelled_programme(doc, label):
         prog = build(doc, Path(os.fspath(path)).resolve().parent)
-    except (FieldError, ValueError) as exc:
-        raise BrakingFileError(f"{label}: {exc}") from None
-    prog.source = label
-    return prog
+        prog.source = label
+        return prog
+
+    return read_document(path, labelled_programme)
 
 
 # -- a user's component, an FMU --------------------------------------------------------------

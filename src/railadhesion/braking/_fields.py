@@ -12,8 +12,8 @@ import os
 import tomllib
 from collections.abc import Mapping
 
-__all__ = ["BrakingFileError", "FieldError", "read_toml", "number", "integer", "string",
-           "table", "keys", "boolean"]
+__all__ = ["BrakingFileError", "FieldError", "read_toml", "read_document", "number", "integer",
+           "string", "table", "keys", "boolean"]
 
 
 class BrakingFileError(ValueError):
@@ -48,6 +48,17 @@ def read_toml(path) -> tuple[dict, str]:
         raise BrakingFileError(f"{label}: not valid TOML: {exc}") from None
     except UnicodeDecodeError as exc:
         raise BrakingFileError(f"{label}: not UTF-8 text: {exc}") from None
+
+
+def read_document(path, build):
+    """``build(document, label)`` of the TOML file ``path`` (:func:`read_toml`; ``label`` names
+    the file); a :class:`FieldError` or ``ValueError`` it raises becomes a
+    :class:`BrakingFileError` naming the file."""
+    doc, label = read_toml(path)
+    try:
+        return build(doc, label)
+    except (FieldError, ValueError) as exc:
+        raise BrakingFileError(f"{label}: {exc}") from None
 
 
 def table(value, where: str) -> Mapping:

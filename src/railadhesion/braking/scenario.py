@@ -24,13 +24,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from railadhesion.braking._fields import (
-    BrakingFileError,
     FieldError,
     boolean,
     integer,
     keys,
     number,
-    read_toml,
+    read_document,
     string,
     table,
 )
@@ -398,13 +397,8 @@ def _scenario_from_document(doc: Mapping, base: Path, label: str = "") -> BrakeS
 
 def load_scenario(path) -> BrakeScenario:
     """Read and validate a scenario TOML file (paths inside are relative to the file)."""
-    doc, label = read_toml(path)
-    try:
-        return _scenario_from_document(doc, Path(os.fspath(path)).resolve().parent, label)
-    except FieldError as exc:
-        raise BrakingFileError(f"{label}: {exc}") from None
-    except ValueError as exc:
-        raise BrakingFileError(f"{label}: {exc}") from None
+    return read_document(path, lambda doc, label: _scenario_from_document(
+        doc, Path(os.fspath(path)).resolve().parent, label))
 
 
 def run_scenario(scenario: BrakeScenario, progress=None, dt: float | None = None):

@@ -57,7 +57,7 @@ from railadhesion.braking._fields import (
     integer,
     keys,
     number,
-    read_toml,
+    read_document,
     string,
     table,
 )
@@ -296,13 +296,7 @@ def load_vehicle(path_or_name=DEFAULT_VEHICLE) -> Vehicle:
             )
         with resources.as_file(resource) as p:
             return load_vehicle(p)
-    doc, label = read_toml(text)
-    try:
-        return vehicle_from_document(doc)
-    except FieldError as exc:
-        raise BrakingFileError(f"{label}: {exc}") from None
-    except ValueError as exc:
-        raise BrakingFileError(f"{label}: {exc}") from None
+    return read_document(text, lambda doc, _label: vehicle_from_document(doc))
 
 
 def vehicle_from_field(text: str, where: str, base: Path) -> Vehicle:
