@@ -50,7 +50,6 @@ from railadhesion.braking._bench_common import (
     write_summary,
 )
 from railadhesion.braking._fields import (
-    BrakingFileError,
     FieldError,
     boolean,
     integer,
@@ -362,10 +361,8 @@ def _programme_from_document(doc, base: Path) -> OdometryProgramme:
                "defaults": defaults, "case": wsp_cases}
     if "wsp" in doc:
         wsp_doc["wsp"] = doc["wsp"]
-    try:
-        runs = programme_from_document(wsp_doc, base)
-    except BrakingFileError as exc:
-        raise FieldError("", str(exc)) from None
+    # its BrakingFileError (a ValueError) names the field; read_programme_file adds the file
+    runs = programme_from_document(wsp_doc, base)
     out = []
     for k, (run, extra) in enumerate(zip(runs.cases, extras, strict=True)):
         where = f"case[{k}] ({run.name})"
