@@ -16,8 +16,10 @@ Prints:
 * the table model's cost per contact, vectorised over 100 000 and 1 000 000 contacts with
   spin, beside the package's vectorised Polach on the same inputs in the same run (issue 22
   target: at most 3x Polach): a/b (and Fz) varying per contact (the 4-D lookup, Kalker's
-  coefficients per contact for both models), a and b as arrays of equal values, a and b
-  given once (the 3-D lookup); Coulomb friction, falling friction and nu = 0.25. Both run
+  coefficients per contact for both models; with one nu the table takes them from Kalker's
+  rows at that nu, with nu per contact too it looks them up contact by contact as Polach
+  does), a and b as arrays of equal values, a and b given once (the 3-D lookup); Coulomb
+  friction, falling friction and nu = 0.25. Both run
   in parallel at these sizes (``NUMBA_NUM_THREADS=1`` for one thread).
 
 * with ``--before REV`` (e.g. ``--before 2a7873f``, the solver before its influence sums were
@@ -196,6 +198,7 @@ def _bench_table(n: int, repeat: int) -> None:
     av = rng.uniform(3e-3, 8e-3, n)
     bv = rng.uniform(3e-3, 8e-3, n)
     fzv = rng.uniform(5e4, 1.2e5, n)
+    nuv = rng.uniform(0.25, 0.30, n)  # nu per contact too (Kalker's coefficients per contact)
     ae, be = np.full(n, a), np.full(n, b)  # arrays of equal values
 
     def best(ft, fp):
@@ -215,6 +218,9 @@ def _bench_table(n: int, repeat: int) -> None:
         ("Coulomb, a/b varying",
          lambda: exact_table_forces(xs, ys, ps, fzv, av, bv, mu),
          lambda: polach_forces(xs, ys, ps, fzv, v, av, bv, mu0=mu)),
+        ("Coulomb, a/b and nu varying",
+         lambda: exact_table_forces(xs, ys, ps, fzv, av, bv, mu, poisson=nuv),
+         lambda: polach_forces(xs, ys, ps, fzv, v, av, bv, mu0=mu, poisson=nuv)),
         ("falling, a/b varying",
          lambda: exact_table_forces(xs, ys, ps, fzv, av, bv, mu, **FALLING),
          lambda: polach_forces(xs, ys, ps, fzv, v, av, bv, mu0=mu, A=0.4, B=0.6)),
