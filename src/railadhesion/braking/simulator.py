@@ -299,17 +299,52 @@ def _entry_on_first_call(attributes: dict, name: str, dispatcher):
     rows,] dt) that, on its first call, puts the dispatcher's compiled entry point into
     ``attributes[name]`` (:func:`railadhesion._jit.kernel_entry`; found by a call with
     dt = NaN, which the step refuses before doing anything) and calls it: every later call
-    of ``advance()`` then skips numba's type resolution of the arguments. The arguments
-    keep their types (the simulator's own buffer and rows, dt a float)."""
+    of ``advance()`` then skips numba's type resolution of the arguments (the simulator's
+    ``advance`` is bound to the entry point again: :func:`_stepping`). The arguments keep
+    their types (the simulator's own buffer and rows, dt a float)."""
 
     def first_call(*args):
         from railadhesion._jit import kernel_entry
 
         entry = kernel_entry(dispatcher, (*args[:-1], math.nan))
         attributes[name] = entry
+        attributes["_bind_advance"]()
         return entry(*args)
 
     return first_call
+
+
+def _stepping(sim):
+    """``(advance, bind)``: the simulator ``sim``'s :meth:`BrakingSimulator.advance` as a
+    closure over what a call needs (the step's entry point, the simulator's buffer and history
+    rows, its live state), and the function that binds it to the simulator's current ones
+    (after :meth:`BrakingSimulator._build`, a new block of rows, the entry point bound on the
+    first call). A call then looks up no attribute (each ``self._...`` of a method costs tens
+    of nanoseconds: an instance dictionary that ``__dict__`` made a split table is not
+    specialised by CPython 3.11). Like a bound method, the closure keeps the simulator alive."""
+    handle = sim._handle
+    call = buffer = rows = live = None
+
+    def advance(dt):
+        if dt.__class__ is not float:
+            dt = _as_float(dt)
+        if rows is None:
+            status = call(buffer, dt)
+        else:
+            status = call(buffer, rows, dt)
+        if status > 1:
+            handle(status, dt)
+        return live
+
+    def bind():
+        nonlocal call, buffer, rows, live
+        d = sim.__dict__
+        buffer, rows, live = d["_buffer"], d["_rows"], d["_live"]
+        call = d["_advance"] if rows is None else d["_advance_recorded"]
+
+    for name in ("__module__", "__name__", "__qualname__", "__doc__"):
+        setattr(advance, name, getattr(BrakingSimulator.advance, name))
+    return advance, bind
 
 
 def largest_stable_step(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float):
@@ -570,6 +605,9 @@ class BrakingSimulator:
         d["_blocks"] = []
         d["_live"] = LiveState(machine, n)
         d["_inputs"] = StepInputs(machine, n)
+        if "advance" not in d:  # the same closure after a rebuild (a caller may hold it)
+            d["advance"], d["_bind_advance"] = _stepping(self)
+        d["_bind_advance"]()
 
     def _adhesion_tables(self, st, n):
         """The adhesion model's settings and constant tables, the model family and the
@@ -751,16 +789,16 @@ class BrakingSimulator:
         in the compiled code (a bad value raises ``ValueError`` naming the input and axle).
         A step longer than ``max_step`` is split into equal sub-steps. At rest (after the
         stop) nothing changes any more.
+
+        Each simulator's ``advance`` is this call as a closure over the simulator's records
+        (bound when it is built), which shadows the method: no attribute is looked up per call.
         """
-        if dt.__class__ is not float:
-            dt = _as_float(dt)
-        if self._rows is None:
-            status = self._advance(self._buffer, dt)
-        else:
-            status = self._advance_recorded(self._buffer, self._rows, dt)
-        if status > 1:
-            self._handle(status, dt)
-        return self._live
+        return self.__dict__["advance"](dt)
+
+    def _set_rows(self, rows):
+        """A new block of history rows (the step and :meth:`advance` then write into it)."""
+        self.__dict__["_rows"] = rows
+        self._bind_advance()
 
     def _handle(self, status, dt):
         """Statuses other than OK/STOPPED of a step call: new rows block, or an error."""
@@ -769,7 +807,7 @@ class BrakingSimulator:
             nsub = max(1, int(math.ceil(dt / self.max_step - 1e-9)))
             nrow = int(s["rows_written"])
             self._blocks.append(self._rows[:nrow].copy())
-            self.__dict__["_rows"] = np.empty((max(_ROWS_BLOCK, nsub), self._ncols))
+            self._set_rows(np.empty((max(_ROWS_BLOCK, nsub), self._ncols)))
             s["rows_written"] = 0
             status = self._advance_recorded(self._buffer, self._rows, _as_float(dt))
             if status <= 1:
@@ -890,7 +928,7 @@ class BrakingSimulator:
             if s["rows_written"] > 0:
                 self._blocks.append(self._rows[:int(s["rows_written"])].copy())
             if self._rows.shape[0] != chunk:
-                self.__dict__["_rows"] = np.empty((chunk, self._ncols))
+                self._set_rows(np.empty((chunk, self._ncols)))
             s["rows_written"] = 0
             k_end = min(nmax, int(s["run_step"]) + chunk)
             status = run(self._machine, self._tables, self._rows, float(dt), k_end, self._aux)
