@@ -73,3 +73,19 @@ def test_limits():
     assert math.isclose(mu, 0.5 * (0.6 * math.exp(-36.0) + 0.4), rel_tol=1e-9)
     # no friction left (A = 0, exp underflows): nothing, no NaN
     assert polach_longitudinal(1.0, 1e4, stiffness, 0.5, 0.5, 0.3, 0.0, 5.0)[0] < 1e-300
+
+
+@given(s=st.one_of(st.just(0.0), st.floats(1e-9, 1.0)), v=st.floats(0.0, 100.0),
+       stiffness=st.floats(1.0, 1e3), k_a=st.floats(0.01, 1.0), k_s=st.floats(0.01, 1.0),
+       mu0=st.floats(0.02, 1.0), big_a=st.floats(0.0, 2.0), big_b=st.floats(0.0, 5.0))
+@SETTINGS
+def test_split_into_terms_and_evaluation_gives_the_same_numbers(s, v, stiffness, k_a, k_s, mu0,
+                                                                 big_a, big_b):
+    # the braking lanes keep the creepage-independent terms and evaluate the rest: bit for bit
+    from railadhesion.models.polach import polach_longitudinal_at, polach_longitudinal_terms
+    from railadhesion.numerics import jit
+
+    at, terms = jit(polach_longitudinal_at), jit(polach_longitudinal_terms)
+    slope, ratio = terms(stiffness, k_a, k_s)
+    assert at(s, v, slope, ratio, mu0, big_a, big_b) == polach_longitudinal(
+        s, v, stiffness, k_a, k_s, mu0, big_a, big_b)

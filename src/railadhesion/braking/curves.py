@@ -17,7 +17,9 @@ three functions chosen when the step is compiled by the type of its ``aux`` argu
 * an integer (0): the built-in models, Polach sets on track sections or WILAC with a
   water-flow profile (``settings.model``). Each axle's curve is a weighted sum of Polach
   curves, evaluated by :func:`railadhesion.models.polach.polach_longitudinal` (the law and
-  its analytic slopes) in one loop over *lanes*, one per axle and set of non-zero weight,
+  its analytic slopes; its creepage-independent terms kept per lane, the rest by
+  :func:`~railadhesion.models.polach.polach_longitudinal_at`) in one loop over *lanes*, one
+  per axle and set of non-zero weight,
   which the compiler vectorises: the law is the plain function, inlined into the loop with
   the curve it calls (a call of its compiled dispatcher in the loop body would keep the
   loop scalar);
@@ -56,7 +58,7 @@ from railadhesion.braking.records import (
 )
 from railadhesion.contact.table import exact_table_law
 from railadhesion.models.kernels import wilac_weights_scalar
-from railadhesion.models.polach import polach_longitudinal
+from railadhesion.models.polach import polach_longitudinal_at, polach_longitudinal_terms
 from railadhesion.models.wilac_parameters import (
     wilac_clip,
     wilac_factors,
@@ -87,7 +89,9 @@ def new_workspace() -> np.ndarray:
 @njit(cache=True, error_model="numpy")
 def build_lanes(c, n, kc, weights, params, stiffness):
     """Lanes of every (axle, set) of non-zero weight, axle by axle, into workspace ``c``,
-    padded with lanes of weight 0 to a multiple of ``LANE_BLOCK``.
+    padded with lanes of weight 0 to a multiple of ``LANE_BLOCK``. Each lane holds the part
+    of Polach's curve that depends on its contact and set only
+    (:func:`~railadhesion.models.polach.polach_longitudinal_terms`).
 
     ``weights`` (n, K), ``params`` (n, K, 5) = (k_A, k_S, mu0, A, B), ``stiffness`` (n,) =
     (π/4) G a b C11 / Q per axle.
@@ -101,9 +105,8 @@ def build_lanes(c, n, kc, weights, params, stiffness):
                 continue
             c.lane_axle[j] = i
             c.lane_weight[j] = w
-            c.lane_stiffness[j] = stiffness[i]
-            c.lane_k_a[j] = params[i, k, 0]
-            c.lane_k_s[j] = params[i, k, 1]
+            c.lane_slope[j], c.lane_ratio[j] = polach_longitudinal_terms(
+                stiffness[i], params[i, k, 0], params[i, k, 1])
             c.lane_mu0[j] = params[i, k, 2]
             c.lane_a[j] = params[i, k, 3]
             c.lane_b[j] = params[i, k, 4]
@@ -113,9 +116,8 @@ def build_lanes(c, n, kc, weights, params, stiffness):
     while j % LANE_BLOCK != 0:  # padding: copies of the last lane with weight 0
         c.lane_axle[j] = c.lane_axle[last]
         c.lane_weight[j] = 0.0
-        c.lane_stiffness[j] = c.lane_stiffness[last]
-        c.lane_k_a[j] = c.lane_k_a[last]
-        c.lane_k_s[j] = c.lane_k_s[last]
+        c.lane_slope[j] = c.lane_slope[last]
+        c.lane_ratio[j] = c.lane_ratio[last]
         c.lane_mu0[j] = c.lane_mu0[last]
         c.lane_a[j] = c.lane_a[last]
         c.lane_b[j] = c.lane_b[last]
@@ -127,9 +129,9 @@ def build_lanes(c, n, kc, weights, params, stiffness):
 def _lane_curves(c, speed):
     """The weighted Polach curve of every lane (the loop the compiler vectorises)."""
     for j in range(c.lane_count):
-        m, dm, dv = polach_longitudinal(c.lane_creep[j], speed, c.lane_stiffness[j],
-                                        c.lane_k_a[j], c.lane_k_s[j], c.lane_mu0[j],
-                                        c.lane_a[j], c.lane_b[j])
+        m, dm, dv = polach_longitudinal_at(c.lane_creep[j], speed, c.lane_slope[j],
+                                           c.lane_ratio[j], c.lane_mu0[j], c.lane_a[j],
+                                           c.lane_b[j])
         w = c.lane_weight[j]
         c.lane_mu[j] = w * m
         c.lane_dmu[j] = w * dm

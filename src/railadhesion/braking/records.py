@@ -86,8 +86,8 @@ CURVE = _record([
     ("peak_x2", "f8", _A), ("peak_f1", "f8", _A), ("peak_f2", "f8", _A),
     ("peak_best", "f8", _A), ("peak_side", "i8", _A),
     ("wilac_scratch", "f8", (8, MAX_AXLES)),
-    ("lane_axle", "i8", _L), ("lane_weight", "f8", _L), ("lane_stiffness", "f8", _L),
-    ("lane_k_a", "f8", _L), ("lane_k_s", "f8", _L), ("lane_mu0", "f8", _L),
+    ("lane_axle", "i8", _L), ("lane_weight", "f8", _L), ("lane_slope", "f8", _L),
+    ("lane_ratio", "f8", _L), ("lane_mu0", "f8", _L),
     ("lane_a", "f8", _L), ("lane_b", "f8", _L), ("lane_creep", "f8", _L),
     ("lane_mu", "f8", _L), ("lane_dmu", "f8", _L), ("lane_dmv", "f8", _L),
 ])

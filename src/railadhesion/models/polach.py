@@ -76,6 +76,8 @@ __all__ = [
     "polach_forces",
     "polach_law",
     "polach_longitudinal",
+    "polach_longitudinal_at",
+    "polach_longitudinal_terms",
 ]
 
 _TWO_OVER_PI = 2.0 / math.pi
@@ -199,13 +201,29 @@ def polach_longitudinal(creep, speed, stiffness, k_A, k_S, mu0, A, B):  # noqa: 
     mu_k). No friction left (A = 0 and exp(-B w) underflowed) gives (0, 0, 0), as
     :func:`polach_law` gives no force. Call-free (vectorises when inlined in a loop).
     """
+    slope, ratio = polach_longitudinal_terms(stiffness, k_A, k_S)
+    return polach_longitudinal_at(creep, speed, slope, ratio, mu0, A, B)
+
+
+@jitable(inline="always")
+def polach_longitudinal_terms(stiffness, k_A, k_S):  # noqa: N803
+    """The part of :func:`polach_longitudinal` that depends on the contact and the parameter
+    set only, not on the creepage or the speed: ``(slope, ratio)``, the curve's initial slope
+    (2/pi)(k_A + k_S) K and k_S / k_A (computed once per contact and set by a caller that
+    evaluates the curve at many creepages, then :func:`polach_longitudinal_at`)."""
+    return _TWO_OVER_PI * (k_A + k_S) * stiffness, k_S / k_A
+
+
+@jitable(inline="always")
+def polach_longitudinal_at(creep, speed, slope, ratio, mu0, A, B):  # noqa: N803
+    """:func:`polach_longitudinal` from its :func:`polach_longitudinal_terms` ``slope`` and
+    ``ratio``: ``(mu, dmu/ds, dmu/dV)``, the same numbers. Call-free."""
     w = creep * speed
     mu_k = mu0 * falling_friction_factor(w, A, B)
     dmu_k = mu0 * falling_friction_slope(w, A, B)  # d mu_k / d w
     friction = mu_k > 0.0
     mu_k = mu_k if friction else 1.0  # zeros below
-    slope = _TWO_OVER_PI * (k_A + k_S) * stiffness
-    f, df_ds, _ = polach_curve(creep, slope, 1.0 / mu_k, k_S / k_A)
+    f, df_ds, _ = polach_curve(creep, slope, 1.0 / mu_k, ratio)
     df_dmu = (f - creep * df_ds) / mu_k
     if not friction:
         return 0.0, 0.0, 0.0
