@@ -204,6 +204,31 @@ def test_wilac_axle_parameters_equal_the_library_regressions():
             np.testing.assert_array_equal(weights[a], wilac_weights_scalar(water[a], packed))
 
 
+def test_wilac_axle_parameters_of_weighted_conditions_only():
+    """weighted_only (the braking step's refresh): the conditions some axle of a block of four
+    weights get exactly the full computation's parameters; a condition no axle of a block
+    weights is left as it was there."""
+    from railadhesion.braking.curves import wilac_axle_parameters
+    from railadhesion.braking.records import MAX_AXLES
+    from railadhesion.models.kernels import pack_wilac
+    from railadhesion.models.wilac import default_wilac_parameters
+
+    packed = pack_wilac(default_wilac_parameters())
+    loads = np.array([36e3, 36e3, 21e3, 21e3, 52e3, 52e3])
+    water = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 5.0])  # dry, then a padded block, damper
+    full, weights = np.empty((6, 4, 5)), np.empty((6, 4))
+    wilac_axle_parameters(packed, loads, 31.0, water, weights, full,
+                          np.empty((8, MAX_AXLES)))
+    part = np.full((6, 4, 5), -1.0)
+    wilac_axle_parameters(packed, loads, 31.0, water, np.empty((6, 4)), part,
+                          np.empty((8, MAX_AXLES)), True)
+    for block in (slice(0, 4), slice(4, 6)):
+        used = (weights[block] != 0.0).any(axis=0)
+        assert 0 < used.sum() < 4
+        np.testing.assert_array_equal(part[block][:, used], full[block][:, used])
+        assert (part[block][:, ~used] == -1.0).all()
+
+
 def test_new_parameters_before_the_first_step_rebuild_the_simulator():
     sim = BrakingSimulator(VEHICLE, PolachAdhesion("polach2005_dry"), 10.0)
     sim.max_step = 1e-3

@@ -320,7 +320,8 @@ def water_flow_at(x, values, linear, where):
 
 
 @njit(cache=True, error_model="numpy")
-def wilac_axle_parameters(packed, wheel_loads, speed, water, weights, params, scratch):
+def wilac_axle_parameters(packed, wheel_loads, speed, water, weights, params, scratch,
+                          weighted_only=False):
     """WILAC's weights (n, 4) and Polach parameters (n, 4, 5) of every axle, through the
     WILAC laws of :mod:`railadhesion.models.wilac_parameters`.
 
@@ -334,6 +335,11 @@ def wilac_axle_parameters(packed, wheel_loads, speed, water, weights, params, sc
     their packed indices, where ``wilac_regression`` picks each factor of each term out of a
     tuple through a jump table): the loop differs from ``wilac_regression``'s, the terms,
     their order and the clip do not, and neither do the numbers.
+
+    ``weighted_only``: the parameters of a condition are computed only for the blocks of four
+    axles in which an axle gives it a non-zero weight (the others are left as they were: a
+    curve of weight 0 is not evaluated, :func:`build_lanes`), e.g. two of the four
+    conditions on a dry rail.
     """
     n = wheel_loads.shape[0]
     for a in range(n):
@@ -354,6 +360,13 @@ def wilac_axle_parameters(packed, wheel_loads, speed, water, weights, params, sc
         for j in range(5):
             first, count = wilac_terms(packed, i, j)
             for b in range(0, padded, WILAC_AXLE_BLOCK):  # four sums in registers
+                last = min(b + WILAC_AXLE_BLOCK, n)
+                if weighted_only:
+                    used = False
+                    for a in range(b, last):
+                        used = used or weights[a, i] != 0.0
+                    if not used:
+                        continue
                 s0 = s1 = s2 = s3 = 0.0
                 for t in range(count):
                     p = first + 4 * t
@@ -367,8 +380,8 @@ def wilac_axle_parameters(packed, wheel_loads, speed, water, weights, params, sc
                     s3 = s3 + wilac_term(c, fa[b + 3], fb[b + 3], fc[b + 3])
                 scratch[7, b], scratch[7, b + 1], scratch[7, b + 2], scratch[7, b + 3] = (
                     s0, s1, s2, s3)
-            for a in range(n):
-                params[a, i, j] = wilac_clip(scratch[7, a], packed, j)
+                for a in range(b, last):
+                    params[a, i, j] = wilac_clip(scratch[7, a], packed, j)
 
 
 @njit(cache=True, error_model="numpy")
@@ -415,7 +428,7 @@ def _builtin_refresh(s, st, tables):
     c = s.curve
     wilac_axle_parameters(tables[st.wilac_at:st.wilac_at + st.wilac_count], s.wheel_load[:n],
                           max(s.speed, 0.0), s.water[:n], s.weights[:n], s.params[:n],
-                          c.wilac_scratch)
+                          c.wilac_scratch, True)
     build_lanes(c, n, MAX_CONDITIONS, s.weights, s.params, s.stiffness)
 
 
