@@ -44,9 +44,11 @@ MAX_AXLES = 12
 MAX_CONDITIONS = 4
 #: Largest number of (axle, condition) pairs evaluated together.
 MAX_LANES = MAX_AXLES * MAX_CONDITIONS
-#: The lanes are padded to a multiple of this (the SIMD width in doubles with AVX-512): the
-#: vectorised loop over lanes then has no scalar remainder, which costs more than the padding.
-LANE_BLOCK = 8
+#: The lanes are padded to a multiple of this: the vectorised loop over lanes then has no
+#: scalar remainder, which costs more than the padding. LLVM vectorises it four doubles wide
+#: (256-bit vectors, also where AVX-512 is there, with no interleaving): a block of four
+#: lanes is one vector iteration, and four axles on one Polach set are four lanes, not eight.
+LANE_BLOCK = 4
 #: WILAC's regressions are evaluated for this many axles at once (four sums in
 #: :func:`railadhesion.braking.curves.wilac_axle_parameters`; MAX_AXLES is a multiple).
 WILAC_AXLE_BLOCK = 4
