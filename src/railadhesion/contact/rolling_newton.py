@@ -17,11 +17,12 @@ directions of the current iterate and solves the linearised equations. The linea
 solved by restarted GMRES (Saad & Schultz, SIAM J. Sci. Stat. Comput. 7, 1986) with the
 products by ``K`` done by 2-D FFT on the zero-padded grid (the Toeplitz structure of the
 influence coefficients, as in CONTACT: Vollebregt, J. Comput. Phys. 257, 2014), preconditioned
-on the right by the summation along the rolling direction from the leading edge (the inverse
-of the rolling difference ``(u_I - u_{I+})/dx`` that dominates ``K``; what is left is close to
-the half-space compliance). GMRES's tolerance per step is Eisenstat & Walker's choice 2 (SIAM
-J. Sci. Comput. 17, 1996; without their safeguard), never tighter than the stop needs; a
-backtracking line search on ``|F|`` guards each step.
+on the right by the summation along the rolling direction from the leading edge on the stick
+elements (the inverse of the rolling difference ``(u_I - u_{I+})/dx`` that dominates ``K``;
+what is left is close to the half-space compliance) and by the identity on the slip elements
+(whose equations are dominated by the traction change itself). GMRES's tolerance per step is
+Eisenstat & Walker's choice 2 (SIAM J. Sci. Comput. 17, 1996; without their safeguard), never
+tighter than the stop needs; a backtracking line search on ``|F|`` guards each step.
 
 The solution is the discrete solution the Gauss-Seidel solver finds; the two stop on
 comparable, not identical, measures (here ``max |F|``, a Jacobi step with the true diagonal;
@@ -228,10 +229,13 @@ class SteadySolution:
 
 
 @jit(fastmath=True)
-def _sum_from_leading_edge(v, where, out_x, out_y):
-    """``out = S v``: each row summed from the leading edge (+x, the last column) backwards.
-    ``v`` holds the x then the y components of the contact elements, packed; ``where[j, i]``
-    is the element's index in it, -1 outside the contact (``out`` 0 there)."""
+def _sum_from_leading_edge(v, where, slip, out_x, out_y):
+    """``out = M v``, the right preconditioner: on the stick elements each row summed from
+    the leading edge (+x, the last column) backwards over the stick elements, the inverse of
+    the rolling difference that dominates their equations (``r K dp``); on the slip elements
+    (``slip``, packed) the identity, their equations being dominated by ``dp`` itself. ``v``
+    holds the x then the y components of the contact elements, packed; ``where[j, i]`` is
+    the element's index in it, -1 outside the contact (``out`` 0 there)."""
     my, mx = where.shape
     m = v.size // 2
     for j in range(my):
@@ -239,7 +243,10 @@ def _sum_from_leading_edge(v, where, out_x, out_y):
         ay = 0.0
         for i in range(mx - 1, -1, -1):
             k = where[j, i]
-            if k >= 0:
+            if k >= 0 and slip[k]:
+                out_x[j, i] = v[k]
+                out_y[j, i] = v[m + k]
+            elif k >= 0:
                 ax += v[k]
                 ay += v[m + k]
                 out_x[j, i] = ax
@@ -361,7 +368,7 @@ def solve_steady_rolling(
         c = g[rows, cols] * inv
 
         def jac(v, slip_k=slip_k, nx_=nx_, ny_=ny_, c=c):
-            _sum_from_leading_edge(v, where, dpx, dpy)
+            _sum_from_leading_edge(v, where, slip_k, dpx, dpy)
             kx, ky = operator(dpx, dpy, single=True)
             out = np.empty(v.size)
             _linearised(dpx, dpy, kx, ky, rows, cols, slip_k, nx_, ny_, c, r, out)
@@ -375,7 +382,7 @@ def solve_steady_rolling(
             y, _, _ = gmres(jac, rhs, eta)
         except np.linalg.LinAlgError:  # a breakdown: leave the case unconverged
             break
-        _sum_from_leading_edge(y, where, dpx, dpy)
+        _sum_from_leading_edge(y, where, slip_k, dpx, dpy)
         # backtracking on |F| (2-norm): the full step unless it fails to decrease; no step
         # that decreases it in 5 halvings: stop, unconverged (the caller hands over)
         fnorm = math.sqrt(float(np.sum(fx * fx + fy * fy)))
