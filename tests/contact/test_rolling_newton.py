@@ -14,7 +14,14 @@ from hypothesis import strategies as st
 
 from railadhesion.contact import exact
 from railadhesion.contact.exact import exact_rolling
-from railadhesion.contact.rolling_newton import RollingOperator, gmres, solve_steady_rolling
+from railadhesion.contact.rolling_newton import (
+    DenseRolling,
+    RollingOperator,
+    gmres,
+    gmres_batch,
+    solve_steady_rolling,
+    solve_steady_rolling_batch,
+)
 
 ANY_INPUT = pytest.mark.filterwarnings(
     "ignore::railadhesion.plausibility.PlausibilityWarning",
@@ -337,3 +344,99 @@ def test_newton_reproduces_contacts_fastsim_example():
     assert r.method == "newton"
     assert round(float(r.fy / (0.3 * 82e3)), 4) == -0.6074
     assert round(float(r.mz), 2) == -48.21
+
+
+# ---------------------------------------------------------- many cases of a small grid at once
+
+
+def _dense(n, ratio=1.0):
+    xh, yh, shape, _ = exact._grid_shape(n, n, 1.0, np.empty((0, 0)))
+    kernel = exact._rolling_kernel(n, n, 1.0, ratio, 0.28)
+    return DenseRolling(*kernel, shape > 0), RollingOperator(*kernel)
+
+
+def test_dense_operator_equals_the_fft_product():
+    dense, op = _dense(11, 0.7)
+    rng = np.random.default_rng(8)
+    px, py = rng.normal(size=(2, 3, 11, 11)) * dense.inside
+    k = dense.pack(px, py) @ dense.matrix.T
+    for c in range(3):
+        kx, ky = op(px[c], py[c])
+        ref = dense.pack((kx * dense.inside)[None], (ky * dense.inside)[None])[0]
+        np.testing.assert_allclose(k[c], ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+    fx, fy = dense.unpack(dense.pack(px, py))
+    np.testing.assert_array_equal(fx, px)
+    np.testing.assert_array_equal(fy, py)
+    with pytest.raises(ValueError, match="inside"):
+        DenseRolling(*exact._rolling_kernel(5, 5, 1.0, 1.0, 0.28), np.ones((4, 5), bool))
+
+
+def test_preconditioner_inverts_the_rolling_difference_in_stick_and_is_one_in_slip():
+    """M sums each grid row from the leading edge over the stick elements (the inverse of the
+    backward difference along the row) and leaves the slip elements alone."""
+    from railadhesion.contact import rolling_newton as rn
+
+    dense, _ = _dense(9)
+    rng = np.random.default_rng(9)
+    v = rng.normal(size=(1, 2 * dense.m))
+    slip = rng.random((1, dense.m)) < 0.3
+    out = np.empty_like(v)
+    rn._mixed_precondition(v, dense.rows, np.array([0]), slip, out)
+    where = np.full((9, 9), -1, np.int64)
+    where[dense.rows, dense.cols] = np.arange(dense.m)
+    ox, oy = np.zeros((9, 9)), np.zeros((9, 9))
+    rn._sum_from_leading_edge(v[0], where, slip[0], ox, oy)  # the one-case form: the same
+    np.testing.assert_allclose(dense.pack(ox[None], oy[None]), out, rtol=1e-14)
+    for half in (0, 1):
+        part = out[0, half * dense.m:(half + 1) * dense.m]
+        vin = v[0, half * dense.m:(half + 1) * dense.m]
+        for k in range(dense.m):
+            same_row = np.flatnonzero((dense.rows == dense.rows[k]) & (dense.cols >= dense.cols[k])
+                                      & ~slip[0])  # fmt: skip
+            want = vin[k] if slip[0, k] else vin[same_row].sum()
+            assert part[k] == pytest.approx(want, abs=1e-12)
+
+
+def test_gmres_batch_equals_gmres_case_by_case():
+    """Each case its own Krylov space, stop and solution, restarted or not."""
+    rng = np.random.default_rng(10)
+    n, nb = 40, 7
+    mats = np.eye(n) * 4.0 + rng.normal(size=(nb, n, n)) * 0.4
+    rhs = rng.normal(size=(nb, n))
+    rhs[3] = 0.0  # nothing to solve
+    rtol = np.array([1e-1, 1e-4, 1e-10, 1e-6, 1e-10, 1e-3, 1e-8])
+    x, products, rel = gmres_batch(lambda c, v: np.einsum("bij,bj->bi", mats[c], v), rhs, rtol,
+                                   restart=6, max_products=300)  # fmt: skip
+    for c in range(nb):
+        if c == 3:
+            assert products[c] == 0 and not x[c].any()
+            continue
+        xs, p1, r1 = gmres(lambda v, c=c: mats[c] @ v, rhs[c], rtol[c], restart=6,
+                           max_products=300)  # fmt: skip
+        assert rel[c] <= rtol[c] and products[c] == p1
+        true_rel = np.linalg.norm(rhs[c] - mats[c] @ x[c]) / np.linalg.norm(rhs[c])
+        assert true_rel <= 2 * rtol[c]  # the single-precision basis
+        np.testing.assert_allclose(x[c], xs, atol=5 * rtol[c] * np.abs(xs).max() + 1e-6)
+
+
+def test_batch_solver_inputs_are_checked():
+    dense, _ = _dense(8)
+    g = np.ones((2, dense.m))
+    w = np.zeros((2, 2 * dense.m))
+    bad = [
+        (dict(g=g[:, :-1]), "g must have shape"),
+        (dict(w=w[:1]), "g must have shape"),
+        (dict(g=g * 0.0), "g must be finite and > 0"),
+        (dict(g=g * np.inf), "g must be finite and > 0"),
+        (dict(w=w * np.nan), "w"),
+        (dict(tol=1.0), "tol"),
+        (dict(max_steps=0), "max_steps"),
+    ]
+    for change, match in bad:
+        kw = dict(g=g, w=w)
+        kw.update(change)
+        with pytest.raises(ValueError, match=match):
+            solve_steady_rolling_batch(kw.pop("g"), kw.pop("w"), dense, **kw)
+    sol = solve_steady_rolling_batch(g, w, dense)  # no rigid slip: nothing to do
+    assert sol.converged.all() and not sol.p.any() and not sol.newton_steps.any()
+

@@ -24,6 +24,10 @@ what is left is close to the half-space compliance) and by the identity on the s
 Eisenstat & Walker's choice 2 (SIAM J. Sci. Comput. 17, 1996; without their safeguard), never
 tighter than the stop needs; a backtracking line search on ``|F|`` guards each step.
 
+On small grids, many cases of one grid are solved together (:func:`solve_steady_rolling_batch`):
+the products by ``K`` are then one dense matrix product for all of them
+(:class:`DenseRolling`), each case keeping its own Newton steps, Krylov space and stop.
+
 The solution is the discrete solution the Gauss-Seidel solver finds; the two stop on
 comparable, not identical, measures (here ``max |F|``, a Jacobi step with the true diagonal;
 there the change of a sweep), so the same ``tol`` gives about the same accuracy. With a start
@@ -45,7 +49,16 @@ from scipy.linalg import solve_triangular
 from railadhesion._validate import check_finite, check_nonnegative, check_range
 from railadhesion.numerics import jit
 
-__all__ = ["RollingOperator", "SteadySolution", "gmres", "solve_steady_rolling"]
+__all__ = [
+    "BatchSolution",
+    "DenseRolling",
+    "RollingOperator",
+    "SteadySolution",
+    "gmres",
+    "gmres_batch",
+    "solve_steady_rolling",
+    "solve_steady_rolling_batch",
+]
 
 
 class RollingOperator:
@@ -407,3 +420,382 @@ def solve_steady_rolling(
     f = np.where((pt > g) | (slip & (pt > 0.0)), g / np.where(pt > 0.0, pt, 1.0), 1.0) * inside
     return SteadySolution(px * (f * gmax), py * (f * gmax), sx * gmax, sy * gmax, state, steps,
                           operator.products - products0, err, err <= tol)  # fmt: skip
+
+
+# ---------------------------------------------------------------------------------------------
+# Many cases of one grid at once: dense products, batched GMRES
+# ---------------------------------------------------------------------------------------------
+
+
+class DenseRolling:
+    """The rolling operator of one grid as dense matrices on its contact elements, for solving
+    many cases of that grid at once (:func:`solve_steady_rolling_batch`).
+
+    On small grids a product by ``K`` costs less as one matrix product for a whole batch of
+    cases than as FFTs case by case: the influence matrix is shared by every case of the grid,
+    and a matrix-matrix product runs near the processor's peak. Built from the same kernel as
+    :class:`RollingOperator`, for the elements where ``inside`` is True (the same for every
+    case of the batch); vectors are packed as ``[x components, y components]`` of those
+    elements in row-major order.
+
+    Parameters
+    ----------
+    kxx, kxy, kyy : ndarray
+        Kernel as for :class:`RollingOperator`, shape (2 my - 1, 2 mx - 1).
+    inside : ndarray of bool
+        The contact elements, shape (my, mx).
+    """
+
+    def __init__(self, kxx, kxy, kyy, inside):
+        shape_k = np.shape(kxx)
+        inside = np.asarray(inside, dtype=bool)
+        if any(np.shape(k) != shape_k for k in (kxy, kyy)) or len(shape_k) != 2 or \
+                inside.shape != ((shape_k[0] + 1) // 2, (shape_k[1] + 1) // 2):  # fmt: skip
+            raise ValueError(
+                "kxx, kxy, kyy must have one shape (2 my - 1, 2 mx - 1) and inside (my, mx), "
+                f"got {[np.shape(k) for k in (kxx, kxy, kyy)]} and {inside.shape}"
+            )
+        self.my, self.mx = inside.shape
+        self.inside = inside
+        self.rows, self.cols = np.nonzero(inside)
+        m = self.rows.size
+        self.m = m
+        dj = self.rows[:, None] - self.rows[None, :] + self.my - 1
+        di = self.cols[:, None] - self.cols[None, :] + self.mx - 1
+        bxx, bxy, byy = (np.asarray(k, float)[dj, di] for k in (kxx, kxy, kyy))
+        #: ``K`` on the packed contact elements, (2m, 2m): ``(K p)_k = sum_l K[k, l] p_l``
+        self.matrix = np.block([[bxx, bxy], [bxy, byy]])
+        #: the same in single precision, for the products of the Newton systems
+        self.matrix32 = self.matrix.astype(np.float32)
+        self.diagonal = (float(kxx[self.my - 1, self.mx - 1]), float(kyy[self.my - 1, self.mx - 1]))
+
+    def pack(self, fx, fy):
+        """Packed vectors (B, 2m) of fields (B, my, mx)."""
+        return np.concatenate((fx[:, self.rows, self.cols], fy[:, self.rows, self.cols]), axis=1)
+
+    def unpack(self, v):
+        """Fields (B, my, mx) x and y of packed vectors (B, 2m); 0 outside the contact."""
+        m = self.m
+        fx = np.zeros((v.shape[0], self.my, self.mx))
+        fy = np.zeros_like(fx)
+        fx[:, self.rows, self.cols] = v[:, :m]
+        fy[:, self.rows, self.cols] = v[:, m:]
+        return fx, fy
+
+
+@jit
+def _givens_batch(hess, rot, e, live, h, hn, k, out):
+    """:func:`_givens_column` for the cases ``live`` of a batch (``hess`` (b, M+1, M), ``rot``
+    (b, 2, M), ``e`` (b, M+1); ``h`` (len(live), k+1), ``hn`` (len(live),)); ``out`` receives
+    each case's least-squares residual."""
+    for q in range(live.size):
+        out[q] = _givens_column(hess[live[q]], rot[live[q]], e[live[q]], h[q], hn[q], k)
+
+
+@jit
+def _back_substitute(hess, e, k_used, y):
+    """``y[b, :k] = R_b^{-1} e_b[:k]`` (R the upper triangle of ``hess[b]``, k = ``k_used[b]``);
+    0 beyond. A zero pivot (a breakdown) gives a zero component."""
+    for b in range(k_used.size):
+        k = k_used[b]
+        y[b, :] = 0.0
+        for i in range(k - 1, -1, -1):
+            s = e[b, i]
+            for j in range(i + 1, k):
+                s -= hess[b, i, j] * y[b, j]
+            d = hess[b, i, i]
+            y[b, i] = s / d if d != 0.0 else 0.0
+
+
+def gmres_batch(matvec, rhs, rtol, restart=40, max_products=400):
+    """GMRES(m) for many independent systems ``A_b x_b = rhs_b`` at once (as :func:`gmres`,
+    case by case: each case its own Krylov space, stop and solution; the products of a step
+    are one call for all cases still running).
+
+    ``matvec(cases, V)`` returns ``A_b v_b`` for the cases ``cases`` (indices into the batch)
+    and vectors ``V`` (len(cases), n). ``rhs`` (B, n), ``rtol`` (B,). Returns ``(x, products,
+    relative residual)`` per case.
+    """
+    nb, n = rhs.shape
+    x = np.zeros((nb, n))
+    bnorm = np.linalg.norm(rhs, axis=1)
+    rel_all = np.zeros(nb)
+    products = np.zeros(nb, np.int64)
+    todo = np.flatnonzero(bnorm > 0.0)
+    r = rhs[todo]
+    m = int(restart)
+    while todo.size:
+        beta = np.linalg.norm(r, axis=1)
+        rel_all[todo] = beta / bnorm[todo]
+        go = (rel_all[todo] > rtol[todo]) & (products[todo] < max_products) & (beta > 0.0)
+        todo, r, beta = todo[go], r[go], beta[go]
+        if not todo.size:
+            break
+        _gmres_cycle(matvec, todo, r, beta, bnorm, rtol, m, max_products, x, products, rel_all)
+        again = (rel_all[todo] > rtol[todo]) & (products[todo] < max_products)
+        todo = todo[again]
+        if todo.size:
+            r = rhs[todo] - matvec(todo, x[todo])
+            products[todo] += 1
+    return x, products, rel_all
+
+
+def _gmres_cycle(matvec, slots, r, beta, bnorm, rtol, m, max_products, x, products, rel_all):
+    """One cycle of :func:`gmres_batch` (at most ``m`` products per case) for the cases
+    ``slots`` with residuals ``r``: adds the corrections to ``x``. The basis is kept in single
+    precision (the systems are solved to 1e-1 to 1e-4). Cases that stop early still ride
+    along in the products (their results unused) until they are half the batch; then they
+    are finished and the arrays compacted, so the basis is copied at most a few times."""
+    b, n = r.shape
+    basis = np.zeros((b, m + 1, n), np.float32)
+    hess = np.zeros((b, m + 1, m))
+    rot = np.zeros((b, 2, m))
+    e = np.zeros((b, m + 1))
+    e[:, 0] = beta
+    basis[:, 0] = r / beta[:, None]
+    k_used = np.zeros(b, np.int64)
+    live = np.ones(b, bool)
+
+    def finish(which):
+        y = np.zeros((which.sum(), m))
+        _back_substitute(hess[which], e[which], k_used[which], y)
+        x[slots[which]] += np.einsum("bk,bkn->bn", y, basis[which, :m], dtype=float)
+
+    for k in range(m):
+        if live.sum() <= b // 2:  # compact: finish the stopped cases, keep the live ones
+            finish(~live)
+            slots, basis, hess, rot, e, k_used = (
+                v[live] for v in (slots, basis, hess, rot, e, k_used))
+            b = slots.size
+            live = np.ones(b, bool)
+        w = matvec(slots, basis[:, k])
+        idx = np.flatnonzero(live)
+        products[slots[idx]] += 1
+        h = np.empty((idx.size, k + 1))
+        hn = np.empty(idx.size)
+        _arnoldi(basis, idx, w, k, h, hn)
+        res = np.empty(idx.size)
+        _givens_batch(hess, rot, e, idx, h, hn, k, res)
+        cases = slots[idx]
+        rel = res / bnorm[cases]
+        rel_all[cases] = rel
+        k_used[idx] = k + 1
+        stop = (hn == 0.0) | (rel <= rtol[cases]) | (products[cases] >= max_products)
+        live[idx[stop]] = False
+        if not live.any():
+            break
+    finish(np.ones(b, bool))
+
+
+@jit(fastmath=True)
+def _arnoldi(basis, idx, w, k, h, hn):
+    """Orthogonalise ``w[c]`` against ``basis[c, :k+1]`` for the cases ``c = idx[q]``
+    (classical Gram-Schmidt, repeated once when the first pass loses more than half the norm's
+    square, as :func:`gmres`); ``h[q]``, ``hn[q]`` receive the Hessenberg column and the norm
+    left, ``basis[c, k+1]`` the new vector (when there is room)."""
+    n = w.shape[1]
+    m1 = basis.shape[1]
+    for q in range(idx.size):
+        c = idx[q]
+        v = basis[c]
+        wc = w[c]
+        wn = 0.0
+        for i in range(n):
+            wn += wc[i] * wc[i]
+        for j in range(k + 1):
+            h[q, j] = 0.0
+        for rep in range(2):
+            for j in range(k + 1):
+                t = 0.0
+                for i in range(n):
+                    t += v[j, i] * wc[i]
+                h[q, j] += t
+                for i in range(n):
+                    wc[i] -= t * v[j, i]
+            left = 0.0
+            for i in range(n):
+                left += wc[i] * wc[i]
+            if rep == 0 and left >= 0.49 * wn:
+                break
+        hn[q] = math.sqrt(left)
+        if k + 1 < m1 and hn[q] > 0.0:
+            inv = 1.0 / hn[q]
+            for i in range(n):
+                v[k + 1, i] = wc[i] * inv
+
+
+@jit(fastmath=True)
+def _mixed_precondition(v, rows, cases, slip, out):
+    """``out = M v`` with M the summation from the leading edge on the stick elements and the
+    identity on the slip elements of case ``cases[q]`` (row q)."""
+    m = rows.size
+    for q in range(cases.size):
+        c = cases[q]
+        for half in range(2):
+            o = half * m
+            acc = 0.0
+            for k in range(m - 1, -1, -1):
+                if k == m - 1 or rows[k] != rows[k + 1]:
+                    acc = 0.0
+                if slip[c, k]:
+                    out[q, o + k] = v[q, o + k]
+                else:
+                    acc += v[q, o + k]
+                    out[q, o + k] = acc
+
+
+@jit(fastmath=True)
+def _batch_linearised(dp, kd, cases, slip, nx, ny, cf, r, out):
+    """:func:`_linearised` for packed batches: row ``q`` of ``out`` from ``dp = S v`` and
+    ``kd = K S v`` of case ``cases[q]`` (its ``slip``, ``nx, ny, cf`` rows)."""
+    m = slip.shape[1]
+    for q in range(cases.size):
+        c = cases[q]
+        for k in range(m):
+            kx = kd[q, k]
+            ky = kd[q, m + k]
+            if slip[c, k]:
+                ux = dp[q, k] - r * kx
+                uy = dp[q, m + k] - r * ky
+                d = nx[c, k] * ux + ny[c, k] * uy
+                out[q, k] = dp[q, k] - cf[c, k] * (ux - d * nx[c, k])
+                out[q, m + k] = dp[q, m + k] - cf[c, k] * (uy - d * ny[c, k])
+            else:
+                out[q, k] = r * kx
+                out[q, m + k] = r * ky
+
+
+@dataclass
+class BatchSolution:
+    """Result of :func:`solve_steady_rolling_batch`: fields packed (B, 2m) as in
+    :class:`DenseRolling`, the rest per case (B,)."""
+
+    p: np.ndarray
+    """Tractions over G, packed [-]."""
+    s: np.ndarray
+    """Slip, packed [-] (0 in stick)."""
+    slip: np.ndarray
+    """Whether each contact element slips, (B, m)."""
+    newton_steps: np.ndarray
+    products: np.ndarray
+    residual: np.ndarray
+    converged: np.ndarray
+
+
+def solve_steady_rolling_batch(g, w, dense: DenseRolling, *, tol=1e-6, p=None, max_steps=60):
+    """:func:`solve_steady_rolling` for many cases of one grid at once, with dense products
+    (:class:`DenseRolling`) and :func:`gmres_batch`: the same equations, start, forcing
+    terms, line search and stop, case by case.
+
+    Parameters
+    ----------
+    g : ndarray
+        Traction bound per contact element, > 0 and finite, (B, m).
+    w : ndarray
+        Rigid slip, packed (B, 2m).
+    dense : DenseRolling
+    tol, max_steps
+        As for :func:`solve_steady_rolling`.
+    p : ndarray, optional
+        Start, packed (B, 2m); projected on the bound. Default 0.
+    """
+    m = dense.m
+    g = np.asarray(g, float)
+    w = np.asarray(w, float)
+    nb = g.shape[0] if g.ndim == 2 else -1
+    if g.shape != (nb, m) or w.shape != (nb, 2 * m):
+        raise ValueError(f"g must have shape (B, {m}) and w (B, {2 * m}), got {g.shape}, "
+                         f"{w.shape}")  # fmt: skip
+    if not (np.all(np.isfinite(g)) and np.all(g > 0.0)):
+        raise ValueError("g must be finite and > 0 on every contact element")
+    w = check_finite(w, "w")
+    tol = float(check_range(tol, "tol", 1e-14, 1e-1))
+    if isinstance(max_steps, bool) or not isinstance(max_steps, int | np.integer) or \
+            max_steps < 1:  # fmt: skip
+        raise ValueError(f"max_steps must be an integer >= 1, got {max_steps!r}")
+    # scaled to a bound of 1 per case (as solve_steady_rolling)
+    gmax = g.max(axis=1)
+    g = g / gmax[:, None]
+    w = w / gmax[:, None]
+    if p is None:
+        p = np.zeros((nb, 2 * m))
+    else:
+        p = check_finite(np.asarray(p, float), "p") / gmax[:, None]
+        pt = np.hypot(p[:, :m], p[:, m:])
+        f = np.where(pt > g, g / np.where(pt > 0.0, pt, 1.0), 1.0)
+        p = p * np.concatenate((f, f), axis=1)
+    r = 2.0 / (dense.diagonal[0] + dense.diagonal[1])
+    kt = np.ascontiguousarray(dense.matrix.T)
+    k32 = np.ascontiguousarray(dense.matrix32.T)
+    tiny = 1e-300
+
+    def evaluate(cases, pc):
+        s = w[cases] + pc @ kt
+        z = pc - r * s
+        nz = np.hypot(z[:, :m], z[:, m:])
+        gc = g[cases]
+        slip = nz > gc
+        f = np.where(slip, gc / np.maximum(nz, tiny), 1.0)
+        q = z * np.concatenate((f, f), axis=1)
+        fres = pc - q
+        qn = np.hypot(q[:, :m], q[:, m:]).max(axis=1)
+        err = np.abs(fres).max(axis=1) / np.maximum(qn, 1e-12)
+        return fres, s, z, nz, slip, err
+
+    allc = np.arange(nb)
+    fres, s, z, nz, slip, err = evaluate(allc, p)
+    steps = np.zeros(nb, np.int64)
+    products = np.zeros(nb, np.int64)
+    last_err = err.copy()
+    failed = np.zeros(nb, bool)
+    while True:
+        act = np.flatnonzero((err > tol) & ~failed & (steps < max_steps))
+        if not act.size:
+            break
+        steps[act] += 1
+        slip_a = slip[act]
+        inv = np.where(slip_a, 1.0 / np.maximum(nz[act], tiny), 0.0)
+        nx_, ny_ = z[act, :m] * inv, z[act, m:] * inv
+        c = g[act] * inv
+
+        def jac(k, v, nx_=nx_, ny_=ny_, c=c, slip_a=slip_a):  # k: indices into act
+            dp = np.empty(v.shape)
+            _mixed_precondition(v, dense.rows, k, slip_a, dp)
+            kd = dp.astype(np.float32) @ k32
+            out = np.empty(v.shape)
+            _batch_linearised(dp, kd, k, slip_a, nx_, ny_, c, r, out)
+            return out
+
+        ratio = np.where(steps[act] > 1, err[act] / np.maximum(last_err[act], tiny), 1.0)
+        eta = np.where(steps[act] > 1, np.minimum(0.1, 0.9 * ratio**2), 0.1)
+        eta = np.minimum(np.maximum(eta, 0.3 * tol / err[act]), 0.1)
+        y, used, _ = gmres_batch(jac, -fres[act], eta)
+        products[act] += used
+        dp = np.empty(y.shape)
+        _mixed_precondition(y, dense.rows, np.arange(act.size), slip_a, dp)
+        fnorm = np.linalg.norm(fres[act], axis=1)
+        lam = np.ones(act.size)
+        pending = np.arange(act.size)
+        for _ in range(5):
+            cases = act[pending]
+            cand = p[cases] + lam[pending, None] * dp[pending]
+            res = evaluate(cases, cand)
+            products[cases] += 1
+            ok = np.linalg.norm(res[0], axis=1) <= (1.0 - 1e-4 * lam[pending]) * fnorm[pending]
+            good = cases[ok]
+            last_err[good] = err[good]
+            p[good] = cand[ok]
+            fres[good], s[good], z[good], nz[good], slip[good], err[good] = (
+                v[ok] for v in res)
+            lam[pending[~ok]] *= 0.5
+            pending = pending[~ok]
+            if not pending.size:
+                break
+        failed[act[pending]] = True
+    # the returned tractions satisfy the bound exactly, and lie on it in slip
+    pt = np.hypot(p[:, :m], p[:, m:])
+    f = np.where((pt > g) | (slip & (pt > 0.0)), g / np.where(pt > 0.0, pt, 1.0), 1.0)
+    f2 = np.concatenate((f, f), axis=1)
+    slip2 = np.concatenate((slip, slip), axis=1)
+    return BatchSolution(p * f2 * gmax[:, None], np.where(slip2, s, 0.0) * gmax[:, None], slip,
+                         steps, products, err, err <= tol)  # fmt: skip
