@@ -419,6 +419,63 @@ def test_gmres_batch_equals_gmres_case_by_case():
         np.testing.assert_allclose(x[c], xs, atol=5 * rtol[c] * np.abs(xs).max() + 1e-6)
 
 
+@ANY_INPUT
+@settings(max_examples=15, deadline=None)
+@given(
+    log_aob=st.sampled_from([np.log(0.2), 0.0, np.log(2.0), np.log(5.0)]),
+    n=st.integers(8, 32),
+    seed=st.integers(0, 2**16),
+)
+def test_many_cases_together_equal_gauss_seidel(log_aob, n, seed):
+    """Cases of one small grid solved together (dense products, batched GMRES): forces and
+    stick/slip maps as Gauss-Seidel's, any creepage direction and size, with spin."""
+    rng = np.random.default_rng(seed)
+    aob = np.exp(log_aob)
+    a, b = 6e-3 * np.sqrt(aob), 6e-3 / np.sqrt(aob)
+    m = exact._DENSE_MIN_CASES  # the fewest solved together
+    creep = 10 ** rng.uniform(-4.5, -1.5, m)
+    angle = rng.uniform(0, 2 * np.pi, m)
+    spin = rng.choice([0.0, 0.4, -1.5, 5.0], m)
+    args = (creep * np.cos(angle), creep * np.sin(angle), spin, FZ, a, b, MU)
+    gs = exact_rolling(*args, nx=n, ny=n, method="gauss-seidel", tol=1e-8, return_fields=True)
+    nw = exact_rolling(*args, nx=n, ny=n, method="newton", tol=1e-8, return_fields=True)
+    assert nw.method == "newton"
+    for f in ("fx", "fy"):
+        np.testing.assert_allclose(getattr(nw, f), getattr(gs, f), rtol=0, atol=1e-7 * FZ * MU)
+    np.testing.assert_allclose(nw.mz, gs.mz, rtol=0, atol=1e-7 * FZ * MU * 6e-3)
+    assert (nw.state != gs.state).sum() <= 2  # an element exactly on the stick/slip edge
+
+
+@ANY_INPUT
+def test_batch_mixing_shapes_frictionless_and_loadless_cases(monkeypatch):
+    """One call with two a/b (two groups), a case without friction and one without load:
+    each as when solved alone (case by case, by FFT products), and the order of the cases
+    changes nothing, beyond round-off (1e-9 mu Q at tol = 1e-10)."""
+    monkeypatch.setattr(exact, "_DENSE_MIN_CASES", 2)
+    xi = np.array([1e-3, 0.0, 2e-4, 1e-3, -5e-4, 1e-3])
+    eta = np.array([0.0, 5e-4, -2e-4, 0.0, 3e-4, 1e-3])
+    phi = np.array([0.0, 0.5, -1.0, 0.0, 2.0, 0.0])
+    fz = np.array([FZ, FZ, FZ, 0.0, FZ, FZ])
+    a = np.array([5e-3, 5e-3, 8e-3, 5e-3, 8e-3, 5e-3])
+    b = np.array([5e-3, 5e-3, 4e-3, 5e-3, 4e-3, 5e-3])
+    mu = np.array([MU, MU, MU, MU, MU, 0.0])
+    kw = dict(nx=20, ny=20, method="newton", tol=1e-10)
+    together = exact_rolling(xi, eta, phi, fz, a, b, mu, **kw)
+    assert together.method == "newton"
+    order = np.array([4, 2, 0, 5, 1, 3])
+    shuffled = exact_rolling(xi[order], eta[order], phi[order], fz[order], a[order], b[order],
+                             mu[order], **kw)  # fmt: skip
+    for c in range(xi.size):
+        alone = exact_rolling(xi[c], eta[c], phi[c], fz[c], a[c], b[c], mu[c], **kw)
+        for f in ("fx", "fy", "mz"):
+            ref = float(getattr(alone, f)) / (FZ * MU * (a[c] if f == "mz" else 1.0))
+            got = float(getattr(together, f)[c]) / (FZ * MU * (a[c] if f == "mz" else 1.0))
+            assert got == pytest.approx(ref, rel=0, abs=1e-9)
+        k = int(np.flatnonzero(order == c)[0])
+        assert float(shuffled.fy[k]) == pytest.approx(float(together.fy[c]), rel=0, abs=1e-9 * FZ)
+    assert together.fx[3] == 0.0 and together.fx[5] == 0.0
+
+
 def test_batch_solver_inputs_are_checked():
     dense, _ = _dense(8)
     g = np.ones((2, dense.m))
@@ -440,3 +497,23 @@ def test_batch_solver_inputs_are_checked():
     sol = solve_steady_rolling_batch(g, w, dense)  # no rigid slip: nothing to do
     assert sol.converged.all() and not sol.p.any() and not sol.newton_steps.any()
 
+
+@ANY_INPUT
+def test_cases_go_together_from_the_minimum_count(monkeypatch):
+    """Groups of at least ``_DENSE_MIN_CASES`` cases of one grid go together (dense
+    products); fewer, case by case (FFT products); both give the same forces."""
+    calls = []
+    real = exact.solve_steady_rolling_batch
+
+    def spy(g, *args, **kw):
+        calls.append(g.shape[0])
+        return real(g, *args, **kw)
+
+    monkeypatch.setattr(exact, "solve_steady_rolling_batch", spy)
+    n = exact._DENSE_MIN_CASES
+    xi = np.linspace(1e-4, 2e-3, n)
+    few = exact_rolling(xi[:-1], 2e-4, 0.3, FZ, 6e-3, 4e-3, MU, nx=24, ny=24, method="newton")
+    assert calls == []
+    many = exact_rolling(xi, 2e-4, 0.3, FZ, 6e-3, 4e-3, MU, nx=24, ny=24, method="newton")
+    assert calls == [n, n]  # the 12 x 12 start, then the 24 x 24 grid
+    np.testing.assert_allclose(many.fx[:-1], few.fx, rtol=0, atol=1e-7 * FZ * MU)

@@ -52,7 +52,12 @@ from railadhesion._validate import (
 )
 from railadhesion.contact.friction import falling_friction_factor
 from railadhesion.contact.kalker import check_creepages, check_rolling_inputs
-from railadhesion.contact.rolling_newton import RollingOperator, solve_steady_rolling
+from railadhesion.contact.rolling_newton import (
+    DenseRolling,
+    RollingOperator,
+    solve_steady_rolling,
+    solve_steady_rolling_batch,
+)
 from railadhesion.numerics import jit
 from railadhesion.plausibility import input_checker
 
@@ -964,6 +969,21 @@ _COARSE_TOL = 1e-2
 _COARSE_MIN = 12
 #: Newton steps allowed before a solve is handed to Gauss-Seidel (3-6 are typical).
 _NEWTON_MAX_STEPS = 60
+#: Newton solves the Coulomb cases of grids up to this many elements together, with dense
+#: products (:class:`~railadhesion.contact.rolling_newton.DenseRolling`; its matrix has
+#: (2 x contact elements)^2 entries: 26 MB in double precision at 32 x 32); larger grids
+#: case by case with FFT products.
+_DENSE_MAX_ELEMENTS = 1024
+#: Cases solved together (the Krylov bases of a batch take about 40 x 2 x elements x 4 bytes
+#: per case).
+_DENSE_BATCH = 256
+#: Fewer cases of one a/b and nu than this go case by case: building the dense matrices
+#: costs more than it saves (break-even measured at about 16 cases on 16 x 16 to 32 x 32).
+_DENSE_MIN_CASES = 16
+#: Coarse starts of the batched path: grids down to this many elements along an axis and
+#: this many elements in all.
+_DENSE_COARSE_MIN = 6
+_DENSE_COARSE_ELEMENTS = 144
 
 
 @dataclass
@@ -1011,8 +1031,147 @@ def _solve_cases(idx, flat, shape_in, opts, out: _BatchOutput, newton: bool) -> 
             out.state[by_loop] = st_sub
             out.mu_local[by_loop] = mu_sub
     rest = idx[~coulomb] if not newton else idx
+    if newton and nx * ny <= _DENSE_MAX_ELEMENTS:
+        rest = _solve_dense_batches(idx[coulomb], flat, shape_in, opts, out, rest)
     if rest.size:
         _solve_one_by_one(rest, flat, shape_in, opts, out, newton)
+
+
+def _dense_fields(idx, flat, mx, my, scale, spin_offset, xh, yh, shape, ssum, inside):
+    """The traction bounds (len(idx), m) and packed rigid slips (len(idx), 2m) of the cases
+    ``idx`` on a grid, and their dy/dx."""
+    m = int(inside.sum())
+    g_all, w_all, ratio = np.empty((idx.size, m)), np.empty((idx.size, 2 * m)), np.empty(idx.size)
+    g, wx, wy = np.empty((my, mx)), np.empty((my, mx)), np.empty((my, mx))
+    for q, c in enumerate(idx):
+        case = tuple(float(v[c]) for v in flat[:8])
+        dx, dy = _case_fields(*case, scale, spin_offset, xh, yh, shape, ssum, g, wx, wy)
+        g_all[q] = g[inside]
+        w_all[q, :m] = wx[inside]
+        w_all[q, m:] = wy[inside]
+        ratio[q] = dy / dx
+    return g_all, w_all, ratio
+
+
+def _dense_newton(idx, flat, mx, my, scale, spin_offset, shape_in, tol, cache):
+    """Semismooth Newton for the Coulomb cases ``idx`` of one (mx, my) grid, all with one
+    dy/dx and nu, solved together (:func:`solve_steady_rolling_batch`), each started from
+    the solution on a grid half as fine (nested iteration, as :func:`_coarse_start`;
+    Hertz's pressure on the coarse grids). Returns the grid's shape data, its
+    :class:`DenseRolling` and the solution."""
+    xh, yh, shape, ssum = _grid_shape(mx, my, scale, shape_in)
+    inside = shape > 0.0
+    g, w, ratio = _dense_fields(idx, flat, mx, my, scale, spin_offset, xh, yh, shape, ssum,
+                                inside)  # fmt: skip
+    nu = float(flat[8][idx[0]])
+    key = (mx, my, float(ratio[0]), nu, inside.tobytes())
+    if key not in cache:
+        cache[key] = DenseRolling(*_rolling_kernel(mx, my, 1.0, float(ratio[0]), nu), inside)
+    dense = cache[key]
+    start = None
+    mc, nc = (mx + 1) // 2, (my + 1) // 2
+    if min(mc, nc) >= _DENSE_COARSE_MIN and mc * nc >= _DENSE_COARSE_ELEMENTS:
+        coarse = _dense_newton(idx, flat, mc, nc, scale, spin_offset, np.empty((0, 0)),
+                               _COARSE_TOL, cache)  # fmt: skip
+        (xc, yc, _, _), dense_c, sol_c = coarse
+        key_i = ("interpolation", mc, nc, mx, my, scale, inside.tobytes())
+        if key_i not in cache:
+            cache[key_i] = _interpolation_matrix(dense_c, xc, yc, dense, xh, yh)
+        start = sol_c.p @ cache[key_i].T
+    sol = solve_steady_rolling_batch(g, w, dense, tol=tol, p=start, max_steps=_NEWTON_MAX_STEPS)
+    return (xh, yh, shape, ssum), dense, sol
+
+
+def _interpolation_matrix(coarse: DenseRolling, xc, yc, fine: DenseRolling, xf, yf):
+    """The packed-to-packed matrix of :func:`_interpolate` (bilinear, separable: the product
+    of its weights along x and along y) from a coarse grid's contact elements onto a fine
+    grid's, the same for the x and y components."""
+    wx = np.array([np.interp(xf, xc, e) for e in np.eye(xc.size)]).T  # (fine x, coarse x)
+    wy = np.array([np.interp(yf, yc, e) for e in np.eye(yc.size)]).T
+    full = np.kron(wy, wx)  # row-major (y, x) on both grids
+    part = full[np.ix_(fine.rows * xf.size + fine.cols, coarse.rows * xc.size + coarse.cols)]
+    out = np.zeros((2 * fine.m, 2 * coarse.m))
+    out[: fine.m, : coarse.m] = part
+    out[fine.m :, coarse.m :] = part
+    return out
+
+
+def _solve_dense_batches(idx, flat, shape_in, opts, out: _BatchOutput, rest):
+    """Newton on the Coulomb cases ``idx`` of a small grid, solved together in groups of one
+    dy/dx and nu (:func:`_dense_newton`); a case Newton does not finish is finished by
+    Gauss-Seidel from Newton's iterate (and counts as solved by Gauss-Seidel). Returns
+    ``rest`` without the cases solved here (cases without friction, mu p_n = 0, stay)."""
+    nx, ny, scale, spin_offset, tol, max_iter, tol_f, max_f, keep, warm = opts
+    if not idx.size:
+        return rest
+    bound = flat[6][idx] * flat[3][idx]  # mu Fz: no traction bound at all when 0
+    idx = idx[bound > 0.0]
+    # group by the grid's dy/dx and nu: (b/a) (nx/ny)
+    ratio = (flat[5][idx] / flat[4][idx]) * (nx / ny)
+    keys = np.stack((ratio, flat[8][idx]), axis=1)
+    _, group = np.unique(keys, axis=0, return_inverse=True)
+    cache: dict = {}
+    kernels: dict = {}
+    done = []
+    for gi in range(int(group.max()) + 1 if group.size else 0):
+        members = idx[group.ravel() == gi]
+        if members.size < _DENSE_MIN_CASES:
+            continue
+        for lo in range(0, members.size, _DENSE_BATCH):
+            chunk = members[lo:lo + _DENSE_BATCH]
+            (xh, yh, shape, _), dense, sol = _dense_newton(
+                chunk, flat, nx, ny, scale, spin_offset, shape_in, tol, cache)
+            px, py = dense.unpack(sol.p)
+            sx, sy = dense.unpack(sol.s)
+            state = np.where(dense.inside, 1, 0).astype(np.int8)
+            for q, c in enumerate(chunk):
+                st = state.copy()
+                st[dense.rows[sol.slip[q]], dense.cols[sol.slip[q]]] = _SLIP
+                its, err = int(sol.newton_steps[q]), float(sol.residual[q])
+                out.newton[c] = bool(sol.converged[q])
+                case = tuple(float(v[c]) for v in flat[:8])
+                if not sol.converged[q]:
+                    its, err = _finish_by_gauss_seidel(
+                        c, case, flat, opts, shape_in, kernels, px[q], py[q], sx[q], sy[q], st,
+                        its)  # fmt: skip
+                dx = 2.0 * scale * case[4] / nx
+                dy = 2.0 * scale * case[5] / ny
+                _case_forces(px[q], py[q], st, shape, xh, yh, case[4], case[5], dx, dy,
+                             case[7], out.forces[c])  # fmt: skip
+                out.iterations[c] = its
+                out.residual[c] = err
+                out.outer[c] = 0
+                if keep:
+                    out.fields[0][c] = px[q] * case[7]
+                    out.fields[1][c] = py[q] * case[7]
+                    out.fields[2][c] = sx[q]
+                    out.fields[3][c] = sy[q]
+                    out.state[c] = st
+                    out.mu_local[c] = (shape > 0.0) * case[6]
+            done.append(chunk)
+    if not done:
+        return rest
+    return np.setdiff1d(rest, np.concatenate(done), assume_unique=True)
+
+
+def _finish_by_gauss_seidel(c, case, flat, opts, shape_in, kernels, px, py, sx, sy, st, its):
+    """Gauss-Seidel (always convergent) from Newton's last iterate ``px, py`` (over G, in
+    place, with the slip and the state) for case ``c``; returns (Newton steps + sweeps,
+    residual)."""
+    nx, ny, scale, spin_offset, tol, max_iter = opts[:6]
+    xh, yh, shape, ssum = _grid_shape(nx, ny, scale, shape_in)
+    g, wx, wy = np.empty((ny, nx)), np.empty((ny, nx)), np.empty((ny, nx))
+    dx, dy = _case_fields(*case, scale, spin_offset, xh, yh, shape, ssum, g, wx, wy)
+    key = (dy / dx, float(flat[8][c]))
+    if key not in kernels:
+        kernels[key] = _case_kernel(nx, ny, key[0], key[1])
+    sweeps, err = _gauss_seidel(g, wx, wy, *kernels[key], tol, max_iter, px, py, sx, sy, st)
+    if not (np.all(np.isfinite(px)) and np.all(np.isfinite(py))):
+        raise FloatingPointError(
+            f"exact_rolling: no finite solution for case {int(c)} (creepages {case[:3]}, "
+            f"bound max {float(g.max()):.3g}): please report it"
+        )
+    return its + sweeps, err
 
 
 def _interpolate(field, xc, yc, xf, yf):
@@ -1399,10 +1558,13 @@ def exact_rolling(
     (``railadhesion.contact.rolling_newton.solve_steady_rolling``): Coulomb's law as a
     projection equation, linearised on the current stick set and slip directions, each
     linear system solved by GMRES with 2-D FFT products, preconditioned by the summation
-    along the rolling direction; each case starts from the solution on a grid half as fine
-    (nested iteration down to 12 elements), which leaves 3-6 Newton steps, each friction
-    update from the previous tractions. A solve Newton does not finish goes on by
-    Gauss-Seidel from Newton's iterate.
+    along the rolling direction on the stick elements (the identity on the slip elements);
+    each case starts from the solution on a grid half as fine (nested iteration down to 12
+    elements), which leaves 3-6 Newton steps, each friction update from the previous
+    tractions. On grids of up to 1024 elements the Coulomb cases of one a/b and nu are
+    solved together, with dense matrix products for the whole group
+    (``rolling_newton.solve_steady_rolling_batch``): the fast way to many cases on a small
+    grid. A solve Newton does not finish goes on by Gauss-Seidel from Newton's iterate.
 
     Examples
     --------
