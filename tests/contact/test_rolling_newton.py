@@ -517,3 +517,21 @@ def test_cases_go_together_from_the_minimum_count(monkeypatch):
     many = exact_rolling(xi, 2e-4, 0.3, FZ, 6e-3, 4e-3, MU, nx=24, ny=24, method="newton")
     assert calls == [n, n]  # the 12 x 12 start, then the 24 x 24 grid
     np.testing.assert_allclose(many.fx[:-1], few.fx, rtol=0, atol=1e-7 * FZ * MU)
+
+
+@ANY_INPUT
+def test_auto_takes_newton_for_many_cases_of_a_small_grid():
+    """``method="auto"`` below 40 x 40: Gauss-Seidel for a few cases, Newton (together) from
+    ``_DENSE_AUTO_CASES`` Coulomb cases of one a/b and nu; the same forces either way."""
+    n = exact._DENSE_AUTO_CASES
+    xi = np.linspace(-2e-3, 2e-3, n)
+    phi = np.linspace(-1.0, 1.0, n)
+    many = exact_rolling(xi, 3e-4, phi, FZ, 6e-3, 4e-3, MU, nx=16, ny=16)
+    assert many.method == "newton"
+    few = exact_rolling(xi[:-1], 3e-4, phi[:-1], FZ, 6e-3, 4e-3, MU, nx=16, ny=16)
+    assert few.method == "gauss-seidel"
+    np.testing.assert_allclose(many.fx[:-1], few.fx, rtol=0, atol=1e-6 * FZ * MU)
+    np.testing.assert_allclose(many.fy[:-1], few.fy, rtol=0, atol=1e-6 * FZ * MU)
+    falling = exact_rolling(xi, 3e-4, phi, FZ, 6e-3, 4e-3, MU, nx=16, ny=16, speed=20.0,
+                            friction_ratio=0.4, friction_decay=0.6)  # fmt: skip
+    assert falling.method == "gauss-seidel"  # falling friction: case by case, as before

@@ -980,6 +980,10 @@ _DENSE_BATCH = 256
 #: Fewer cases of one a/b and nu than this go case by case: building the dense matrices
 #: costs more than it saves (break-even measured at about 16 cases on 16 x 16 to 32 x 32).
 _DENSE_MIN_CASES = 16
+#: ``method="auto"`` solves groups of this many Coulomb cases (or more) of one a/b and nu on a
+#: grid of up to ``_DENSE_MAX_ELEMENTS`` by Newton, together: 1.4-2.1 times faster than
+#: Gauss-Seidel at 64 cases on 16 x 16 to 32 x 32 (docs/exact-solver.md), and more with more.
+_DENSE_AUTO_CASES = 64
 #: Coarse starts of the batched path: grids down to this many elements along an axis and
 #: this many elements in all.
 _DENSE_COARSE_MIN = 6
@@ -1003,13 +1007,19 @@ def _is_coulomb(friction_ratio, friction_decay, speed):
     return (friction_ratio == 1.0) | (friction_decay * speed == 0.0)
 
 
-def _solve_cases(idx, flat, shape_in, opts, out: _BatchOutput, newton: bool) -> None:
+def _solve_cases(idx, flat, shape_in, opts, out: _BatchOutput, newton: bool,
+                 auto: bool = False) -> None:  # fmt: skip
     """Solve the cases ``idx`` of the flat inputs into ``out``: Coulomb cases by the compiled
     Gauss-Seidel loop, or by Newton when ``newton``; falling-friction cases one by one, the
-    outer iteration on the slip velocity around either solver."""
+    outer iteration on the slip velocity around either solver. With ``auto`` (and not
+    ``newton``), groups of at least ``_DENSE_AUTO_CASES`` Coulomb cases of one a/b and nu on
+    a small grid go to Newton, solved together."""
     nx, ny, scale, spin_offset, tol, max_iter, tol_f, max_f, keep, warm = opts
     coulomb = _is_coulomb(flat[10][idx], flat[11][idx], flat[9][idx])
     by_loop = idx[:0] if newton else idx[coulomb]
+    if auto and by_loop.size >= _DENSE_AUTO_CASES and nx * ny <= _DENSE_MAX_ELEMENTS:
+        by_loop = _solve_dense_batches(by_loop, flat, shape_in, opts, out, by_loop,
+                                       min_cases=_DENSE_AUTO_CASES)  # fmt: skip
     if by_loop.size:
         m = by_loop.size
         o_f, o_it, o_err = np.empty((m, 4)), np.empty(m, np.int64), np.empty(m)
@@ -1096,12 +1106,14 @@ def _interpolation_matrix(coarse: DenseRolling, xc, yc, fine: DenseRolling, xf, 
     return out
 
 
-def _solve_dense_batches(idx, flat, shape_in, opts, out: _BatchOutput, rest):
+def _solve_dense_batches(idx, flat, shape_in, opts, out: _BatchOutput, rest, min_cases=None):
     """Newton on the Coulomb cases ``idx`` of a small grid, solved together in groups of one
-    dy/dx and nu (:func:`_dense_newton`); a case Newton does not finish is finished by
-    Gauss-Seidel from Newton's iterate (and counts as solved by Gauss-Seidel). Returns
-    ``rest`` without the cases solved here (cases without friction, mu p_n = 0, stay)."""
+    dy/dx and nu of at least ``min_cases`` cases (default ``_DENSE_MIN_CASES``;
+    :func:`_dense_newton`); a case Newton does not finish is finished by Gauss-Seidel from
+    Newton's iterate (and counts as solved by Gauss-Seidel). Returns ``rest`` without the
+    cases solved here (smaller groups, and cases without friction, mu p_n = 0, stay)."""
     nx, ny, scale, spin_offset, tol, max_iter, tol_f, max_f, keep, warm = opts
+    min_cases = _DENSE_MIN_CASES if min_cases is None else min_cases
     if not idx.size:
         return rest
     bound = flat[6][idx] * flat[3][idx]  # mu Fz: no traction bound at all when 0
@@ -1115,7 +1127,7 @@ def _solve_dense_batches(idx, flat, shape_in, opts, out: _BatchOutput, rest):
     done = []
     for gi in range(int(group.max()) + 1 if group.size else 0):
         members = idx[group.ravel() == gi]
-        if members.size < _DENSE_MIN_CASES:
+        if members.size < min_cases:
             continue
         for lo in range(0, members.size, _DENSE_BATCH):
             chunk = members[lo:lo + _DENSE_BATCH]
@@ -1499,9 +1511,10 @@ def exact_rolling(
         coefficient of friction.
     warm_start : bool, optional
         Gauss-Seidel only (ignored where Newton solves, so with ``method="auto"`` from
-        40 x 40 elements): start each case from the tractions of the previous case when the
-        grid is the same (same a/b and nu): fewer sweeps along creep curves. The results then
-        depend on the order of the cases within the tolerance ``tol``. Default False.
+        40 x 40 elements, and for groups of 64 Coulomb cases or more): start each case from
+        the tractions of the previous case when the grid is the same (same a/b and nu):
+        fewer sweeps along creep curves. The results then depend on the order of the cases
+        within the tolerance ``tol``. Default False.
     pressure : {"hertz", "discrete"}, optional
         Normal pressure on the grid: Hertz's ellipse at the element centres (default), or the
         solution of the discrete normal problem on the same grid for the quadratic gap of
@@ -1513,10 +1526,12 @@ def exact_rolling(
     method : {"auto", "newton", "gauss-seidel"}, optional
         Solver of the discrete problem (Notes): semismooth Newton (``"newton"``),
         element-wise Gauss-Seidel (``"gauss-seidel"``), or ``"auto"`` (default): Newton on
-        grids of 1600 elements (40 x 40, ``NEWTON_MIN_ELEMENTS``) or more, Gauss-Seidel
-        below. Both give the same solution within about ``tol``, with Coulomb or falling
-        friction (the outer iteration on the slip velocity is the same around either); the
-        result's ``method`` says which was used.
+        grids of 1600 elements (40 x 40, ``NEWTON_MIN_ELEMENTS``) or more; below, Newton for
+        64 or more Coulomb cases of one a/b and nu on grids of up to 1024 elements (solved
+        together, see Notes) and Gauss-Seidel for the rest. Both give the same solution
+        within about ``tol``, with Coulomb or falling friction (the outer iteration on the
+        slip velocity is the same around either); the result's ``method`` says which was
+        used.
 
     Returns
     -------
@@ -1610,13 +1625,14 @@ def exact_rolling(
     if method not in ("auto", "newton", "gauss-seidel"):
         raise ValueError(f"method must be 'auto', 'newton' or 'gauss-seidel', got {method!r}")
     newton = method == "newton" or (method == "auto" and nx * ny >= NEWTON_MIN_ELEMENTS)
+    auto = method == "auto"
     out = _BatchOutput(out_f, out_iter, out_err, out_outer, fields, state, mu_all,
                        np.zeros(n, np.bool_))  # fmt: skip
     opts = (nx, ny, scale, spin_offset, tol, max_iter, tol_friction, max_friction_iter,
             bool(return_fields), bool(warm_start))  # fmt: skip
     if pressure == "hertz":
         shapes = None
-        _solve_cases(np.arange(n), flat, np.empty((0, 0)), opts, out, newton)
+        _solve_cases(np.arange(n), flat, np.empty((0, 0)), opts, out, newton, auto)
     else:  # one discrete normal solution per (a/b, nu), the cases solved group by group
         aob_all = flat[4] / flat[5]
         keys = np.stack([aob_all, flat[8]], axis=1)
@@ -1626,7 +1642,7 @@ def exact_rolling(
         for k, (aob_k, nu_k) in enumerate(uniq):
             idx = np.flatnonzero(inverse == k)
             shp = _discrete_shape(float(aob_k), float(nu_k), nx, ny, scale)
-            _solve_cases(idx, flat, shp, opts, out, newton)
+            _solve_cases(idx, flat, shp, opts, out, newton, auto)
             if return_fields:
                 shapes[idx] = shp
     if n == 0:
