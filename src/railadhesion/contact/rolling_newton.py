@@ -47,7 +47,7 @@ import scipy.fft as sfft
 from scipy.linalg import solve_triangular
 
 from railadhesion._validate import check_finite, check_nonnegative, check_range
-from railadhesion.numerics import jit
+from railadhesion.numerics import jit, jitable
 
 __all__ = [
     "BatchSolution",
@@ -241,52 +241,63 @@ class SteadySolution:
     """Whether ``residual <= tol``."""
 
 
-@jit(fastmath=True)
-def _sum_from_leading_edge(v, where, slip, out_x, out_y):
-    """``out = M v``, the right preconditioner: on the stick elements each row summed from
-    the leading edge (+x, the last column) backwards over the stick elements, the inverse of
-    the rolling difference that dominates their equations (``r K dp``); on the slip elements
-    (``slip``, packed) the identity, their equations being dominated by ``dp`` itself. ``v``
-    holds the x then the y components of the contact elements, packed; ``where[j, i]`` is
-    the element's index in it, -1 outside the contact (``out`` 0 there)."""
-    my, mx = where.shape
-    m = v.size // 2
-    for j in range(my):
-        ax = 0.0
-        ay = 0.0
-        for i in range(mx - 1, -1, -1):
-            k = where[j, i]
-            if k >= 0 and slip[k]:
-                out_x[j, i] = v[k]
-                out_y[j, i] = v[m + k]
-            elif k >= 0:
-                ax += v[k]
-                ay += v[m + k]
-                out_x[j, i] = ax
-                out_y[j, i] = ay
-            else:
-                out_x[j, i] = 0.0
-                out_y[j, i] = 0.0
+#: Floor of |z| in the projection's divisions.
+_TINY = 1e-300
+
+
+def _projection(px, py, sx, sy, g, r):
+    """Coulomb's law as a projection, element by element, for fields of any shape:
+    ``F = p - P_g(p - r s)`` with ``P_g`` the projection on the disc of radius ``g`` (0
+    outside the contact; Alart & Curnier 1991). Returns ``(Fx, Fy, zx, zy, |z|, slip, |P_g(z)|)``
+    with ``z = p - r s`` and ``slip`` where ``|z| > g`` in the contact."""
+    inside = g > 0.0
+    zx, zy = px - r * sx, py - r * sy
+    nz = np.hypot(zx, zy)
+    slip = inside & (nz > g)
+    f = np.where(slip, g / np.maximum(nz, _TINY), 1.0) * inside
+    qx, qy = f * zx, f * zy  # P_g(z), the projected traction
+    return px - qx, py - qy, zx, zy, nz, slip, np.hypot(qx, qy)
+
+
+def _onto_bound(px, py, g, slip):
+    """The factor that puts tractions back on their bound: where ``|p| > g``, and on it where
+    ``slip`` (0 outside the contact)."""
+    pt = np.hypot(px, py)
+    on = (pt > g) | (slip & (pt > 0.0))
+    return np.where(on, g / np.where(pt > 0.0, pt, 1.0), 1.0) * (g > 0.0)
+
+
+def _forcing(err, last_err, later, tol):
+    """GMRES's relative tolerance for a Newton step: Eisenstat & Walker's choice 2
+    (``0.9 (err/last_err)^2``, 0.1 at the first step, ``later`` False; without their
+    safeguard), never tighter than the stop needs (``0.3 tol/err``) nor looser than 0.1."""
+    eta = np.where(later, np.minimum(0.1, 0.9 * (err / np.maximum(last_err, _TINY)) ** 2), 0.1)
+    return np.minimum(np.maximum(eta, 0.3 * tol / err), 0.1)
+
+
+@jitable
+def _newton_row(dx, dy, kx, ky, slip, nx, ny, c, r):
+    """One element's row of the Newton matrix times ``dp = (dx, dy)``, with ``(kx, ky) = K dp``
+    there: ``r K dp`` in stick; ``dp - c (I - n n^T)(dp - r K dp)`` in slip (the derivative of
+    ``p - P_g(p - r s)`` at ``z = p - r s``, ``n = z/|z|``, ``c = g/|z|``)."""
+    if slip:
+        ux = dx - r * kx
+        uy = dy - r * ky
+        d = nx * ux + ny * uy
+        return dx - c * (ux - d * nx), dy - c * (uy - d * ny)
+    return r * kx, r * ky
 
 
 @jit(fastmath=True)
 def _linearised(dx, dy, kx, ky, rows, cols, slip, nx, ny, c, r, out):
     """Newton matrix times ``dp`` on the contact elements (``rows, cols``; packed as in
-    :func:`_sum_from_leading_edge`): ``r (K dp)`` in stick; ``dp - c (I - n n^T)(dp - r K dp)``
-    in slip (the derivative of ``p - P_g(p - r s)``; ``nx, ny, c`` packed)."""
+    :func:`_mixed_precondition`; :func:`_newton_row` each, ``slip, nx, ny, c`` packed)."""
     m = rows.size
     for k in range(m):
         j = rows[k]
         i = cols[k]
-        if slip[k]:
-            ux = dx[j, i] - r * kx[j, i]
-            uy = dy[j, i] - r * ky[j, i]
-            d = nx[k] * ux + ny[k] * uy
-            out[k] = dx[j, i] - c[k] * (ux - d * nx[k])
-            out[m + k] = dy[j, i] - c[k] * (uy - d * ny[k])
-        else:
-            out[k] = r * kx[j, i]
-            out[m + k] = r * ky[j, i]
+        out[k], out[m + k] = _newton_row(dx[j, i], dy[j, i], kx[j, i], ky[j, i], slip[k],
+                                         nx[k], ny[k], c[k], r)  # fmt: skip
 
 
 def solve_steady_rolling(
@@ -348,21 +359,14 @@ def solve_steady_rolling(
     else:
         px = check_finite(px, "px") / gmax
         py = check_finite(py, "py") / gmax
-        pt = np.hypot(px, py)
-        f = np.where(pt > g, g / np.where(pt > 0.0, pt, 1.0), 1.0) * inside
+        f = _onto_bound(px, py, g, False)
         px, py = px * f, py * f
-    tiny = 1e-300
 
     def evaluate(px, py):
         kx, ky = operator(px, py)
         sx, sy = wx + kx, wy + ky
-        zx, zy = px - r * sx, py - r * sy
-        nz = np.hypot(zx, zy)
-        slip = inside & (nz > g)
-        f = np.where(slip, g / np.maximum(nz, tiny), 1.0) * inside
-        qx, qy = f * zx, f * zy  # P_g(z), the projected traction
-        fx, fy = px - qx, py - qy
-        pref = max(float(np.max(np.hypot(qx, qy))), 1e-12)  # the bound is scaled to 1
+        fx, fy, zx, zy, nz, slip, qn = _projection(px, py, sx, sy, g, r)
+        pref = max(float(np.max(qn)), 1e-12)  # the bound is scaled to 1
         err = max(float(np.max(np.abs(fx))), float(np.max(np.abs(fy)))) / pref
         return (fx, fy, sx, sy, zx, zy, nz, slip), err
 
@@ -370,32 +374,36 @@ def solve_steady_rolling(
     steps = 0
     last_err = err
     rows, cols = np.nonzero(inside)
-    where = np.full(g.shape, -1, np.int64)
-    where[rows, cols] = np.arange(rows.size)
-    dpx, dpy = np.empty_like(g), np.empty_like(g)
+    m = rows.size
+    dpx, dpy = np.zeros_like(g), np.zeros_like(g)
+    one = np.zeros(1, np.int64)
+
+    def precondition(v, slip_k):  # dp = M v, on the grid (0 outside the contact)
+        dp = np.empty((1, v.size))
+        _mixed_precondition(v[None], rows, one, slip_k[None], dp)
+        dpx[rows, cols] = dp[0, :m]
+        dpy[rows, cols] = dp[0, m:]
     while err > tol and steps < max_steps:
         steps += 1
         slip_k = slip[rows, cols]
-        inv = np.where(slip_k, 1.0 / np.maximum(nz[rows, cols], tiny), 0.0)
+        inv = np.where(slip_k, 1.0 / np.maximum(nz[rows, cols], _TINY), 0.0)
         nx_, ny_ = zx[rows, cols] * inv, zy[rows, cols] * inv
         c = g[rows, cols] * inv
 
         def jac(v, slip_k=slip_k, nx_=nx_, ny_=ny_, c=c):
-            _sum_from_leading_edge(v, where, slip_k, dpx, dpy)
+            precondition(v, slip_k)
             kx, ky = operator(dpx, dpy, single=True)
             out = np.empty(v.size)
             _linearised(dpx, dpy, kx, ky, rows, cols, slip_k, nx_, ny_, c, r, out)
             return out
 
-        # forcing term (Eisenstat & Walker 1996, choice 2), no tighter than the stop needs
-        eta = min(0.1, 0.9 * (err / last_err) ** 2) if steps > 1 else 0.1
-        eta = min(max(eta, 0.3 * tol / err), 0.1)
+        eta = float(_forcing(err, last_err, steps > 1, tol))
         rhs = -np.concatenate((fx[rows, cols], fy[rows, cols]))
         try:
             y, _, _ = gmres(jac, rhs, eta)
         except np.linalg.LinAlgError:  # a breakdown: leave the case unconverged
             break
-        _sum_from_leading_edge(y, where, slip_k, dpx, dpy)
+        precondition(y, slip_k)
         # backtracking on |F| (2-norm): the full step unless it fails to decrease; no step
         # that decreases it in 5 halvings: stop, unconverged (the caller hands over)
         fnorm = math.sqrt(float(np.sum(fx * fx + fy * fy)))
@@ -416,8 +424,7 @@ def solve_steady_rolling(
     sx = np.where(slip, sx, 0.0)
     sy = np.where(slip, sy, 0.0)
     # the returned tractions satisfy the bound exactly, and lie on it in slip
-    pt = np.hypot(px, py)
-    f = np.where((pt > g) | (slip & (pt > 0.0)), g / np.where(pt > 0.0, pt, 1.0), 1.0) * inside
+    f = _onto_bound(px, py, g, slip)
     return SteadySolution(px * (f * gmax), py * (f * gmax), sx * gmax, sy * gmax, state, steps,
                           operator.products - products0, err, err <= tol)  # fmt: skip
 
@@ -646,23 +653,16 @@ def _mixed_precondition(v, rows, cases, slip, out):
 
 @jit(fastmath=True)
 def _batch_linearised(dp, kd, cases, slip, nx, ny, cf, r, out):
-    """:func:`_linearised` for packed batches: row ``q`` of ``out`` from ``dp = S v`` and
-    ``kd = K S v`` of case ``cases[q]`` (its ``slip``, ``nx, ny, cf`` rows)."""
+    """:func:`_linearised` for packed batches: row ``q`` of ``out`` from ``dp = M v`` and
+    ``kd = K M v`` of case ``cases[q]`` (its ``slip``, ``nx, ny, cf`` rows;
+    :func:`_newton_row` each)."""
     m = slip.shape[1]
     for q in range(cases.size):
         c = cases[q]
         for k in range(m):
-            kx = kd[q, k]
-            ky = kd[q, m + k]
-            if slip[c, k]:
-                ux = dp[q, k] - r * kx
-                uy = dp[q, m + k] - r * ky
-                d = nx[c, k] * ux + ny[c, k] * uy
-                out[q, k] = dp[q, k] - cf[c, k] * (ux - d * nx[c, k])
-                out[q, m + k] = dp[q, m + k] - cf[c, k] * (uy - d * ny[c, k])
-            else:
-                out[q, k] = r * kx
-                out[q, m + k] = r * ky
+            out[q, k], out[q, m + k] = _newton_row(dp[q, k], dp[q, m + k], kd[q, k],
+                                                   kd[q, m + k], slip[c, k], nx[c, k],
+                                                   ny[c, k], cf[c, k], r)  # fmt: skip
 
 
 @dataclass
@@ -720,27 +720,24 @@ def solve_steady_rolling_batch(g, w, dense: DenseRolling, *, tol=1e-6, p=None, m
     if p is None:
         p = np.zeros((nb, 2 * m))
     else:
-        p = check_finite(np.asarray(p, float), "p") / gmax[:, None]
-        pt = np.hypot(p[:, :m], p[:, m:])
-        f = np.where(pt > g, g / np.where(pt > 0.0, pt, 1.0), 1.0)
+        p = check_finite(np.asarray(p, float), "p")
+        if p.shape != (nb, 2 * m):
+            raise ValueError(f"p must have shape ({nb}, {2 * m}) (one start per case), got "
+                             f"{p.shape}")  # fmt: skip
+        p = p / gmax[:, None]
+        f = _onto_bound(p[:, :m], p[:, m:], g, False)
         p = p * np.concatenate((f, f), axis=1)
     r = 2.0 / (dense.diagonal[0] + dense.diagonal[1])
     kt = np.ascontiguousarray(dense.matrix.T)
     k32 = np.ascontiguousarray(dense.matrix32.T)
-    tiny = 1e-300
 
     def evaluate(cases, pc):
         s = w[cases] + pc @ kt
-        z = pc - r * s
-        nz = np.hypot(z[:, :m], z[:, m:])
-        gc = g[cases]
-        slip = nz > gc
-        f = np.where(slip, gc / np.maximum(nz, tiny), 1.0)
-        q = z * np.concatenate((f, f), axis=1)
-        fres = pc - q
-        qn = np.hypot(q[:, :m], q[:, m:]).max(axis=1)
-        err = np.abs(fres).max(axis=1) / np.maximum(qn, 1e-12)
-        return fres, s, z, nz, slip, err
+        fx, fy, zx, zy, nz, slip, qn = _projection(pc[:, :m], pc[:, m:], s[:, :m], s[:, m:],
+                                                   g[cases], r)  # fmt: skip
+        fres = np.concatenate((fx, fy), axis=1)
+        err = np.abs(fres).max(axis=1) / np.maximum(qn.max(axis=1), 1e-12)
+        return fres, s, np.concatenate((zx, zy), axis=1), nz, slip, err
 
     allc = np.arange(nb)
     fres, s, z, nz, slip, err = evaluate(allc, p)
@@ -754,7 +751,7 @@ def solve_steady_rolling_batch(g, w, dense: DenseRolling, *, tol=1e-6, p=None, m
             break
         steps[act] += 1
         slip_a = slip[act]
-        inv = np.where(slip_a, 1.0 / np.maximum(nz[act], tiny), 0.0)
+        inv = np.where(slip_a, 1.0 / np.maximum(nz[act], _TINY), 0.0)
         nx_, ny_ = z[act, :m] * inv, z[act, m:] * inv
         c = g[act] * inv
 
@@ -766,9 +763,7 @@ def solve_steady_rolling_batch(g, w, dense: DenseRolling, *, tol=1e-6, p=None, m
             _batch_linearised(dp, kd, k, slip_a, nx_, ny_, c, r, out)
             return out
 
-        ratio = np.where(steps[act] > 1, err[act] / np.maximum(last_err[act], tiny), 1.0)
-        eta = np.where(steps[act] > 1, np.minimum(0.1, 0.9 * ratio**2), 0.1)
-        eta = np.minimum(np.maximum(eta, 0.3 * tol / err[act]), 0.1)
+        eta = _forcing(err[act], last_err[act], steps[act] > 1, tol)
         y, used, _ = gmres_batch(jac, -fres[act], eta)
         products[act] += used
         dp = np.empty(y.shape)
@@ -793,8 +788,7 @@ def solve_steady_rolling_batch(g, w, dense: DenseRolling, *, tol=1e-6, p=None, m
                 break
         failed[act[pending]] = True
     # the returned tractions satisfy the bound exactly, and lie on it in slip
-    pt = np.hypot(p[:, :m], p[:, m:])
-    f = np.where((pt > g) | (slip & (pt > 0.0)), g / np.where(pt > 0.0, pt, 1.0), 1.0)
+    f = _onto_bound(p[:, :m], p[:, m:], g, slip)
     f2 = np.concatenate((f, f), axis=1)
     slip2 = np.concatenate((slip, slip), axis=1)
     return BatchSolution(p * f2 * gmax[:, None], np.where(slip2, s, 0.0) * gmax[:, None], slip,
