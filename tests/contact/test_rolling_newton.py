@@ -7,6 +7,8 @@ tolerance. The CONTACT cases of test_exact.py on grids of 40 x 40 and more (the 
 at 44 x 44, tractcurv at 48 x 44) already run on Newton there (``method="auto"``).
 """
 
+from unittest import mock
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -372,8 +374,9 @@ def test_dense_operator_equals_the_fft_product():
 
 
 def test_preconditioner_inverts_the_rolling_difference_in_stick_and_is_one_in_slip():
-    """M sums each grid row from the leading edge over the stick elements (the inverse of the
-    backward difference along the row) and leaves the slip elements alone."""
+    """M (both solvers') sums each grid row from the leading edge over the stick elements
+    (the inverse of the backward difference along the row) and leaves the slip elements
+    alone."""
     from railadhesion.contact import rolling_newton as rn
 
     dense, _ = _dense(9)
@@ -382,11 +385,6 @@ def test_preconditioner_inverts_the_rolling_difference_in_stick_and_is_one_in_sl
     slip = rng.random((1, dense.m)) < 0.3
     out = np.empty_like(v)
     rn._mixed_precondition(v, dense.rows, np.array([0]), slip, out)
-    where = np.full((9, 9), -1, np.int64)
-    where[dense.rows, dense.cols] = np.arange(dense.m)
-    ox, oy = np.zeros((9, 9)), np.zeros((9, 9))
-    rn._sum_from_leading_edge(v[0], where, slip[0], ox, oy)  # the one-case form: the same
-    np.testing.assert_allclose(dense.pack(ox[None], oy[None]), out, rtol=1e-14)
     for half in (0, 1):
         part = out[0, half * dense.m:(half + 1) * dense.m]
         vin = v[0, half * dense.m:(half + 1) * dense.m]
@@ -438,8 +436,11 @@ def test_many_cases_together_equal_gauss_seidel(log_aob, n, seed):
     spin = rng.choice([0.0, 0.4, -1.5, 5.0], m)
     args = (creep * np.cos(angle), creep * np.sin(angle), spin, FZ, a, b, MU)
     gs = exact_rolling(*args, nx=n, ny=n, method="gauss-seidel", tol=1e-8, return_fields=True)
-    nw = exact_rolling(*args, nx=n, ny=n, method="newton", tol=1e-8, return_fields=True)
+    with mock.patch.object(exact, "solve_steady_rolling_batch",
+                           wraps=exact.solve_steady_rolling_batch) as together:  # fmt: skip
+        nw = exact_rolling(*args, nx=n, ny=n, method="newton", tol=1e-8, return_fields=True)
     assert nw.method == "newton"
+    assert together.called  # solved together, not case by case
     for f in ("fx", "fy"):
         np.testing.assert_allclose(getattr(nw, f), getattr(gs, f), rtol=0, atol=1e-7 * FZ * MU)
     np.testing.assert_allclose(nw.mz, gs.mz, rtol=0, atol=1e-7 * FZ * MU * 6e-3)
@@ -473,7 +474,7 @@ def test_batch_mixing_shapes_frictionless_and_loadless_cases(monkeypatch):
             assert got == pytest.approx(ref, rel=0, abs=1e-9)
         k = int(np.flatnonzero(order == c)[0])
         assert float(shuffled.fy[k]) == pytest.approx(float(together.fy[c]), rel=0, abs=1e-9 * FZ)
-    assert together.fx[3] == 0.0 and together.fx[5] == 0.0
+    assert together.fx[3] == 0.0 and together.fx[5] == 0.0  # no load; no friction
 
 
 def test_batch_solver_inputs_are_checked():
@@ -535,3 +536,58 @@ def test_auto_takes_newton_for_many_cases_of_a_small_grid():
     falling = exact_rolling(xi, 3e-4, phi, FZ, 6e-3, 4e-3, MU, nx=16, ny=16, speed=20.0,
                             friction_ratio=0.4, friction_decay=0.6)  # fmt: skip
     assert falling.method == "gauss-seidel"  # falling friction: case by case, as before
+
+
+@ANY_INPUT
+def test_cases_solved_together_unfinished_go_on_by_gauss_seidel(monkeypatch):
+    """A group solved together whose Newton runs out of steps is finished case by case by
+    Gauss-Seidel from Newton's iterate: the Gauss-Seidel forces, reported as such."""
+    n = exact._DENSE_MIN_CASES
+    xi = np.linspace(1e-4, 3e-3, n)
+    args = (xi, 3e-4, 0.5, FZ, 9e-3, 3e-3, MU)
+    gs = exact_rolling(*args, nx=24, ny=12, method="gauss-seidel")
+    monkeypatch.setattr(exact, "_NEWTON_MAX_STEPS", 1)
+    nw = exact_rolling(*args, nx=24, ny=12, method="newton")
+    assert nw.method in ("gauss-seidel", "newton+gauss-seidel")
+    assert np.all(nw.iterations > 1)  # Newton's step plus the sweeps
+    np.testing.assert_allclose(nw.fy, gs.fy, rtol=0, atol=1e-6 * FZ * MU)
+
+
+@ANY_INPUT
+@pytest.mark.parametrize(
+    "grid, options",
+    [((26, 14), {}), ((20, 20), {"pressure": "discrete", "scale": 1.1}),
+     ((24, 24), {"scale": 1.3, "spin_offset": 0.0})],
+)  # fmt: skip
+def test_fields_of_cases_solved_together_equal_gauss_seidels(grid, options):
+    """``return_fields`` by the path that solves cases together: tractions, slip, stick/slip
+    map, pressure and local friction as Gauss-Seidel's, on a non-square grid with a coarse
+    start, with the discrete pressure, a larger grid extent and another spin offset."""
+    n = exact._DENSE_MIN_CASES
+    rng = np.random.default_rng(12)
+    creep = 10 ** rng.uniform(-4, -2.5, n)
+    angle = rng.uniform(0, 2 * np.pi, n)
+    args = (creep * np.cos(angle), creep * np.sin(angle), rng.choice([0.0, 0.6], n), FZ, 8e-3,
+            5e-3, MU)  # fmt: skip
+    kw = dict(nx=grid[0], ny=grid[1], tol=1e-9, return_fields=True, **options)
+    gs = exact_rolling(*args, method="gauss-seidel", **kw)
+    nw = exact_rolling(*args, method="newton", **kw)
+    assert nw.method == "newton"
+    scale = MU * np.max(gs.pn)
+    for f in ("px", "py"):
+        np.testing.assert_allclose(getattr(nw, f), getattr(gs, f), rtol=0, atol=1e-6 * scale)
+    for f in ("sx", "sy"):
+        np.testing.assert_allclose(getattr(nw, f), getattr(gs, f), rtol=0, atol=1e-8)
+    np.testing.assert_array_equal(nw.pn, gs.pn)
+    np.testing.assert_array_equal(nw.mu_local, gs.mu_local)
+    assert (nw.state != gs.state).sum() <= 2
+    assert not nw.sx[nw.state != 2].any()  # no slip in stick, nor outside the contact
+
+
+def test_batch_start_must_have_one_row_per_case():
+    dense, _ = _dense(8)
+    g = np.ones((3, dense.m))
+    w = np.full((3, 2 * dense.m), 1e-3)
+    for p in (np.zeros(2 * dense.m), np.zeros((1, 2 * dense.m)), np.zeros((3, dense.m))):
+        with pytest.raises(ValueError, match="p must have shape"):
+            solve_steady_rolling_batch(g, w, dense, p=p)

@@ -58,7 +58,7 @@ from railadhesion.contact.rolling_newton import (
     solve_steady_rolling,
     solve_steady_rolling_batch,
 )
-from railadhesion.numerics import jit
+from railadhesion.numerics import jit, jitable
 from railadhesion.plausibility import input_checker
 
 __all__ = [
@@ -825,6 +825,13 @@ def _grid_shape(mx, my, scale, shape_in):
     return xh, yh, shape, ssum
 
 
+@jitable
+def _element_size(a, b, mx, my, scale):
+    """Element size ``(dx, dy)`` [m] of the ``mx x my`` grid over ``[-scale a, scale a] x
+    [-scale b, scale b]`` (scalars or arrays; callable from compiled code)."""
+    return 2.0 * scale * a / mx, 2.0 * scale * b / my
+
+
 @jit(error_model="python")
 def _case_fields(xi, eta, phi, fz, a, b, mu, gmod, scale, spin_offset, xh, yh, shape, ssum, g,
                  wx, wy):  # fmt: skip
@@ -833,8 +840,7 @@ def _case_fields(xi, eta, phi, fz, a, b, mu, gmod, scale, spin_offset, xh, yh, s
     ``sum(p_n dA) = Fz`` exactly; ``w = (xi - phi y, eta + phi (x + spin_offset dx))``
     (Kalker 1990, eq. 1.1.11; the spin term CONTACT's FACPHI upstream)."""
     my, mx = shape.shape
-    dx = 2.0 * scale * a / mx
-    dy = 2.0 * scale * b / my
+    dx, dy = _element_size(a, b, mx, my, scale)
     pfac = fz / (ssum * dx * dy)
     for j in range(my):
         y = b * yh[j]
@@ -971,8 +977,9 @@ _COARSE_MIN = 12
 _NEWTON_MAX_STEPS = 60
 #: Newton solves the Coulomb cases of grids up to this many elements together, with dense
 #: products (:class:`~railadhesion.contact.rolling_newton.DenseRolling`; its matrix has
-#: (2 x contact elements)^2 entries: 26 MB in double precision at 32 x 32); larger grids
-#: case by case with FFT products.
+#: (2 x contact elements)^2 entries: 21 MB in double precision at 32 x 32, 812 contact
+#: elements, with about as much again in its single-precision and transposed copies);
+#: larger grids case by case with FFT products.
 _DENSE_MAX_ELEMENTS = 1024
 #: Cases solved together (the Krylov bases of a batch take about 40 x 2 x elements x 4 bytes
 #: per case).
@@ -1118,9 +1125,9 @@ def _solve_dense_batches(idx, flat, shape_in, opts, out: _BatchOutput, rest, min
         return rest
     bound = flat[6][idx] * flat[3][idx]  # mu Fz: no traction bound at all when 0
     idx = idx[bound > 0.0]
-    # group by the grid's dy/dx and nu: (b/a) (nx/ny)
-    ratio = (flat[5][idx] / flat[4][idx]) * (nx / ny)
-    keys = np.stack((ratio, flat[8][idx]), axis=1)
+    # group by the grid's dy/dx (to 1e-12: the same a/b may round differently) and nu
+    dx, dy = _element_size(flat[4][idx], flat[5][idx], nx, ny, scale)
+    keys = np.stack((np.round(np.log(dy / dx), 12), flat[8][idx]), axis=1)
     _, group = np.unique(keys, axis=0, return_inverse=True)
     cache: dict = {}
     kernels: dict = {}
@@ -1146,10 +1153,9 @@ def _solve_dense_batches(idx, flat, shape_in, opts, out: _BatchOutput, rest, min
                     its, err = _finish_by_gauss_seidel(
                         c, case, flat, opts, shape_in, kernels, px[q], py[q], sx[q], sy[q], st,
                         its)  # fmt: skip
-                dx = 2.0 * scale * case[4] / nx
-                dy = 2.0 * scale * case[5] / ny
-                _case_forces(px[q], py[q], st, shape, xh, yh, case[4], case[5], dx, dy,
-                             case[7], out.forces[c])  # fmt: skip
+                _case_forces(px[q], py[q], st, shape, xh, yh, case[4], case[5],
+                             *_element_size(case[4], case[5], nx, ny, scale), case[7],
+                             out.forces[c])  # fmt: skip
                 out.iterations[c] = its
                 out.residual[c] = err
                 out.outer[c] = 0
@@ -1178,12 +1184,18 @@ def _finish_by_gauss_seidel(c, case, flat, opts, shape_in, kernels, px, py, sx, 
     if key not in kernels:
         kernels[key] = _case_kernel(nx, ny, key[0], key[1])
     sweeps, err = _gauss_seidel(g, wx, wy, *kernels[key], tol, max_iter, px, py, sx, sy, st)
+    _check_finish(px, py, g, int(c), case[:3])
+    return its + sweeps, err
+
+
+def _check_finish(px, py, g, c, creepages):
+    """FloatingPointError unless the tractions Gauss-Seidel finished from Newton's iterate are
+    finite (a failure of both solvers: a bug to report)."""
     if not (np.all(np.isfinite(px)) and np.all(np.isfinite(py))):
         raise FloatingPointError(
-            f"exact_rolling: no finite solution for case {int(c)} (creepages {case[:3]}, "
+            f"exact_rolling: no finite solution for case {c} (creepages {creepages}, "
             f"bound max {float(g.max()):.3g}): please report it"
         )
-    return its + sweeps, err
 
 
 def _interpolate(field, xc, yc, xf, yf):
@@ -1274,11 +1286,7 @@ def _solve_one_by_one(idx, flat, shape_in, opts, out: _BatchOutput, newton: bool
             finished_by_newton = False  # Gauss-Seidel (always convergent) from Newton's iterate
             sweeps, err = _gauss_seidel(g, wx, wy, *gs_kernel(), tol, max_iter, px, py, sx, sy,
                                         st)  # fmt: skip
-            if not (np.all(np.isfinite(px)) and np.all(np.isfinite(py))):
-                raise FloatingPointError(
-                    f"exact_rolling: no finite solution for case {label[0]} (creepages "
-                    f"{label[1]}, bound max {float(g.max()):.3g}): please report it"
-                )
+            _check_finish(px, py, g, *label)
             return sol.newton_steps + sweeps, err
 
         if _is_coulomb(fratio, decay, speed):
@@ -1576,10 +1584,11 @@ def exact_rolling(
     along the rolling direction on the stick elements (the identity on the slip elements);
     each case starts from the solution on a grid half as fine (nested iteration down to 12
     elements), which leaves 3-6 Newton steps, each friction update from the previous
-    tractions. On grids of up to 1024 elements the Coulomb cases of one a/b and nu are
-    solved together, with dense matrix products for the whole group
-    (``rolling_newton.solve_steady_rolling_batch``): the fast way to many cases on a small
-    grid. A solve Newton does not finish goes on by Gauss-Seidel from Newton's iterate.
+    tractions. On grids of up to 1024 elements, groups of 16 or more Coulomb cases of one
+    a/b and nu are solved together, with dense matrix products for the whole group
+    (``rolling_newton.solve_steady_rolling_batch``; their coarse starts too, down to 6
+    elements along an axis and 144 in all): the fast way to many cases on a small grid. A
+    solve Newton does not finish goes on by Gauss-Seidel from Newton's iterate.
 
     Examples
     --------
