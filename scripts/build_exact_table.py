@@ -10,10 +10,12 @@ and c chosen so that tau = mu p0/G = 1e-3 and c = 1 cm; the results depend only 
 normalised creepages), on the build grid :func:`railadhesion.contact.table.build_grid` of
 each a/b (``--grid`` n: n x n up to a/b = 1, up to 2n x n/2 for long contacts). The
 Kalker-scaled node creepages are converted with the linear coefficients of the build grid
-itself (solved first, stored as ``cgrid``). The 6,699 cases of a row are solved by
-semismooth Newton, together (``method="newton"``: dense products on these small grids, see
-docs/exact-solver.md), to the tolerance ``TOL``. ``--jobs 2`` solves two a/b rows at a time,
-each process on one core (its BLAS limited to one thread). Runtime with ``--jobs 2`` on a
+itself (solved first, stored as ``cgrid``). The 6,699 cases of a row are solved to the
+tolerance ``TOL`` by ``exact_rolling``'s ``method="auto"``: on the default grids (576
+elements), by semismooth Newton, together (dense products; docs/exact-solver.md); on grids of
+``--grid`` 33 to 39, by Gauss-Seidel warm-started along the row; from 40 x 40, by Newton case
+by case. ``--jobs 2`` solves two a/b rows at a time, each process on one core (its BLAS
+limited to one thread). Runtime with ``--jobs 2`` on a
 two-core Intel Xeon at 2.5 GHz (2026-11-28, load average 1.2): 103 s at the default
 ``--grid 24``; by Gauss-Seidel, warm-started along the rows, it was 347 s. The two builds'
 node values agree within 2.5e-5 mu Fz.
@@ -91,7 +93,7 @@ def solve_row(ratio: float, n: int):
         warnings.simplefilter("ignore", PlausibilityWarning)
         r = exact_rolling(
             xs * f / cg[0], ys * f / cg[1], ss * f / (cg[2] * C), fz, a, b, MU,
-            shear_modulus=G, poisson=TABLE_POISSON, nx=nx, ny=ny, tol=TOL, method="newton",
+            shear_modulus=G, poisson=TABLE_POISSON, nx=nx, ny=ny, tol=TOL, warm_start=True,
         )  # fmt: skip
     values = np.stack([r.fx / (MU * fz), r.fy / (MU * fz), r.mz / (MU * fz * C)])
     return values, np.array(cg), (nx, ny)
