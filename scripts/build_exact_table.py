@@ -16,7 +16,7 @@ elements), by semismooth Newton, together (dense products; docs/exact-solver.md)
 ``--grid`` 33 to 39, by Gauss-Seidel warm-started along the row; from 40 x 40, by Newton case
 by case. ``--jobs 2`` solves two a/b rows at a time, each process on one core (its BLAS
 limited to one thread). Runtime with ``--jobs 2`` on a
-two-core Intel Xeon at 2.5 GHz (2026-11-28, load average 1.2): 103 s at the default
+two-core Intel Xeon at 2.5 GHz (2026-11-28, load average 0.9-1.2): 96-103 s at the default
 ``--grid 24``; by Gauss-Seidel, warm-started along the rows, it was 347 s. The two builds'
 node values agree within 2.5e-5 mu Fz.
 """
