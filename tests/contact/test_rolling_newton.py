@@ -591,3 +591,18 @@ def test_batch_start_must_have_one_row_per_case():
     for p in (np.zeros(2 * dense.m), np.zeros((1, 2 * dense.m)), np.zeros((3, dense.m))):
         with pytest.raises(ValueError, match="p must have shape"):
             solve_steady_rolling_batch(g, w, dense, p=p)
+
+
+@ANY_INPUT
+def test_friction_of_1e_300_is_full_slip_by_both_solvers():
+    """mu = 1e-300: the slip dwarfs the bound by 1e299; both solvers give full sliding,
+    F = -mu Fz (Gauss-Seidel overflowed in its local solution and returned NaN; with
+    ``auto`` the answer then depended on how many cases the call held)."""
+    xi = np.full(exact._DENSE_AUTO_CASES, 2e-3)
+    xi[0] = 1e-5
+    for mu in (1e-300, 1e-250):
+        for method, n in (("gauss-seidel", 2), ("newton", 2), ("auto", xi.size - 1),
+                          ("auto", xi.size)):  # fmt: skip
+            r = exact_rolling(xi[:n], 0.0, 0.0, FZ, 5e-3, 5e-3, mu, nx=16, ny=16, method=method)
+            np.testing.assert_allclose(r.fx / (mu * FZ), -1.0, rtol=1e-12)
+            assert not np.any(r.fy)

@@ -356,9 +356,13 @@ def _local_slip(ssx, ssy, kx, ky, g):
     """Traction on the bound |p| = g with p = -g s/|s|, s = ss + diag(kx, ky) p.
 
     Writing p = g e, s = -lam e (lam >= 0): ``e = -ss/(lam + g k)``, and lam solves
-    ``(ssx/(lam + g kx))^2 + (ssy/(lam + g ky))^2 = 1`` (convex, decreasing: Newton from 0).
+    ``(ssx/(lam + g kx))^2 + (ssy/(lam + g ky))^2 = 1`` (convex, decreasing: Newton from
+    below converges monotonically). The root lies in ``[|ss| - g max(k), |ss| - g min(k)]``:
+    Newton starts from the lower end (or 0), so that ``ss/(lam + g k)`` stays of order one
+    even when the slip dwarfs the bound (friction fallen to 1e-300), where a start from 0
+    overflowed in the squares.
     """
-    lam = 0.0
+    lam = max(0.0, math.hypot(ssx, ssy) - g * max(kx, ky))
     for _ in range(60):
         dx_ = lam + g * kx
         dy_ = lam + g * ky
@@ -593,11 +597,11 @@ def _gauss_seidel(g, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, tol, max_iter, px, p
     k0xx = np.ascontiguousarray(kxx[:, c0])
     k0xy = np.ascontiguousarray(kxy[:, c0])
     k0yy = np.ascontiguousarray(kyy[:, c0])
-    gt = np.ascontiguousarray(g.T)
-    wxt = np.ascontiguousarray(wx.T)
-    wyt = np.ascontiguousarray(wy.T)
-    pxt = np.ascontiguousarray(px.T)
-    pyt = np.ascontiguousarray(py.T)
+    gt = g.T.copy()  # copies (C order), scaled below: never views of the caller's arrays
+    wxt = wx.T.copy()
+    wyt = wy.T.copy()
+    pxt = px.T.copy()
+    pyt = py.T.copy()
     sxt = np.zeros((mx, my))
     syt = np.zeros((mx, my))
     stt = np.zeros((mx, my), np.int8)
@@ -613,6 +617,20 @@ def _gauss_seidel(g, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, tol, max_iter, px, p
             else:
                 pxt[ix, iy] = 0.0
                 pyt[ix, iy] = 0.0
+    # the problem is invariant under (p, w, g) -> (p, w, g) 2^k: solved with the largest bound
+    # in [0.5, 1), so that tiny friction (bounds of 1e-300) does not underflow in g^2; a power
+    # of two keeps every product exact, so the iterates are those of the unscaled problem
+    unit = math.ldexp(1.0, math.frexp(gmax)[1]) if gmax > 0.0 else 1.0
+    if unit != 1.0:
+        inv = 1.0 / unit
+        for ix in range(mx):
+            for iy in range(my):
+                gt[ix, iy] *= inv
+                wxt[ix, iy] *= inv
+                wyt[ix, iy] *= inv
+                pxt[ix, iy] *= inv
+                pyt[ix, iy] *= inv
+        gmax *= inv
     sweeps = 0
     err = 0.0
     pref = 1.0
@@ -693,8 +711,8 @@ def _gauss_seidel(g, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, tol, max_iter, px, p
         syt[:] = wyt
     for iy in range(my):
         for ix in range(mx):
-            px[iy, ix] = pxt[ix, iy]
-            py[iy, ix] = pyt[ix, iy]
+            px[iy, ix] = pxt[ix, iy] * unit
+            py[iy, ix] = pyt[ix, iy] * unit
             if gt[ix, iy] <= 0.0:
                 state[iy, ix] = _EXTERIOR
                 sx[iy, ix] = 0.0 if gmax > 0.0 else sxt[ix, iy]
@@ -705,8 +723,8 @@ def _gauss_seidel(g, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, tol, max_iter, px, p
                     sx[iy, ix] = 0.0  # zero up to the solver tolerance
                     sy[iy, ix] = 0.0
                 else:
-                    sx[iy, ix] = sxt[ix, iy]
-                    sy[iy, ix] = syt[ix, iy]
+                    sx[iy, ix] = sxt[ix, iy] * unit
+                    sy[iy, ix] = syt[ix, iy] * unit
     return sweeps, err / pref
 
 
