@@ -312,12 +312,13 @@ def test_scale_invariance_down_to_tiny_bounds():
 
 @ANY_INPUT
 def test_friction_falling_to_almost_nothing():
-    """Creepage 1 at 50 m/s with A = 0, B = 10 s/m: the local friction falls by 1e-200; Newton
-    must neither crash nor stall."""
-    r = exact_rolling(1.0, 0.0, 0.0, FZ, 5e-3, 5e-3, MU, nx=12, ny=12, method="newton",
-                      speed=50.0, friction_ratio=0.0, friction_decay=10.0)  # fmt: skip
-    assert np.isfinite(r.fx) and abs(float(r.fx)) < 1e-100 * FZ
-    assert int(r.friction_iterations) < 200
+    """Creepage 1 at 50 m/s with A = 0, B = 10 s/m: the local friction falls by 1e-200; neither
+    solver may crash or stall."""
+    for method in ("newton", "gauss-seidel"):  # Gauss-Seidel ran out of updates before
+        r = exact_rolling(1.0, 0.0, 0.0, FZ, 5e-3, 5e-3, MU, nx=12, ny=12, method=method,
+                          speed=50.0, friction_ratio=0.0, friction_decay=10.0)  # fmt: skip
+        assert np.isfinite(r.fx) and abs(float(r.fx)) < 1e-100 * FZ
+        assert int(r.friction_iterations) < 10
 
 
 def test_empty_batch_names_the_requested_method():
