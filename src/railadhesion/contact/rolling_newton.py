@@ -44,7 +44,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.fft as sfft
-from scipy.linalg import solve_triangular
 
 from railadhesion._validate import check_finite, check_nonnegative, check_range
 from railadhesion.numerics import jit, jitable
@@ -133,62 +132,18 @@ def _spectral_product(spectra, f):
 
 
 def gmres(matvec, rhs, rtol, restart=40, max_products=400):
-    """Restarted GMRES(m) for ``A x = rhs`` from ``x = 0`` (Saad & Schultz 1986).
+    """Restarted GMRES(m) for ``A x = rhs`` from ``x = 0`` (Saad & Schultz 1986): one system,
+    by :func:`gmres_batch` (the one implementation) with a double-precision basis.
 
     Arnoldi with classical Gram-Schmidt, repeated once when the first pass loses more than
     half the norm's square ("twice is enough": Giraud et al., Numer. Math. 101, 2005), Givens
     rotations for the least-squares problem. Stops when ``|rhs - A x| <= rtol |rhs|`` or
     after ``max_products`` products. Returns ``(x, products, relative residual)``.
     """
-    if isinstance(restart, bool) or not isinstance(restart, int | np.integer) or restart < 1:
-        raise ValueError(f"restart must be an integer >= 1, got {restart!r}")
-    if isinstance(max_products, bool) or not isinstance(max_products, int | np.integer) or \
-            max_products < 1:  # fmt: skip
-        raise ValueError(f"max_products must be an integer >= 1, got {max_products!r}")
-    n = rhs.size
-    x = np.zeros(n)
-    bnorm = float(np.linalg.norm(rhs))
-    if bnorm == 0.0:
-        return x, 0, 0.0
-    m = int(restart)
-    basis = np.empty((m + 1, n))
-    hess = np.zeros((m + 1, m))
-    rot = np.zeros((2, m))  # cos, sin
-    products = 0
-    r = rhs
-    while True:
-        beta = float(np.linalg.norm(r))
-        rel = beta / bnorm
-        if rel <= rtol or products >= max_products:
-            return x, products, rel
-        basis[0] = r / beta
-        e = np.zeros(m + 1)
-        e[0] = beta
-        k_used = 0
-        for k in range(m):
-            w = matvec(basis[k])
-            products += 1
-            v = basis[: k + 1]
-            wn = float(np.linalg.norm(w))
-            h = v @ w
-            w -= h @ v
-            hn = float(np.linalg.norm(w))
-            if hn < 0.7 * wn:  # cancellation: orthogonalise again
-                h2 = v @ w
-                w -= h2 @ v
-                h += h2
-                hn = float(np.linalg.norm(w))
-            rel = _givens_column(hess, rot, e, h, hn, k) / bnorm
-            k_used = k + 1
-            if hn == 0.0 or rel <= rtol or products >= max_products:
-                break
-            basis[k + 1] = w / hn
-        y = solve_triangular(hess[:k_used, :k_used], e[:k_used])
-        x += y @ basis[:k_used]
-        if rel <= rtol or products >= max_products:
-            return x, products, rel
-        r = rhs - matvec(x)
-        products += 1
+    x, products, rel = gmres_batch(lambda cases, v: matvec(v[0])[None], np.asarray(rhs)[None],
+                                   np.array([float(rtol)]), restart, max_products,
+                                   single=False)  # fmt: skip
+    return x[0], int(products[0]), float(rel[0])
 
 
 @jit
@@ -399,10 +354,7 @@ def solve_steady_rolling(
 
         eta = float(_forcing(err, last_err, steps > 1, tol))
         rhs = -np.concatenate((fx[rows, cols], fy[rows, cols]))
-        try:
-            y, _, _ = gmres(jac, rhs, eta)
-        except np.linalg.LinAlgError:  # a breakdown: leave the case unconverged
-            break
+        y, _, _ = gmres(jac, rhs, eta)
         precondition(y, slip_k)
         # backtracking on |F| (2-norm): the full step unless it fails to decrease; no step
         # that decreases it in 5 halvings: stop, unconverged (the caller hands over)
@@ -514,15 +466,23 @@ def _back_substitute(hess, e, k_used, y):
             y[b, i] = s / d if d != 0.0 else 0.0
 
 
-def gmres_batch(matvec, rhs, rtol, restart=40, max_products=400):
-    """GMRES(m) for many independent systems ``A_b x_b = rhs_b`` at once (as :func:`gmres`,
-    case by case: each case its own Krylov space, stop and solution; the products of a step
-    are one call for all cases still running).
+def gmres_batch(matvec, rhs, rtol, restart=40, max_products=400, single=True):
+    """GMRES(m) for many independent systems ``A_b x_b = rhs_b`` at once (:func:`gmres`, case
+    by case: each case its own Krylov space, stop and solution; the products of a step are one
+    call for all cases still running).
 
     ``matvec(cases, V)`` returns ``A_b v_b`` for the cases ``cases`` (indices into the batch)
-    and vectors ``V`` (len(cases), n). ``rhs`` (B, n), ``rtol`` (B,). Returns ``(x, products,
-    relative residual)`` per case.
+    and vectors ``V`` (len(cases), n). ``rhs`` (B, n), ``rtol`` (B,). ``single``: the Krylov
+    basis in single precision (enough for systems solved to 1e-1 to 1e-4, as Newton's are;
+    half the memory traffic). A breakdown (a zero pivot) leaves the solution as far as it got.
+    Returns ``(x, products, relative residual)`` per case.
     """
+    if isinstance(restart, bool) or not isinstance(restart, int | np.integer) or restart < 1:
+        raise ValueError(f"restart must be an integer >= 1, got {restart!r}")
+    if isinstance(max_products, bool) or not isinstance(max_products, int | np.integer) or \
+            max_products < 1:  # fmt: skip
+        raise ValueError(f"max_products must be an integer >= 1, got {max_products!r}")
+    dtype = np.float32 if single else np.float64
     nb, n = rhs.shape
     x = np.zeros((nb, n))
     bnorm = np.linalg.norm(rhs, axis=1)
@@ -538,7 +498,8 @@ def gmres_batch(matvec, rhs, rtol, restart=40, max_products=400):
         todo, r, beta = todo[go], r[go], beta[go]
         if not todo.size:
             break
-        _gmres_cycle(matvec, todo, r, beta, bnorm, rtol, m, max_products, x, products, rel_all)
+        _gmres_cycle(matvec, todo, r, beta, bnorm, rtol, m, max_products, x, products, rel_all,
+                     dtype)  # fmt: skip
         again = (rel_all[todo] > rtol[todo]) & (products[todo] < max_products)
         todo = todo[again]
         if todo.size:
@@ -547,14 +508,15 @@ def gmres_batch(matvec, rhs, rtol, restart=40, max_products=400):
     return x, products, rel_all
 
 
-def _gmres_cycle(matvec, slots, r, beta, bnorm, rtol, m, max_products, x, products, rel_all):
+def _gmres_cycle(matvec, slots, r, beta, bnorm, rtol, m, max_products, x, products, rel_all,
+                 dtype):  # fmt: skip
     """One cycle of :func:`gmres_batch` (at most ``m`` products per case) for the cases
-    ``slots`` with residuals ``r``: adds the corrections to ``x``. The basis is kept in single
-    precision (the systems are solved to 1e-1 to 1e-4). Cases that stop early still ride
+    ``slots`` with residuals ``r``: adds the corrections to ``x``; the basis of ``dtype``.
+    Cases that stop early still ride
     along in the products (their results unused) until they are half the batch; then they
     are finished and the arrays compacted, so the basis is copied at most a few times."""
     b, n = r.shape
-    basis = np.zeros((b, m + 1, n), np.float32)
+    basis = np.zeros((b, m + 1, n), dtype)
     hess = np.zeros((b, m + 1, m))
     rot = np.zeros((b, 2, m))
     e = np.zeros((b, m + 1))
