@@ -607,3 +607,22 @@ def test_friction_of_1e_300_is_full_slip_by_both_solvers():
             r = exact_rolling(xi[:n], 0.0, 0.0, FZ, 5e-3, 5e-3, mu, nx=16, ny=16, method=method)
             np.testing.assert_allclose(r.fx / (mu * FZ), -1.0, rtol=1e-12)
             assert not np.any(r.fy)
+
+
+@ANY_INPUT
+def test_cases_solved_together_reproduce_contacts_testbank_result():
+    """CONTACT's testbank/contact_addon.ref_out (revision 2322), result element 1 (as in
+    test_exact.py): 21 x 33 elements over 1.2353 a x 1.2353 b, a = 4.25 mm, b = 7.0 mm,
+    Fn = 42083.1 N, CKSI = 1e-3, CPHI = 0.4 rad/m, mu = 0.3, discrete pressure. CONTACT prints
+    FX/(mu FN) = -0.3868, FY/(mu FN) = -0.3657, MZ = -23.67 N m, 138 elements in adhesion and
+    225 in slip. Here 64 copies in one call, which ``auto`` solves together by Newton."""
+    n = exact._DENSE_AUTO_CASES
+    fn = 42083.1
+    r = exact_rolling(np.full(n, 1e-3), 0.0, 0.4, fn, 4.25e-3, 7.0e-3, 0.3, nx=21, ny=33,
+                      scale=5.25 / 4.25, pressure="discrete", return_fields=True)  # fmt: skip
+    assert r.method == "newton"
+    np.testing.assert_allclose(r.fx / (0.3 * fn), -0.3868, atol=0.0002)
+    np.testing.assert_allclose(r.fy / (0.3 * fn), -0.3657, atol=0.0002)
+    np.testing.assert_allclose(r.mz, -23.67, atol=0.02)
+    assert np.all((r.state == 1).sum(axis=(1, 2)) == 138)
+    assert np.all((r.state == 2).sum(axis=(1, 2)) == 225)
