@@ -28,9 +28,10 @@ def contract_rows(typingctx, tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd
               wu2, wu3):  # fmt: skip
     """The cubic interpolation of one contact in a table of rows of NOUT values:
     sum over qt, qd, qu = 0..3 of wt[qt] wd[qd] wu[qu] tab[base + qt st + qd sd + NOUT qu + j],
-    j = 0, 1, 2 (Fx, Fy, Mz). Written in LLVM vector operations: the 4 spin nodes of a
-    (t, theta) pair are 4 NOUT contiguous doubles, loaded and accumulated as one vector
-    (numba does not vectorise such short fixed loops itself: they are unrolled before its
+    j = 0, 1, 2 (Fx, Fy, Mz). ``tab``: float64, or float32 (the table model's values: read
+    as single, widened and summed in double). Written in LLVM vector operations: the 4 spin
+    nodes of a (t, theta) pair are 4 NOUT contiguous values, loaded and accumulated as one
+    vector (numba does not vectorise such short fixed loops itself: they are unrolled before its
     loop vectoriser runs, and its SLP vectoriser is off). The products are summed along
     theta, then t, then u.
 
@@ -39,8 +40,9 @@ def contract_rows(typingctx, tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd
     times slower (measured side by side, one thread; docs/kernels.md).
     The only LLVM IR of the package; it uses numba's public extension API (``intrinsic``)."""
     f64 = types.float64
-    if not (isinstance(tab, types.Array) and tab.dtype == f64 and tab.ndim == 1
-            and tab.layout == "C" and all(isinstance(v, types.Integer) for v in (base, st, sd))
+    if not (isinstance(tab, types.Array) and tab.dtype in (f64, types.float32)
+            and tab.ndim == 1 and tab.layout == "C"
+            and all(isinstance(v, types.Integer) for v in (base, st, sd))
             and all(w == f64 for w in (wt0, wt1, wt2, wt3, wd0, wd1, wd2, wd3, wu0, wu1, wu2,
                                        wu3))):  # fmt: skip
         return None
@@ -58,6 +60,11 @@ def contract_rows(typingctx, tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd
         n = 4 * NOUT
         vrun = ir.VectorType(ir.DoubleType(), n)  # the 4 spin nodes of a (t, theta) pair
         vnode = ir.VectorType(ir.DoubleType(), NOUT)
+        # a single-precision table is read as single (half the memory traffic of the lookup,
+        # which waits mostly on its table rows) and widened before any arithmetic
+        single = signature.args[0].dtype == types.float32
+        vload = ir.VectorType(ir.FloatType(), n) if single else vrun
+        align = 4 if single else 8
         flags = ("contract",)
 
         def splat(x, vty, width):
@@ -71,8 +78,11 @@ def contract_rows(typingctx, tab, base, st, sd, wt0, wt1, wt2, wt3, wd0, wd1, wd
             part = None
             for qd in range(4):
                 row = builder.add(row_t, builder.mul(sd_, ir.Constant(i64, qd)))
-                ptr = builder.bitcast(builder.gep(data, [row], inbounds=True), vrun.as_pointer())
-                term = builder.fmul(builder.load(ptr, align=8), splat(wd[qd], vrun, n),
+                ptr = builder.bitcast(builder.gep(data, [row], inbounds=True), vload.as_pointer())
+                vals = builder.load(ptr, align=align)
+                if single:
+                    vals = builder.fpext(vals, vrun)
+                term = builder.fmul(vals, splat(wd[qd], vrun, n),
                                     flags=flags)  # fmt: skip
                 part = term if part is None else builder.fadd(part, term, flags=flags)
             term = builder.fmul(part, splat(wt[qt], vrun, n), flags=flags)
