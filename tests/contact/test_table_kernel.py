@@ -21,25 +21,35 @@ G, MU, FZ = 8.2e10, 0.3, 1e5
 
 
 def _cubic_weights(v, nodes):
-    """Catmull-Rom weights (n, 4) and node indices (n, 4) along one uniform axis, the ghost
-    nodes beyond the ends folded into the end weights (f[-1] = 3 f0 - 3 f1 + f2, likewise at
-    the other end): the table's scheme (module docstring), written out independently."""
+    """Catmull-Rom weights (n, N + 2) along one uniform axis of N nodes, over the nodes with a
+    ghost node before the first and after the last (index 0 and N + 1): the table's scheme
+    (module docstring), written out independently."""
     n = nodes.size
     q = np.clip((v - nodes[0]) / (nodes[1] - nodes[0]), 0.0, n - 1.0)
     i = np.minimum(np.floor(q), n - 2).astype(int)
     w = q - i
     wts = 0.5 * np.stack([-(w**3) + 2 * w**2 - w, 3 * w**3 - 5 * w**2 + 2,
                           -3 * w**3 + 4 * w**2 + w, w**3 - w**2], axis=1)  # fmt: skip
-    ids = i[:, None] + np.arange(-1, 3)
-    full = np.zeros((v.size, n))  # weight of every node
+    full = np.zeros((v.size, n + 2))  # weight of every node, ghosts included
     rows = np.arange(v.size)[:, None]
-    inside = (ids >= 0) & (ids < n)
-    np.add.at(full, (np.broadcast_to(rows, ids.shape)[inside], ids[inside]), wts[inside])
-    lo = np.where(ids[:, 0] < 0, wts[:, 0], 0.0)
-    hi = np.where(ids[:, 3] > n - 1, wts[:, 3], 0.0)
-    full[:, :3] += lo[:, None] * np.array([3.0, -3.0, 1.0])
-    full[:, -3:] += hi[:, None] * np.array([1.0, -3.0, 3.0])
+    np.add.at(full, (np.broadcast_to(rows, wts.shape), i[:, None] + np.arange(4)), wts)
     return full
+
+
+def _with_ghost_nodes(values):
+    """The file's values (3, na, nt, nd, nu) with a ghost node at both ends of each axis,
+    extrapolated quadratically (f[-1] = 3 f0 - 3 f1 + f2, likewise at the other end) and held
+    in single precision like the file's nodes (the table's scheme, module docstring)."""
+    v = values.astype(float)
+    for ax in range(1, 5):
+        first = np.take(v, [0, 1, 2], axis=ax)
+        last = np.take(v, [-1, -2, -3], axis=ax)
+        lo = 3 * np.take(first, [0], axis=ax) - 3 * np.take(first, [1], axis=ax) + np.take(
+            first, [2], axis=ax)  # fmt: skip
+        hi = 3 * np.take(last, [0], axis=ax) - 3 * np.take(last, [1], axis=ax) + np.take(
+            last, [2], axis=ax)  # fmt: skip
+        v = np.concatenate([lo, v, hi], axis=ax)
+    return v.astype(np.float32).astype(float)
 
 
 def _reference(xi, eta, phi, a, b, nu=0.28):
@@ -64,7 +74,8 @@ def _reference(xi, eta, phi, a, b, nu=0.28):
     wt = _cubic_weights(t, d["tmag"])
     wd = _cubic_weights(th, d["theta"])
     wu = _cubic_weights(u, d["uspin"])
-    out = np.einsum("na,nt,nd,nu,katdu->kn", wa, wt, wd, wu, d["values"], optimize=True)
+    out = np.einsum("na,nt,nd,nu,katdu->kn", wa, wt, wd, wu, _with_ghost_nodes(d["values"]),
+                    optimize=True)  # fmt: skip
     ft = np.maximum(np.hypot(out[0], out[1]), 1.0)
     return (sgn * MU * FZ * out[0] / ft, sgn * sy * MU * FZ * out[1] / ft,
             sgn * sy * MU * FZ * c * out[2])  # fmt: skip
@@ -155,11 +166,13 @@ def _contract_ir(tab, base, st, sd, w):
                         w[9], w[10], w[11])  # fmt: skip
 
 
-def test_llvm_contraction_equals_plain_numba_code():
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_llvm_contraction_equals_plain_numba_code(dtype):
     """The one piece of hand-written LLVM IR (the table's 4 x 4 x 4 contraction) against the
-    same sums in plain numba code, at strides and weights of every kind."""
+    same sums in plain numba code, at strides and weights of every kind, for tables of double
+    and of single precision (the table model's: read as single, summed in double)."""
     rng = np.random.default_rng(8)
-    tab = rng.uniform(-1.0, 1.0, 4000)
+    tab = rng.uniform(-1.0, 1.0, 4000).astype(dtype)
     for st, sd in ((300, 40), (48, 12), (12, 700)):
         for _ in range(50):
             base = int(rng.integers(0, 4000 - 3 * st - 3 * sd - 4 * tm._NOUT))

@@ -600,7 +600,7 @@ def test_a_function_that_allocates_is_refused():
 
 NESTED = np.dtype([("v", "f8"), ("n", "i8", (2, 3)), ("flag", "u1"),
                    ("sub", np.dtype([("k", "i4"), ("w", "f8", (2,))], align=True)),
-                   ("last", "i4")], align=True)  # fmt: skip
+                   ("last", "i4"), ("single", "f4", (5,))], align=True)  # fmt: skip
 
 
 def test_c_struct_reproduces_numpy_layout_and_values(tmp_path):
@@ -612,6 +612,9 @@ def test_c_struct_reproduces_numpy_layout_and_values(tmp_path):
     record["sub"]["k"] = -7
     record["sub"]["w"] = [[math.pi, -1e-300]]
     record["last"] = 2**31 - 1
+    # single precision (the table model's values): shortest texts as float literals, a
+    # whole number, the largest float and a denormal among them
+    record["single"] = [[0.1, -2.0, 3.4028235e38, 1e-45, -1.0e-7]]
     program = tmp_path / "layout.c"
     program.write_text("#include <math.h>\n#include <stddef.h>\n#include <stdint.h>\n"
                        "#include <stdio.h>\n" + c_struct(NESTED, "rec") + "\n"
@@ -628,7 +631,7 @@ def test_c_struct_reproduces_numpy_layout_and_values(tmp_path):
     ("dtype", "message"),
     [
         (np.dtype([("a", "u1"), ("b", "f8")]), "align=True"),
-        (np.dtype([("a", "f4")], align=True), "float64, int64"),
+        (np.dtype([("a", "f2")], align=True), "float64, int64"),
         (np.dtype([("int", "f8")], align=True), "not a valid C identifier"),
         (np.dtype("f8"), "at least one field"),
     ],

@@ -24,7 +24,8 @@ which no interpolation along the two axes can carry. Other quadrants follow from
 symmetries (xi, eta, phi) -> -(xi, eta, phi) (all outputs change sign) and
 (eta, phi) -> -(eta, phi) (Fy and Mz change sign). Interpolation in compiled code, cubic
 (Catmull-Rom) along every axis, with a ghost node beyond each end extrapolated quadratically
-(stored in the table as loaded). The nodes are solved with the build grid's own linear
+(stored in the table as loaded, in single precision like the file's nodes; the sums are in
+double precision). The nodes are solved with the build grid's own linear
 coefficients and looked up with Kalker's
 (:func:`railadhesion.contact.kalker.kalker_coefficients`, the compliances 1/C interpolated
 between Kalker's rows, ``compliance=True``: C linear in b/a overshoots the exact theory's
@@ -206,15 +207,18 @@ def _load():
     data["origin"] = np.array([ax[0] for ax in axes])
     data["inv_step"] = np.array([(ax.size - 1) / (ax[-1] - ax[0]) for ax in axes])
     # outputs last, as rows of _NOUT (Fx, Fy, Mz): the 4 spin nodes of a (t, theta) pair
-    # that a lookup needs are then 12 contiguous doubles, loaded as one SIMD vector; ghost
-    # nodes on every axis
-    # (in double precision: the file holds single)
+    # that a lookup needs are then 12 contiguous values, loaded as one SIMD vector; ghost
+    # nodes on every axis (extrapolated in double precision, then rounded to single like the
+    # file's nodes). Held in single precision, as the file holds them: the 4-D lookup waits
+    # mostly on its table rows (a/b varying per contact: 4 planes of the table, which is
+    # larger than a core's cache), so half the bytes make it faster (benchmarks/
+    # bench_exact.py); the interpolation itself is computed in double precision
     values = _with_ghosts(np.moveaxis(data["values"], 0, -1).astype(float), (0, 1, 2, 3))
-    padded = np.zeros(values.shape[:-1] + (_NOUT,))
+    padded = np.zeros(values.shape[:-1] + (_NOUT,), dtype=np.float32)
     padded[..., :3] = values
     data["padded"] = _read_only(padded)
     data["padded_flat"] = data["padded"].reshape(-1)
-    # distance in memory (doubles) between consecutive nodes along log(a/b), t, theta, u
+    # distance in memory (values) between consecutive nodes along log(a/b), t, theta, u
     data["strides"] = np.array([padded.strides[j] // padded.itemsize for j in range(4)],
                                dtype=np.int64)  # fmt: skip
     for v in ("dims", "strides", "origin", "inv_step"):
@@ -258,9 +262,9 @@ def _slice_at(laob: float) -> np.ndarray:
     na = int(d["dims"][0])
     ia, wa = _locate_uniform(laob, d["origin"][0], d["inv_step"][0], na)
     planes = d["padded"]  # the a/b nodes ia - 1 .. ia + 2 are planes ia .. ia + 3
-    out = np.zeros(planes.shape[1:])
+    out = np.zeros(planes.shape[1:])  # in double precision, as the kernel sums
     for q, w in enumerate(_catmull_rom(wa)):
-        out += w * planes[int(ia) + q]
+        out += w * planes[int(ia) + q].astype(float)
     return _read_only(out.reshape(-1))
 
 

@@ -137,6 +137,7 @@ _C_KEYWORDS = frozenset(
 # FMI Real values are stored in fields of these types (fmi2SetReal rounds for the integers).
 _C_TYPES = {
     "f8": ("double", "RA_F64"),
+    "f4": ("float", None),  # in records only (the table model's values), not as a variable
     "i8": ("int64_t", "RA_I64"),
     "i4": ("int32_t", "RA_I32"),
     "u1": ("uint8_t", "RA_U8"),
@@ -397,7 +398,8 @@ def _c_scalar(dtype: np.dtype, where: str) -> str:
     key = f"{dtype.kind}{dtype.itemsize}"
     if key not in _C_TYPES:
         raise ValueError(f"{where}: dtype {dtype} is not supported "
-                         "(float64, int64, int32, uint8, bool; uint64 in records only)")
+                         "(float64, int64, int32, uint8, bool; float32 and uint64 in records "
+                         "only)")
     return _C_TYPES[key][0]
 
 
@@ -469,11 +471,15 @@ def _c_number(value) -> str:
         return "1" if value else "0"
     if isinstance(value, (int, np.integer)):
         return str(int(value))
+    single = isinstance(value, np.float32)
+    text = str(value) if single else None  # shortest text that reads back to the same float
     value = float(value)
     if value != value:
         return "NAN"
     if value in (np.inf, -np.inf):
         return "INFINITY" if value > 0 else "(-INFINITY)"
+    if single:  # a float literal: the compiler rounds the text to single once (never twice)
+        return text + ("f" if any(c in text for c in ".e") else ".0f")
     return repr(value)  # shortest text that reads back to the same double
 
 

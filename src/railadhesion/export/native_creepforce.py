@@ -16,10 +16,10 @@ they do: the FMU gives the library's numbers (tested to 1e-12 on 10^4 random inp
 force <= 0 (wheel lift-off) gives zero forces and zero adhesion, as the Python FMU.
 
 The table model's step calls :func:`railadhesion.contact.exact_table_law` on the package's 4-D
-table, held in the settings record (2.6 MB, compiled into the binary's start values), with
-the friction of a Polach set; an a/b outside the table's range [0.2, 5] fails the step (its
-other inputs' ranges are the variables' bounds, checked by ``fmi2SetReal``), and it has a
-fourth output, ``Mz``.
+table, held in the settings record (1.3 MB of single-precision values, compiled into the
+binary's start values), with the friction of a Polach set; an a/b outside the table's range
+[0.2, 5] fails the step (its other inputs' ranges are the variables' bounds, checked by
+``fmi2SetReal``), and it has a fourth output, ``Mz``.
 """
 
 from __future__ import annotations
@@ -139,14 +139,15 @@ def _table_step(settings_t, inputs_t):
 
 def _table_step_model(params, variables, inputs_t, friction):
     """The table model (friction μ0, A, B of the Polach set ``params``, or Coulomb's μ0) as a
-    :class:`StepModel`: the package's 4-D table (2.6 MB) compiled into the settings."""
+    :class:`StepModel`: the package's 4-D table (single precision, 1.3 MB) compiled into the
+    settings."""
     from railadhesion.contact.table import exact_table_arrays
 
     tab, dims, strides, origin, inv_step = exact_table_arrays()
     settings_t = np.dtype([("shear_modulus", "f8"), ("poisson", "f8"), ("mu0", "f8"),
                            ("A", "f8"), ("B", "f8"), ("dims", "i8", (4,)),
                            ("strides", "i8", (4,)), ("origin", "f8", (4,)),
-                           ("inv_step", "f8", (4,)), ("tab", "f8", (tab.size,))],
+                           ("inv_step", "f8", (4,)), ("tab", tab.dtype.str, (tab.size,))],
                           align=True)  # fmt: skip
     settings = np.zeros(1, settings_t)
     coulomb = friction == "coulomb"
