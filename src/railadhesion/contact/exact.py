@@ -55,6 +55,7 @@ from railadhesion.contact.kalker import check_creepages, check_rolling_inputs
 from railadhesion.contact.rolling_newton import (
     DenseRolling,
     RollingOperator,
+    cap_rigid_slip,
     solve_steady_rolling,
     solve_steady_rolling_batch,
 )
@@ -619,18 +620,29 @@ def _gauss_seidel(g, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, tol, max_iter, px, p
                 pyt[ix, iy] = 0.0
     # the problem is invariant under (p, w, g) -> (p, w, g) 2^k: solved with the largest bound
     # in [0.5, 1), so that tiny friction (bounds of 1e-300) does not underflow in g^2; a power
-    # of two keeps every product exact, so the iterates are those of the unscaled problem
-    unit = math.ldexp(1.0, math.frexp(gmax)[1]) if gmax > 0.0 else 1.0
-    if unit != 1.0:
-        inv = 1.0 / unit
+    # of two keeps every product exact, so the iterates are those of the unscaled problem.
+    # By ldexp: 2^-k overflows for denormal bounds (friction of 1e-310); and the rigid slips
+    # beyond 2^800 bounds capped (full sliding, cap_rigid_slip), or they overflow when scaled
+    expo = math.frexp(gmax)[1] if gmax > 0.0 else 0
+    unit = math.ldexp(1.0, expo)  # exact down to 2^-1073, the exponent of the least bound
+    wx_cut = np.zeros((mx, my))  # the part of w removed by the cap, added back to the slip
+    wy_cut = np.zeros((mx, my))
+    capped = np.zeros((mx, my), np.bool_)
+    if gmax > 0.0:
+        cx, cy, capped = cap_rigid_slip(wxt, wyt, np.full(mx, gmax))
+        wx_cut = wxt - cx
+        wy_cut = wyt - cy
+        wxt = cx
+        wyt = cy
+    if expo != 0:
         for ix in range(mx):
             for iy in range(my):
-                gt[ix, iy] *= inv
-                wxt[ix, iy] *= inv
-                wyt[ix, iy] *= inv
-                pxt[ix, iy] *= inv
-                pyt[ix, iy] *= inv
-        gmax *= inv
+                gt[ix, iy] = math.ldexp(gt[ix, iy], -expo)
+                wxt[ix, iy] = math.ldexp(wxt[ix, iy], -expo)
+                wyt[ix, iy] = math.ldexp(wyt[ix, iy], -expo)
+                pxt[ix, iy] = math.ldexp(pxt[ix, iy], -expo)
+                pyt[ix, iy] = math.ldexp(pyt[ix, iy], -expo)
+        gmax = math.ldexp(gmax, -expo)
     sweeps = 0
     err = 0.0
     pref = 1.0
@@ -725,6 +737,9 @@ def _gauss_seidel(g, wx, wy, kxx, kxy, kyy, spec, dgx, dgy, tol, max_iter, px, p
                 else:
                     sx[iy, ix] = sxt[ix, iy] * unit
                     sy[iy, ix] = syt[ix, iy] * unit
+                    if capped[ix, iy]:  # the slip is linear in w: the capped part added back
+                        sx[iy, ix] += wx_cut[ix, iy]
+                        sy[iy, ix] += wy_cut[ix, iy]
     return sweeps, err / pref
 
 

@@ -49,10 +49,12 @@ from railadhesion._validate import check_finite, check_nonnegative, check_range
 from railadhesion.numerics import jit, jitable
 
 __all__ = [
+    "SLIP_CAP",
     "BatchSolution",
     "DenseRolling",
     "RollingOperator",
     "SteadySolution",
+    "cap_rigid_slip",
     "gmres",
     "gmres_batch",
     "solve_steady_rolling",
@@ -199,6 +201,45 @@ class SteadySolution:
 #: Floor of |z| in the projection's divisions.
 _TINY = 1e-300
 
+#: Largest rigid slip over the largest traction bound that the solvers scale (2^800): beyond,
+#: an element slides fully whatever the tractions (the elastic slip ``K p`` is at most some
+#: 1e3 bounds), so its rigid slip is capped there, keeping its direction (:func:`cap_rigid_slip`).
+SLIP_CAP = 2.0**800
+
+
+@jit
+def cap_rigid_slip(wx, wy, gmax):
+    """The rigid slip ``wx, wy`` [-] (R, C), row i a case with largest traction bound
+    ``gmax[i]`` (R,), with every element's slip capped at magnitude ``SLIP_CAP gmax[i]``, its
+    direction kept. Returns the capped copies and where they were capped (R, C).
+
+    The problem is invariant under ``(p, w, g) -> (p, w, g)/gmax``; the solvers solve it so
+    scaled, where a friction so small that the bound is denormal (mu = 1e-310) makes ``w/gmax``
+    overflow. An element whose rigid slip exceeds ``SLIP_CAP gmax`` slides fully, ``p = -g
+    w/|w|`` to rounding, with or without the cap; capped, nothing overflows. The slip is
+    linear in ``w``: the caller adds the removed part ``w - capped`` back to the slip it
+    reports. Ordinary inputs (creepages below 1, mu p_n/G above 1e-200) are never capped and
+    are returned bit for bit.
+    """
+    rows, cols = wx.shape
+    cx = np.empty((rows, cols))
+    cy = np.empty((rows, cols))
+    capped = np.zeros((rows, cols), np.bool_)
+    for i in range(rows):
+        lim = SLIP_CAP * gmax[i]  # inf for bounds beyond 2^223: nothing to cap then
+        for j in range(cols):
+            x = wx[i, j]
+            y = wy[i, j]
+            n = math.hypot(x, y)
+            if n > lim:  # the unit vector times lim: w lim/|w| could underflow in lim/|w|
+                cx[i, j] = x / n * lim
+                cy[i, j] = y / n * lim
+                capped[i, j] = True
+            else:
+                cx[i, j] = x
+                cy[i, j] = y
+    return cx, cy, capped
+
 
 def _projection(px, py, sx, sy, g, r):
     """Coulomb's law as a projection, element by element, for fields of any shape:
@@ -305,9 +346,12 @@ def solve_steady_rolling(
         return SteadySolution(zero.copy(), zero.copy(), wx.copy(), wy.copy(),
                               np.zeros(shape, np.int8), 0, 0, 0.0, True)  # fmt: skip
     # the problem is invariant under (p, w, g) -> (p, w, g)/gmax: solved at a bound of order 1
-    # whatever mu p_n/G is (no underflow in norms and floors), scaled back at the end
+    # whatever mu p_n/G is (no underflow in norms and floors), scaled back at the end; rigid
+    # slips beyond 2^800 bounds capped (full sliding), or w/gmax overflows for denormal bounds
+    wx0, wy0 = wx, wy
+    cx, cy, capped = cap_rigid_slip(wx, wy, np.full(shape[0], gmax))
     g = g / gmax
-    wx, wy = wx / gmax, wy / gmax
+    wx, wy = cx / gmax, cy / gmax
     r = 2.0 / (operator.diagonal[0] + operator.diagonal[1])
     if px is None:
         px, py = zero.copy(), zero.copy()
@@ -373,11 +417,14 @@ def solve_steady_rolling(
         last_err = err
         (px, py), (fx, fy, sx, sy, zx, zy, nz, slip), err = accepted
     state = np.where(inside, np.where(slip, 2, 1), 0).astype(np.int8)
-    sx = np.where(slip, sx, 0.0)
-    sy = np.where(slip, sy, 0.0)
+    sx = np.where(slip, sx, 0.0) * gmax
+    sy = np.where(slip, sy, 0.0) * gmax
+    back = capped & slip  # the slip is linear in w: the capped part of w added back
+    sx[back] += (wx0 - cx)[back]
+    sy[back] += (wy0 - cy)[back]
     # the returned tractions satisfy the bound exactly, and lie on it in slip
     f = _onto_bound(px, py, g, slip)
-    return SteadySolution(px * (f * gmax), py * (f * gmax), sx * gmax, sy * gmax, state, steps,
+    return SteadySolution(px * (f * gmax), py * (f * gmax), sx, sy, state, steps,
                           operator.products - products0, err, err <= tol)  # fmt: skip
 
 
@@ -675,10 +722,14 @@ def solve_steady_rolling_batch(g, w, dense: DenseRolling, *, tol=1e-6, p=None, m
     if isinstance(max_steps, bool) or not isinstance(max_steps, int | np.integer) or \
             max_steps < 1:  # fmt: skip
         raise ValueError(f"max_steps must be an integer >= 1, got {max_steps!r}")
-    # scaled to a bound of 1 per case (as solve_steady_rolling)
+    # scaled to a bound of 1 per case, rigid slips capped (as solve_steady_rolling)
     gmax = g.max(axis=1)
+    cx, cy, capped = cap_rigid_slip(w[:, :m], w[:, m:], gmax)
+    capped = np.concatenate((capped, capped), axis=1)
+    w_capped = np.concatenate((cx, cy), axis=1)
+    removed = w - w_capped  # 0 where not capped
     g = g / gmax[:, None]
-    w = w / gmax[:, None]
+    w = w_capped / gmax[:, None]
     if p is None:
         p = np.zeros((nb, 2 * m))
     else:
@@ -753,5 +804,8 @@ def solve_steady_rolling_batch(g, w, dense: DenseRolling, *, tol=1e-6, p=None, m
     f = _onto_bound(p[:, :m], p[:, m:], g, slip)
     f2 = np.concatenate((f, f), axis=1)
     slip2 = np.concatenate((slip, slip), axis=1)
-    return BatchSolution(p * f2 * gmax[:, None], np.where(slip2, s, 0.0) * gmax[:, None], slip,
-                         steps, products, err, err <= tol)  # fmt: skip
+    s = np.where(slip2, s, 0.0) * gmax[:, None]
+    back = slip2 & capped  # the slip is linear in w: the capped part of w added back
+    s[back] += removed[back]
+    return BatchSolution(p * f2 * gmax[:, None], s, slip, steps, products, err,
+                         err <= tol)  # fmt: skip
