@@ -1108,11 +1108,15 @@ def _dense_newton(idx, flat, mx, my, scale, spin_offset, shape_in, tol, cache):
     dy/dx and nu, solved together (:func:`solve_steady_rolling_batch`), each started from
     the solution on a grid half as fine (nested iteration, as :func:`_coarse_start`;
     Hertz's pressure on the coarse grids). Returns the grid's shape data, its
-    :class:`DenseRolling` and the solution."""
+    :class:`DenseRolling` and the solution; None when a case's traction bound underflows to 0
+    on a contact element (mu p_n/G below 5e-324: friction of 1e-323), which Newton's scaling
+    by the largest bound does not admit (the cases are then solved one by one)."""
     xh, yh, shape, ssum = _grid_shape(mx, my, scale, shape_in)
     inside = shape > 0.0
     g, w, ratio = _dense_fields(idx, flat, mx, my, scale, spin_offset, xh, yh, shape, ssum,
                                 inside)  # fmt: skip
+    if not np.all(g > 0.0):
+        return None
     nu = float(flat[8][idx[0]])
     key = (mx, my, float(ratio[0]), nu, inside.tobytes())
     if key not in cache:
@@ -1123,11 +1127,12 @@ def _dense_newton(idx, flat, mx, my, scale, spin_offset, shape_in, tol, cache):
     if min(mc, nc) >= _DENSE_COARSE_MIN and mc * nc >= _DENSE_COARSE_ELEMENTS:
         coarse = _dense_newton(idx, flat, mc, nc, scale, spin_offset, np.empty((0, 0)),
                                _COARSE_TOL, cache)  # fmt: skip
-        (xc, yc, _, _), dense_c, sol_c = coarse
-        key_i = ("interpolation", mc, nc, mx, my, scale, inside.tobytes())
-        if key_i not in cache:
-            cache[key_i] = _interpolation_matrix(dense_c, xc, yc, dense, xh, yh)
-        start = sol_c.p @ cache[key_i].T
+        if coarse is not None:
+            (xc, yc, _, _), dense_c, sol_c = coarse
+            key_i = ("interpolation", mc, nc, mx, my, scale, inside.tobytes())
+            if key_i not in cache:
+                cache[key_i] = _interpolation_matrix(dense_c, xc, yc, dense, xh, yh)
+            start = sol_c.p @ cache[key_i].T
     sol = solve_steady_rolling_batch(g, w, dense, tol=tol, p=start, max_steps=_NEWTON_MAX_STEPS)
     return (xh, yh, shape, ssum), dense, sol
 
@@ -1151,7 +1156,8 @@ def _solve_dense_batches(idx, flat, shape_in, opts, out: _BatchOutput, rest, min
     dy/dx and nu of at least ``min_cases`` cases (default ``_DENSE_MIN_CASES``;
     :func:`_dense_newton`); a case Newton does not finish is finished by Gauss-Seidel from
     Newton's iterate (and counts as solved by Gauss-Seidel). Returns ``rest`` without the
-    cases solved here (smaller groups, and cases without friction, mu p_n = 0, stay)."""
+    cases solved here (smaller groups, cases without friction, mu p_n = 0, and chunks with a
+    bound underflowing to 0 stay)."""
     nx, ny, scale, spin_offset, tol, max_iter, tol_f, max_f, keep, warm = opts
     min_cases = _DENSE_MIN_CASES if min_cases is None else min_cases
     if not idx.size:
@@ -1171,8 +1177,10 @@ def _solve_dense_batches(idx, flat, shape_in, opts, out: _BatchOutput, rest, min
             continue
         for lo in range(0, members.size, _DENSE_BATCH):
             chunk = members[lo:lo + _DENSE_BATCH]
-            (xh, yh, shape, _), dense, sol = _dense_newton(
-                chunk, flat, nx, ny, scale, spin_offset, shape_in, tol, cache)
+            solved = _dense_newton(chunk, flat, nx, ny, scale, spin_offset, shape_in, tol, cache)
+            if solved is None:  # a bound underflowed: the chunk is solved one by one
+                continue
+            (xh, yh, shape, _), dense, sol = solved
             px, py = dense.unpack(sol.p)
             sx, sy = dense.unpack(sol.s)
             state = np.where(dense.inside, 1, 0).astype(np.int8)
