@@ -14,11 +14,13 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from railadhesion.contact import exact
+from railadhesion.contact import exact, rolling_newton
 from railadhesion.contact.exact import exact_rolling
 from railadhesion.contact.rolling_newton import (
+    SLIP_CAP,
     DenseRolling,
     RollingOperator,
+    cap_rigid_slip,
     gmres,
     gmres_batch,
     solve_steady_rolling,
@@ -607,6 +609,161 @@ def test_friction_of_1e_300_is_full_slip_by_both_solvers():
             r = exact_rolling(xi[:n], 0.0, 0.0, FZ, 5e-3, 5e-3, mu, nx=16, ny=16, method=method)
             np.testing.assert_allclose(r.fx / (mu * FZ), -1.0, rtol=1e-12)
             assert not np.any(r.fy)
+
+
+#: The four ways a case is solved: (method, number of cases in the call); 64 cases of one grid
+#: under ``auto`` are solved together by the batched Newton solver.
+DENORMAL_PATHS = (("gauss-seidel", 2), ("newton", 2), ("auto", 2),
+                  ("auto", exact._DENSE_AUTO_CASES))  # fmt: skip
+
+#: One unit of a denormal bound as a traction [Pa], 2^-1074 G: the bound mu p_n/G of an
+#: element is rounded to such units, so its tractions exceed mu p_n by up to one.
+_DENORMAL_G = 2.0**-1074 * 8.2e10
+
+
+def _denormal_rtol(mu, n_contact, nx, ny, a, b, gmod=8.2e10):
+    """Relative accuracy of F = -mu Fz in full sliding when the bound is denormal: each
+    element's bound ``mu p_n/G`` is rounded to a multiple of 2^-1074, an error of at most
+    2^-1075 G dA in its force; 1e-9 when that is smaller (mu = 1e-310: bounds of 1e-312 hold
+    39 bits, 2e-12 relative; mu = 1e-320: bounds of 1e-322 hold 5 bits, 1.6e-2)."""
+    da = (2.0 * a / nx) * (2.0 * b / ny)
+    return max(1e-9, 0.5 * n_contact * (2.0**-1074 * gmod) * da / (mu * FZ))  # 2^-1075 is 0
+
+
+@ANY_INPUT
+@pytest.mark.parametrize("mu", [1e-310, 1e-320])
+def test_friction_with_a_denormal_bound_is_full_slip_by_every_solver(mu):
+    """mu = 1e-310 and 1e-320: the bound mu p_n/G is a denormal number and the rigid slip
+    over it overflows (Gauss-Seidel returned NaN, Newton raised). Rigid slips beyond 2^800
+    bounds are capped (full sliding anyway): every path gives F = -mu Fz (to the rounding of
+    the denormal bounds), finite tractions, every contact element in slip, and the slip
+    reported is the rigid slip, the removed part added back."""
+    xi, nx, a = 2e-3, 16, 5e-3
+    for method, n in DENORMAL_PATHS:
+        r = exact_rolling(np.full(n, xi), 0.0, 0.0, FZ, a, a, mu, nx=nx, ny=nx, method=method,
+                          return_fields=True)  # fmt: skip
+        if n == exact._DENSE_AUTO_CASES:
+            assert np.all(r.method == "newton")  # the batched path
+        contact = r.pn > 0.0
+        n_contact = int(contact[0].sum())
+        rtol = _denormal_rtol(mu, n_contact, nx, nx, a, a)
+        assert rtol <= (1e-9 if mu == 1e-310 else 0.02)
+        np.testing.assert_allclose(r.fx / (mu * FZ), -1.0, rtol=rtol)
+        assert not np.any(r.fy)
+        for f in (r.px, r.py, r.sx, r.sy):
+            assert np.all(np.isfinite(f))
+        assert np.all(np.hypot(r.px, r.py) <= 1.0000001 * mu * r.pn + _DENORMAL_G)
+        np.testing.assert_array_equal(r.state == 2, contact)  # full slip
+        np.testing.assert_allclose(r.sx[contact], xi, rtol=1e-12)
+        np.testing.assert_allclose(r.sy[contact], 0.0, rtol=0, atol=1e-12 * xi)
+
+
+@ANY_INPUT
+def test_friction_of_the_least_denormal_leaves_no_bound():
+    """mu = 5e-324, the least denormal: mu p_n/G (some 1e-326) rounds to 0 on every element,
+    so the discrete problem has no friction left: F = 0 by every path (the batched path
+    hands such cases to the one-by-one solvers; it raised on a zero bound)."""
+    mu = 5e-324
+    for method, n in DENORMAL_PATHS:
+        r = exact_rolling(np.full(n, 2e-3), 0.0, 0.0, FZ, 5e-3, 5e-3, mu, nx=16, ny=16,
+                          method=method, return_fields=True)  # fmt: skip
+        assert not np.any(r.fx) and not np.any(r.fy) and not np.any(r.mz)
+        assert not np.any(r.px) and not np.any(r.py)
+        assert not np.any(r.state)  # no element with a traction bound
+
+
+@ANY_INPUT
+@pytest.mark.parametrize("nx", [15, 16])
+def test_pure_spin_with_a_denormal_bound_stays_within_the_bound(nx):
+    """Pure spin at mu = 1e-310: the rigid slip vanishes only near the spin's pole, where it
+    is not capped (the cap is per element); finite, and |F| <= mu Fz by every path."""
+    mu = 1e-310
+    for method, n in DENORMAL_PATHS:
+        r = exact_rolling(np.zeros(n), 0.0, 2.0, FZ, 6e-3, 4e-3, mu, nx=nx, ny=nx,
+                          method=method, return_fields=True)  # fmt: skip
+        for f in (r.fx, r.fy, r.mz, r.px, r.py, r.sx, r.sy):
+            assert np.all(np.isfinite(f))
+        assert np.all(np.hypot(r.fx, r.fy) <= (1.0 + 1e-9) * mu * FZ)
+        assert np.all(np.hypot(r.px, r.py) <= 1.0000001 * mu * r.pn + _DENORMAL_G)
+        assert np.all(r.mz != 0.0)  # the spin's moment, nearly all elements sliding
+
+
+def test_cap_keeps_the_direction_and_leaves_small_slips_alone():
+    """cap_rigid_slip: beyond SLIP_CAP gmax, the slip is cut to that magnitude along its own
+    direction (no underflow for slips of 1e300 over a bound of 5e-324); below, returned bit for
+    bit."""
+    gmax = np.array([5e-324, 1e-310, 0.01])
+    wx = np.array([[3e-3, 0.0, -1e300], [2e-3, 1e-300, 0.0], [1.0, -0.5, 0.0]])
+    wy = np.array([[4e-3, 0.0, 1e-300], [-2e-3, 0.0, 0.0], [1.0, 0.25, 0.0]])
+    cx, cy, capped = cap_rigid_slip(wx, wy, gmax)
+    lim = SLIP_CAP * gmax[:, None]
+    expect = np.hypot(wx, wy) > lim
+    np.testing.assert_array_equal(capped, expect)
+    np.testing.assert_allclose(np.hypot(cx, cy)[capped], np.broadcast_to(lim, wx.shape)[capped],
+                               rtol=1e-15)  # fmt: skip
+    np.testing.assert_allclose((cx * wy - cy * wx)[capped], 0.0, atol=1e-15 * lim.max())
+    assert np.all(cx[capped] * wx[capped] >= 0.0) and np.all(cy[capped] * wy[capped] >= 0.0)
+    assert cx[~capped].tobytes() == wx[~capped].tobytes()
+    assert cy[~capped].tobytes() == wy[~capped].tobytes()
+
+
+def _cap_spy(record):
+    """cap_rigid_slip, recording whether each call capped anything."""
+
+    def spy(wx, wy, gmax):
+        out = cap_rigid_slip(wx, wy, gmax)
+        record.append(bool(out[2].any()))
+        return out
+
+    return spy
+
+
+@ANY_INPUT
+@settings(max_examples=25, deadline=None)
+@given(
+    log_mu=st.floats(np.log(1e-3), 0.0),
+    log_creep=st.floats(np.log(1e-8), 0.0),
+    angle=st.floats(0.0, 2 * np.pi),
+    spin=st.sampled_from([0.0, 0.5, -5.0]),
+    log_aob=st.floats(np.log(0.2), np.log(5.0)),
+    n=st.sampled_from([1, exact._DENSE_AUTO_CASES]),
+)
+def test_cap_never_triggers_on_ordinary_inputs(log_mu, log_creep, angle, spin, log_aob, n):
+    """mu 1e-3..1, creepage 1e-8..1 (any direction, with spin): no element's rigid slip comes
+    near 2^800 bounds, so the cap changes nothing (its every call, one-case and batched
+    Newton, by a spy; Gauss-Seidel gets the same bounds and slips)."""
+    record = []
+    a = 6e-3 * np.exp(0.5 * log_aob)
+    b = 6e-3 * np.exp(-0.5 * log_aob)
+    creep = np.exp(log_creep)
+    with mock.patch.object(rolling_newton, "cap_rigid_slip", _cap_spy(record)):
+        exact_rolling(np.full(n, creep * np.cos(angle)), creep * np.sin(angle), spin, FZ, a, b,
+                      np.exp(log_mu), nx=12, ny=12, method="newton")  # fmt: skip
+    assert record and not any(record)
+
+
+def _never_capped(wx, wy, gmax):
+    """cap_rigid_slip disabled: the inputs' copies, nothing capped."""
+    return np.array(wx, float), np.array(wy, float), np.zeros(np.shape(wx), bool)
+
+
+@ANY_INPUT
+def test_cap_leaves_ordinary_results_bit_for_bit():
+    """Ordinary cases (mu = 0.3 and 1e-3, creepage and spin) by the one-case and the batched
+    Newton solvers: the same bits as with the cap disabled."""
+    rng = np.random.default_rng(5)
+    n = exact._DENSE_AUTO_CASES
+    xi, eta = rng.uniform(-3e-3, 3e-3, n), rng.uniform(-2e-3, 2e-3, n)
+    phi = rng.choice([0.0, 0.5, 2.0], n)
+    for mu in (0.3, 1e-3):
+        for cases in (3, n):
+            args = (xi[:cases], eta[:cases], phi[:cases], FZ, 6e-3, 4e-3, mu)
+            kw = dict(nx=12, ny=14, method="newton", return_fields=True)
+            r = exact_rolling(*args, **kw)
+            with mock.patch.object(rolling_newton, "cap_rigid_slip", _never_capped):
+                ref = exact_rolling(*args, **kw)
+            for f in ("fx", "fy", "mz", "px", "py", "sx", "sy", "state"):
+                assert np.asarray(getattr(r, f)).tobytes() == np.asarray(getattr(ref, f)).tobytes()
 
 
 @ANY_INPUT
