@@ -578,12 +578,13 @@ class BrakingSimulator:
         s["available"][:n] = np.nan
         s["stop_time"] = s["stop_distance"] = np.nan
         if dtype == MACHINE:  # machine and tables in one buffer: the per-step calls pass it
-            size = MACHINE.itemsize
-            buffer = np.zeros(size + 8 * tables.size, np.uint8)
-            buffer[:size] = machine.view(np.uint8)
-            buffer[size:] = tables.view(np.uint8)
-            machine = buffer[:size].view(MACHINE)
-            tables = buffer[size:].view(np.float64)
+            # (step.split_buffer: the machine record, then records holding the tables)
+            records = 1 + -(-8 * tables.size // MACHINE.itemsize)
+            buffer = np.zeros(records, MACHINE)
+            buffer[:1] = machine
+            buffer[1:].view(np.float64)[: tables.size] = tables
+            machine = buffer[:1]
+            tables = buffer[1:].view(np.float64)[: tables.size]
             step_entries = entries[4:6]
         else:  # another controller or sensor model: its records' dtypes, the typed entries
             buffer = None

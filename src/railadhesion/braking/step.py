@@ -30,7 +30,7 @@ Entry points for Python, on the simulator's one-element ``machine`` array (recor
 :func:`railadhesion.braking.records.machine_dtype`): :func:`advance` (the stepping API),
 :func:`run` (the whole stop of ``simulate``, brake demand included), :func:`available` (the
 adhesion available on request); and, for the stepping API's per-call speed, the same on one
-byte buffer holding the machine and the tables (:func:`advance_builtin`,
+buffer of machine records holding the machine and the tables (:func:`advance_builtin`,
 :func:`advance_python` and their ``_recorded`` forms).
 """
 
@@ -74,9 +74,7 @@ __all__ = ["step", "advance", "advance_unrecorded", "split_buffer", "advance_buf
            "FINGERPRINT", "SAFEGUARD_TOL", "SPEED_FLOOR"]
 
 #: The machine record of the built-in WSP and sensor model. The per-step entry points take
-#: the machine and the tables as one byte buffer (:func:`split_buffer`) and view it with this
-#: dtype: numba's dispatcher then resolves one uint8 array (tens of nanoseconds) instead of a
-#: large structured dtype (microseconds).
+#: the machine and the tables as one array of these records (:func:`split_buffer`).
 MACHINE = machine_dtype(_wsp.SETTINGS_DTYPE, _wsp.STATE_DTYPE, _sensors.SETTINGS_DTYPE,
                         _sensors.STATE_DTYPE)
 
@@ -579,16 +577,18 @@ def advance_unrecorded(machine, tables, dt, aux):
     return advance(machine, tables, None, dt, aux)
 
 
-# The per-step entry points take one byte buffer: the machine record (dtype MACHINE) then the
-# tables (float64). numba's dispatcher then resolves and unboxes one uint8 array per call.
-
-_SIZE = MACHINE.itemsize
+# The per-step entry points take one buffer, an array of MACHINE records: the first is the
+# machine, the ones after it hold the tables (float64, zeros after the last table). One array
+# to unbox per call; and the tables are a view of records as float64, whose bounds numba
+# computes from the two item sizes alone (constants), where a view of bytes as a record
+# divides the byte length by the record's size at run time on every call.
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def split_buffer(buffer):
-    """The machine (one record of :data:`MACHINE`) and the tables in a simulator's buffer."""
-    return buffer[:_SIZE].view(MACHINE), buffer[_SIZE:].view(np.float64)
+    """The machine (its first record, of :data:`MACHINE`) and the tables (the records after
+    it, as float64) in a simulator's buffer."""
+    return buffer[:1], buffer[1:].view(np.float64)
 
 
 @njit(cache=True, error_model="numpy", inline="always")

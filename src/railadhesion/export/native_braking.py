@@ -105,7 +105,7 @@ def braking_step_model(simulator, identifier: str = "railadhesion_braking") -> S
     gives the FMU with the WSP inside: ``valve_k`` are then outputs
     (:func:`railadhesion.export.braking_fmu_variables` with ``wsp=True``)."""
     from railadhesion.braking.records import INPUTS, POLACH, WILAC
-    from railadhesion.braking.step import MACHINE, split_buffer
+    from railadhesion.braking.step import MACHINE
 
     if simulator._rows is not None:  # noqa: SLF001
         raise ValueError("simulator: build it with record=False")
@@ -115,7 +115,7 @@ def braking_step_model(simulator, identifier: str = "railadhesion_braking") -> S
             "simulator: the native braking FMU compiles the package's WSP controller and "
             "sensor model only (WheelSlideProtection, SensorModel); this simulator has another "
             "controller or sensor model: use the Python braking FMU")
-    machine, tables = split_buffer(buffer)
+    machine, tables = simulator._machine, simulator._tables  # noqa: SLF001
     n = int(machine[0]["settings"]["n_axles"])
     if int(machine[0]["settings"]["model"]) not in (POLACH, WILAC):
         raise NativeUnsupported(
