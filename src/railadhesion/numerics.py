@@ -319,7 +319,11 @@ def atan_nonneg(x):
     """arctan(x) for x >= 0 (and inf), within an ulp of libm's; no calls, no branches."""
     big = x > _AT_T3P8
     mid = x > 0.66
-    xr = -1.0 / x if big else ((x - 1.0) / (x + 1.0) if mid else x)
+    # the reduced argument -1/x, (x - 1)/(x + 1) or x as one division (x/1 is x exactly): a
+    # loop over lanes, vectorised, computes both sides of a select, and divides only once
+    num = -1.0 if big else (x - 1.0 if mid else x)
+    den = x if big else (x + 1.0 if mid else 1.0)
+    xr = num / den
     y0 = _HALF_PI if big else (_QUARTER_PI if mid else 0.0)
     extra = _AT_MOREBITS if big else (0.5 * _AT_MOREBITS if mid else 0.0)
     z = xr * xr
