@@ -179,7 +179,11 @@ def polach_curve(creep, slope, inverse_mu, ratio):
     z = math.pi * slope * creep / (2.0 * (1.0 + ratio))
     x = z * inverse_mu
     y = ratio * x
-    g = atan_nonneg(y) / y if y > 1e-6 else 1.0 - y * y / 3.0
+    # g = atan(y)/y, or 1 - y**2/3 near 0: the two quotients as one division (a loop over
+    # lanes, vectorised, computes both sides of a select, and divides only once)
+    far = y > 1e-6
+    t = (atan_nonneg(y) if far else y * y) / (y if far else 3.0)
+    g = t if far else 1.0 - t
     xx = x * x
     f = 2.0 / math.pi * z * (1.0 / (1.0 + xx) + ratio * g)
     fp = (1.0 - xx) / ((1.0 + xx) * (1.0 + xx)) + ratio / (1.0 + y * y)
