@@ -371,13 +371,21 @@ def wilac_axle_parameters(packed, wheel_loads, speed, water, weights, params, sc
                 for t in range(count):
                     p = first + 4 * t
                     c = packed[p]
-                    fa = scratch[int(packed[p + 1])]
-                    fb = scratch[int(packed[p + 2])]
-                    fc = scratch[int(packed[p + 3])]
-                    s0 = s0 + wilac_term(c, fa[b], fb[b], fc[b])
-                    s1 = s1 + wilac_term(c, fa[b + 1], fb[b + 1], fc[b + 1])
-                    s2 = s2 + wilac_term(c, fa[b + 2], fb[b + 2], fc[b + 2])
-                    s3 = s3 + wilac_term(c, fa[b + 3], fb[b + 3], fc[b + 3])
+                    # the rows of the term's three factors, indexed in place (a row view
+                    # per factor would be an array built, and reference-counted, per term)
+                    fa = int(packed[p + 1])
+                    fb = int(packed[p + 2])
+                    fc = int(packed[p + 3])
+                    s0 = s0 + wilac_term(c, scratch[fa, b], scratch[fb, b], scratch[fc, b])
+                    s1 = s1 + wilac_term(
+                        c, scratch[fa, b + 1], scratch[fb, b + 1], scratch[fc, b + 1]
+                    )
+                    s2 = s2 + wilac_term(
+                        c, scratch[fa, b + 2], scratch[fb, b + 2], scratch[fc, b + 2]
+                    )
+                    s3 = s3 + wilac_term(
+                        c, scratch[fa, b + 3], scratch[fb, b + 3], scratch[fc, b + 3]
+                    )
                 scratch[7, b], scratch[7, b + 1], scratch[7, b + 2], scratch[7, b + 3] = (
                     s0, s1, s2, s3)
                 for a in range(b, last):
