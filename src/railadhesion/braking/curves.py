@@ -72,7 +72,7 @@ __all__ = ["new_workspace", "build_lanes", "evaluate_lanes", "peak_lanes", "wate
            "register_python_model", "table_axle_curve", "table_slopes", "table_axle_peak",
            "table_peak",
            "TABLE_AUX",
-           "refresh_adhesion", "evaluate_adhesion", "peak_adhesion"]
+           "refresh_adhesion", "evaluate_adhesion", "peak_adhesion", "evaluation_tables"]
 
 _GOLDEN = 0.6180339887498949
 
@@ -738,6 +738,19 @@ def _implementations(aux):
     return (lambda s, st, tables, aux: None,  # a user law needs only the wheel loads
             lambda s, st, tables, aux, speed: _user_evaluate(s, st, aux, speed),
             lambda s, st, tables, aux, speed: _user_peak(s, st, tables, aux, speed))
+
+
+def evaluation_tables(tables, aux):
+    """The tables that :func:`evaluate_adhesion` of the family ``aux`` reads: ``tables`` for
+    the table model, None for the others (their curves need no table)."""
+    raise NotImplementedError("compiled code only")
+
+
+@overload(evaluation_tables, jit_options={"error_model": "numpy"})
+def _evaluation_tables(tables, aux):
+    if isinstance(aux, types.Float):
+        return lambda tables, aux: tables
+    return lambda tables, aux: None
 
 
 @overload(refresh_adhesion, jit_options={"error_model": "numpy"})

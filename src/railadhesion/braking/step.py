@@ -46,6 +46,7 @@ from railadhesion.braking import wsp as _wsp
 from railadhesion.braking.curves import (
     TABLE_AUX,
     evaluate_adhesion,
+    evaluation_tables,
     peak_adhesion,
     refresh_adhesion,
 )
@@ -370,15 +371,13 @@ def _at_rest(s, st, v0, dt, external):
 
 @njit(cache=True, error_model="numpy")
 def _substep(s, st, u, tables, rows, dt, aux):
-    """One step of length dt with the valves in s.valve and the commands in u."""
+    """One step of length dt with the valves in s.valve and the commands in u (the refresh
+    due at its start done by :func:`step`); ``tables`` as
+    :func:`~railadhesion.braking.curves.evaluation_tables` gives them."""
     n = st.n_axles
     c = s.curve
     radius = st.wheel_radius
     brake = st.brake_coefficient
-    if s.time >= s.next_refresh - 1e-12:
-        _refresh(s, st, tables, aux)
-        period = st.refresh_period
-        s.next_refresh = (math.floor(s.time / period + 1e-9) + 1.0) * period
     v0 = s.speed
     d0 = s.deceleration
     for i in range(n):
@@ -550,7 +549,13 @@ def step(s, st, u, wsp_settings, wsp_state, sensor_settings, sensor_state, table
         if st.wsp_on != 0 and s.time >= s.next_control - 1e-9 * period:
             _control(s, st, u, wsp_settings, wsp_state, sensor_settings, sensor_state)
             s.next_control = (math.floor(s.time / period + 1e-9) + 1.0) * period
-        status = _substep(s, st, u, tables, rows, h, aux)
+        if s.time >= s.next_refresh - 1e-12:
+            _refresh(s, st, tables, aux)
+            every = st.refresh_period
+            s.next_refresh = (math.floor(s.time / every + 1e-9) + 1.0) * every
+        # the tables go on only to a family that evaluates its curves with them: numba counts
+        # the references of an array at the entry and exit of every function it is passed to
+        status = _substep(s, st, u, evaluation_tables(tables, aux), rows, h, aux)
         if status != OK:
             return status
     return OK
