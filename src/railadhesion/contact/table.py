@@ -23,10 +23,12 @@ creepage and large spin met in a corner where the solution depends on the ratio 
 which no interpolation along the two axes can carry. Other quadrants follow from the
 symmetries (xi, eta, phi) -> -(xi, eta, phi) (all outputs change sign) and
 (eta, phi) -> -(eta, phi) (Fy and Mz change sign). Interpolation in compiled code, cubic
-(Catmull-Rom) along every axis, with a ghost node beyond each end extrapolated quadratically
-(stored in the table as loaded, in single precision like the file's nodes; the sums are in
-double precision). The nodes are solved with the build grid's own linear
-coefficients and looked up with Kalker's
+(Catmull-Rom) along t, theta and u, with a ghost node beyond each end extrapolated
+quadratically; along log(a/b) linear between the planes of a grid ``AOB_REFINE`` times
+finer than the file's, on which the cubic through the file's planes (with its ghost planes)
+is evaluated once, at load. The table as loaded holds the values in single precision, like
+the file's nodes; the sums are in double precision. The nodes are solved with the build
+grid's own linear coefficients and looked up with Kalker's
 (:func:`railadhesion.contact.kalker.kalker_coefficients`, the compliances 1/C interpolated
 between Kalker's rows, ``compliance=True``: C linear in b/a overshoots the exact theory's
 coefficients of long contacts by up to 4.5 % between the rows), which removes most of the
@@ -107,6 +109,15 @@ BIG = 1e4
 #: contacts, lateral creepage against spin) closer to the converged solution, for 1.5 times
 #: the rebuild time (docs/validation/exact_models.md).
 BUILD_N = 24
+
+#: Planes of the table as loaded per interval of the file's a/b nodes: the cubic interpolation
+#: along log(a/b) evaluated, once at load, on a grid this many times finer, between whose
+#: planes a lookup interpolates linearly (2 planes a contact rather than the cubic's 4: the
+#: lookup with a/b varying per contact waits mostly on its table rows). The linear step
+#: departs from the cubic by at most 1.2e-3 mu Fz (|(Fx, Fy)|) and 8e-4 mu Fz c (Mz) at the
+#: table's nodes (tests/contact/test_table_kernel.py), against the model's error budget of
+#: 0.02 mu Fz; the table as loaded is then 3.9 MB in single precision.
+AOB_REFINE = 4
 
 
 def table_axes(n_aob=9, n_mag=29, n_dir=7, n_spin=33):
@@ -203,23 +214,30 @@ def _load():
         if ax.size < 4 or not np.allclose(np.diff(ax), (ax[-1] - ax[0]) / (ax.size - 1),
                                           rtol=1e-9, atol=1e-12):  # fmt: skip
             raise RuntimeError("exact_table.npz: table axes are not uniform")
-    data["dims"] = np.array([ax.size for ax in axes], dtype=np.int64)
+    # along log(a/b) the planes of the finer grid (AOB_REFINE), without ghost nodes
+    na = axes[0].size
+    data["dims"] = np.array([(na - 1) * AOB_REFINE + 1] + [ax.size for ax in axes[1:]],
+                            dtype=np.int64)  # fmt: skip
     data["origin"] = np.array([ax[0] for ax in axes])
     data["inv_step"] = np.array([(ax.size - 1) / (ax[-1] - ax[0]) for ax in axes])
+    data["inv_step"][0] *= AOB_REFINE
     # outputs last, as rows of _NOUT (Fx, Fy, Mz): the 4 spin nodes of a (t, theta) pair
     # that a lookup needs are then 12 contiguous values, loaded as one SIMD vector; ghost
-    # nodes on every axis (extrapolated in double precision, then rounded to single like the
-    # file's nodes). Held in single precision, as the file holds them: the 4-D lookup waits
-    # mostly on its table rows (a/b varying per contact: 4 planes of the table, which is
-    # larger than a core's cache), so half the bytes make it faster (benchmarks/
-    # bench_exact.py); the interpolation itself is computed in double precision
+    # nodes on the axes t, theta, u (extrapolated in double precision)
     values = _with_ghosts(np.moveaxis(data["values"], 0, -1).astype(float), (0, 1, 2, 3))
-    padded = np.zeros(values.shape[:-1] + (_NOUT,), dtype=np.float32)
-    padded[..., :3] = values
-    data["padded"] = _read_only(padded)
-    data["padded_flat"] = data["padded"].reshape(-1)
+    # the cubic along log(a/b) (the ghost planes its first and last intervals need) at the
+    # finer grid's nodes: the file's planes at every AOB_REFINE-th, unchanged
+    planes = np.zeros((int(data["dims"][0]),) + values.shape[1:-1] + (_NOUT,), np.float32)
+    for j in range(planes.shape[0]):
+        i, w = _locate_uniform(j / AOB_REFINE, 0.0, 1.0, na)
+        planes[j, ..., :3] = sum(c * values[int(i) + q] for q, c in enumerate(_catmull_rom(w)))
+    # held in single precision, as the file holds the nodes: the 4-D lookup waits mostly on
+    # its table rows (a/b varying per contact), so half the bytes make it faster; the
+    # interpolation itself is computed in double precision
+    data["planes"] = _read_only(planes)
+    data["padded_flat"] = data["planes"].reshape(-1)
     # distance in memory (values) between consecutive nodes along log(a/b), t, theta, u
-    data["strides"] = np.array([padded.strides[j] // padded.itemsize for j in range(4)],
+    data["strides"] = np.array([planes.strides[j] // planes.itemsize for j in range(4)],
                                dtype=np.int64)  # fmt: skip
     for v in ("dims", "strides", "origin", "inv_step"):
         data[v] = _read_only(data[v])
@@ -255,16 +273,13 @@ def _locate_uniform(v, v0, inv_h, n):
 
 @lru_cache(maxsize=32)
 def _slice_at(laob: float) -> np.ndarray:
-    """The table (with ghost nodes) interpolated cubically, as in the kernel, to one
-    log(a/b): a flat read-only array, layout of :func:`_load`'s ``padded`` without the a/b
-    axis."""
+    """The table interpolated, as in the kernel (linearly between the planes of the finer
+    grid along log(a/b)), to one log(a/b): a flat read-only array in double precision,
+    layout of :func:`_load`'s ``planes`` without the a/b axis."""
     d = _load()
-    na = int(d["dims"][0])
-    ia, wa = _locate_uniform(laob, d["origin"][0], d["inv_step"][0], na)
-    planes = d["padded"]  # the a/b nodes ia - 1 .. ia + 2 are planes ia .. ia + 3
-    out = np.zeros(planes.shape[1:])  # in double precision, as the kernel sums
-    for q, w in enumerate(_catmull_rom(wa)):
-        out += w * planes[int(ia) + q].astype(float)
+    ia, wa = _locate_uniform(laob, d["origin"][0], d["inv_step"][0], int(d["dims"][0]))
+    planes = d["planes"]
+    out = (1.0 - wa) * planes[int(ia)].astype(float) + wa * planes[int(ia) + 1].astype(float)
     return _read_only(out.reshape(-1))
 
 
@@ -339,11 +354,12 @@ def table_forces(f0, f1, f2, sgn, sy, kf, c):
 
 @jitable
 def table_sums(tab, dims, strides, origin, inv_step, laob, t, th, u):
-    """The cubic (Catmull-Rom) interpolation of the normalised (Fx, Fy, Mz/c)/(mu Fz) at table
-    coordinates (log a/b, t, theta, u). ``tab``: the table with ghost nodes, flat
-    (:func:`_load`'s ``padded_flat``), its four axes' ``dims``, ``strides``, ``origin``,
-    ``inv_step``; or its slice at one a/b (:func:`_slice_at`, ``strides[0] = 0``; ``laob``
-    unused)."""
+    """The interpolation of the normalised (Fx, Fy, Mz/c)/(mu Fz) at table coordinates
+    (log a/b, t, theta, u): cubic (Catmull-Rom) along t, theta, u, linear between the planes
+    of the finer grid along log(a/b) (``AOB_REFINE``). ``tab``: the table as loaded,
+    flat (:func:`_load`'s ``padded_flat``), its four axes' ``dims``, ``strides``,
+    ``origin``, ``inv_step``; or its slice at one a/b (:func:`_slice_at`,
+    ``strides[0] = 0``; ``laob`` unused)."""
     it, ft = _locate_uniform(t, origin[1], inv_step[1], dims[1])
     id_, fd = _locate_uniform(th, origin[2], inv_step[2], dims[2])
     iu, fu = _locate_uniform(u, origin[3], inv_step[3], dims[3])
@@ -357,16 +373,11 @@ def table_sums(tab, dims, strides, origin, inv_step, laob, t, th, u):
     if sa == 0:
         return contract_rows(tab, o, st, sd, t0, t1, t2, t3, d0, d1, d2, d3, u0, u1, u2, u3)
     ia, fa = _locate_uniform(laob, origin[0], inv_step[0], dims[0])
-    w = _catmull_rom(fa)
     o += int(ia) * sa
-    f0 = f1 = f2 = 0.0
-    for q in range(4):
-        p0, p1, p2 = contract_rows(tab, o + q * sa, st, sd, t0, t1, t2, t3, d0, d1, d2, d3,
-                                      u0, u1, u2, u3)  # fmt: skip
-        f0 += w[q] * p0
-        f1 += w[q] * p1
-        f2 += w[q] * p2
-    return f0, f1, f2
+    p0, p1, p2 = contract_rows(tab, o, st, sd, t0, t1, t2, t3, d0, d1, d2, d3, u0, u1, u2, u3)
+    q0, q1, q2 = contract_rows(tab, o + sa, st, sd, t0, t1, t2, t3, d0, d1, d2, d3, u0, u1, u2,
+                               u3)  # fmt: skip
+    return (1.0 - fa) * p0 + fa * q0, (1.0 - fa) * p1 + fa * q1, (1.0 - fa) * p2 + fa * q2
 
 
 @jitable
@@ -402,9 +413,9 @@ _UNIT = (0.0, 0.0, 1.0, 1.0)
 _NIN = 12
 _R_RATIO, _R_C11 = 12, 13  # C11, C22, C23 in rows 13-15
 _R_T, _R_TH, _R_U, _R_SGN, _R_SY, _R_KF, _R_C, _R_BASE, _R_FAC = range(16, 25)
-_R_W = 25  # 16 rows of cubic weights: t, theta, u, log(a/b)
-_R_F = 41  # the 3 interpolated outputs
-_TROWS = 44
+_R_W = 25  # 12 rows of cubic weights (t, theta, u), 2 of linear ones (log(a/b))
+_R_F = 39  # the 3 interpolated outputs
+_TROWS = 42
 
 
 @jit
@@ -453,9 +464,23 @@ def _stage_weights(v, v0, inv_h, n, stride, base, w, m):
 
 
 @jit
+def _stage_linear(v, v0, inv_h, n, stride, base, w, m):
+    """Linear weights along log(a/b) (coordinates ``v``) into the rows of ``w`` (2, CHUNK), the
+    axis' part of each contact's first table row added to ``base`` (as
+    :func:`_stage_weights`)."""
+    w0, w1 = w[0], w[1]
+    for k in range(m):
+        i, f = _locate_uniform(v[k], v0, inv_h, n)
+        w0[k] = 1.0 - f
+        w1[k] = f
+        base[k] = base[k] + i * stride
+
+
+@jit
 def _stage_sums(tab, buf, m, st, sd, sa):
     """The interpolated outputs of each contact (:func:`~railadhesion.simd.contract_rows`;
-    sa > 0: also along log(a/b), the planes sa apart) into rows _R_F to _R_F + 2."""
+    sa > 0: also along log(a/b), linearly between the planes sa apart) into rows _R_F to
+    _R_F + 2."""
     for k in range(m):
         o = int(buf[_R_BASE * CHUNK + k])
         r = _R_W * CHUNK + k  # the 12 weights along t, theta, u, CHUNK apart
@@ -468,14 +493,15 @@ def _stage_sums(tab, buf, m, st, sd, sa):
             f0, f1, f2 = contract_rows(tab, o, st, sd, w0, w1, w2, w3, w4, w5, w6, w7, w8,
                                           w9, w10, w11)  # fmt: skip
         else:
-            f0 = f1 = f2 = 0.0
-            for q in range(4):
-                wa = buf[(_R_W + 12 + q) * CHUNK + k]
-                p0, p1, p2 = contract_rows(tab, o + q * sa, st, sd, w0, w1, w2, w3, w4, w5,
-                                              w6, w7, w8, w9, w10, w11)  # fmt: skip
-                f0 += wa * p0
-                f1 += wa * p1
-                f2 += wa * p2
+            p0, p1, p2 = contract_rows(tab, o, st, sd, w0, w1, w2, w3, w4, w5, w6, w7, w8, w9,
+                                       w10, w11)  # fmt: skip
+            q0, q1, q2 = contract_rows(tab, o + sa, st, sd, w0, w1, w2, w3, w4, w5, w6, w7, w8,
+                                       w9, w10, w11)  # fmt: skip
+            wa = buf[(_R_W + 12) * CHUNK + k]
+            wb = buf[(_R_W + 13) * CHUNK + k]
+            f0 = wa * p0 + wb * q0
+            f1 = wa * p1 + wb * q1
+            f2 = wa * p2 + wb * q2
         buf[_R_F * CHUNK + k] = f0
         buf[(_R_F + 1) * CHUNK + k] = f1
         buf[(_R_F + 2) * CHUNK + k] = f2
@@ -566,8 +592,8 @@ def _table_chunks(xi, eta, phi, fz, a, b, mu, g, nu, v, la, lb, kc, tab, dims, s
             laob = rows[_R_RATIO]
             for k in range(m):
                 laob[k] = math.log(laob[k])
-            _stage_weights(laob, origin[0], inv_step[0], dims[0], sa, base,
-                           rows[_R_W + 12 : _R_W + 16], m)  # fmt: skip
+            _stage_linear(laob, origin[0], inv_step[0], dims[0], sa, base,
+                          rows[_R_W + 12 : _R_W + 14], m)  # fmt: skip
         _stage_sums(tab, buf, m, strides[1], strides[2], sa)
         _stage_forces(buf, m, ox, oy, oz)
     return nbad

@@ -16,8 +16,8 @@ they do: the FMU gives the library's numbers (tested to 1e-12 on 10^4 random inp
 force <= 0 (wheel lift-off) gives zero forces and zero adhesion, as the Python FMU.
 
 The table model's step calls :func:`railadhesion.contact.exact_table_law` on the package's 4-D
-table, held in the settings record (1.3 MB of single-precision values, compiled into the
-binary's start values), with the friction of a Polach set; an a/b outside the table's range
+table as loaded, held in the settings record (3.9 MB of single-precision values, compiled
+into the binary's start values), with the friction of a Polach set; an a/b outside the table's range
 [0.2, 5] fails the step (its other inputs' ranges are the variables' bounds, checked by
 ``fmi2SetReal``), and it has a fourth output, ``Mz``.
 """
@@ -139,8 +139,8 @@ def _table_step(settings_t, inputs_t):
 
 def _table_step_model(params, variables, inputs_t, friction):
     """The table model (friction μ0, A, B of the Polach set ``params``, or Coulomb's μ0) as a
-    :class:`StepModel`: the package's 4-D table (single precision, 1.3 MB) compiled into the
-    settings."""
+    :class:`StepModel`: the package's 4-D table as loaded (single precision, 3.9 MB) compiled
+    into the settings."""
     from railadhesion.contact.table import exact_table_arrays
 
     tab, dims, strides, origin, inv_step = exact_table_arrays()
