@@ -353,6 +353,18 @@ def table_forces(f0, f1, f2, sgn, sy, kf, c):
 
 
 @jitable
+def _two_planes(tab, o, sa, st, sd, w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, wa, wb):
+    """The interpolation along log(a/b): ``wa`` times the cubic sums
+    (:func:`~railadhesion.simd.contract_rows`, weights ``w0 .. w11`` along t, theta, u) of
+    the plane at ``o`` plus ``wb`` times those of the next plane, ``sa`` further on."""
+    p0, p1, p2 = contract_rows(tab, o, st, sd, w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10,
+                               w11)  # fmt: skip
+    q0, q1, q2 = contract_rows(tab, o + sa, st, sd, w0, w1, w2, w3, w4, w5, w6, w7, w8, w9,
+                               w10, w11)  # fmt: skip
+    return wa * p0 + wb * q0, wa * p1 + wb * q1, wa * p2 + wb * q2
+
+
+@jitable
 def table_sums(tab, dims, strides, origin, inv_step, laob, t, th, u):
     """The interpolation of the normalised (Fx, Fy, Mz/c)/(mu Fz) at table coordinates
     (log a/b, t, theta, u): cubic (Catmull-Rom) along t, theta, u, linear between the planes
@@ -373,11 +385,8 @@ def table_sums(tab, dims, strides, origin, inv_step, laob, t, th, u):
     if sa == 0:
         return contract_rows(tab, o, st, sd, t0, t1, t2, t3, d0, d1, d2, d3, u0, u1, u2, u3)
     ia, fa = _locate_uniform(laob, origin[0], inv_step[0], dims[0])
-    o += int(ia) * sa
-    p0, p1, p2 = contract_rows(tab, o, st, sd, t0, t1, t2, t3, d0, d1, d2, d3, u0, u1, u2, u3)
-    q0, q1, q2 = contract_rows(tab, o + sa, st, sd, t0, t1, t2, t3, d0, d1, d2, d3, u0, u1, u2,
-                               u3)  # fmt: skip
-    return (1.0 - fa) * p0 + fa * q0, (1.0 - fa) * p1 + fa * q1, (1.0 - fa) * p2 + fa * q2
+    return _two_planes(tab, o + int(ia) * sa, sa, st, sd, t0, t1, t2, t3, d0, d1, d2, d3, u0,
+                       u1, u2, u3, 1.0 - fa, fa)  # fmt: skip
 
 
 @jitable
@@ -493,15 +502,9 @@ def _stage_sums(tab, buf, m, st, sd, sa):
             f0, f1, f2 = contract_rows(tab, o, st, sd, w0, w1, w2, w3, w4, w5, w6, w7, w8,
                                           w9, w10, w11)  # fmt: skip
         else:
-            p0, p1, p2 = contract_rows(tab, o, st, sd, w0, w1, w2, w3, w4, w5, w6, w7, w8, w9,
-                                       w10, w11)  # fmt: skip
-            q0, q1, q2 = contract_rows(tab, o + sa, st, sd, w0, w1, w2, w3, w4, w5, w6, w7, w8,
-                                       w9, w10, w11)  # fmt: skip
-            wa = buf[(_R_W + 12) * CHUNK + k]
-            wb = buf[(_R_W + 13) * CHUNK + k]
-            f0 = wa * p0 + wb * q0
-            f1 = wa * p1 + wb * q1
-            f2 = wa * p2 + wb * q2
+            f0, f1, f2 = _two_planes(tab, o, sa, st, sd, w0, w1, w2, w3, w4, w5, w6, w7, w8,
+                                     w9, w10, w11, buf[(_R_W + 12) * CHUNK + k],
+                                     buf[(_R_W + 13) * CHUNK + k])  # fmt: skip
         buf[_R_F * CHUNK + k] = f0
         buf[(_R_F + 1) * CHUNK + k] = f1
         buf[(_R_F + 2) * CHUNK + k] = f2
