@@ -161,8 +161,6 @@ class PlausibleRange:
         return f"[{_g(self.low)}, {_g(self.high)}] {self.unit}".rstrip()
 
 
-_ASSUMPTION = "assumption"
-
 #: Plausible ranges of the physical inputs, by quantity (``docs/checks.md`` prints this table).
 PLAUSIBLE: dict[str, PlausibleRange] = {
     "creepage": PlausibleRange(
