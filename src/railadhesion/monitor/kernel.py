@@ -81,7 +81,6 @@ _NODES = layout.NODES
 _FINITE = layout.FINITE_NODES
 _FAMILY = layout.FAMILY
 _SHAPES = len(layout.SHAPES)
-_RING = layout.RING
 _NAN = math.nan
 _INF = math.inf
 
