@@ -612,31 +612,30 @@ def odometry_update(settings, state, t, wheel_speeds, radar, accel, drive, out):
         u = wheel_speeds[i] * radius
         fastest = max(fastest, u)
         slowest = min(slowest, u)
-        steady = True
-        if True:  # the wheel's speed against the accelerometer's (or model's): no drift
-            q = u - st.v_int
-            st.q_fast[i] += a_fast * (q - st.q_fast[i])
-            st.q_slow[i] += a_slow * (q - st.q_slow[i])
-            trend = st.q_fast[i] - st.q_slow[i]
-            steady = abs(trend) <= s.trend_threshold
-            st.q_env[i] -= env_decay
-            if trend > s.trend_threshold and lower_ok:
-                st.q_peak[i] = max(st.q_peak[i], st.q_fast[i])
-            elif st.q_peak[i] > -math.inf and trend < 0.0:
-                # the end of a re-acceleration under braking: at its peak the wheel rolled at
-                # the train speed (a speed fix) unless it re-applied before: a partial
-                # recovery peaks below the wheel's earlier full ones (its envelope; the
-                # accelerometer's integral moves it by at most the bias bound) and below
-                # the estimate's gate
-                peak = st.q_peak[i]
-                z = st.v_int + peak
-                st.q_peak[i] = -math.inf
-                if (lower_ok and z >= v_pred - gate
-                        and peak >= st.q_env[i] - s.speed_tolerance * z - s.speed_tolerance_abs):
-                    _update_speed(st, z, (e * z) ** 2 / 3.0 + (s.speed_tolerance * z) ** 2
-                                  + s.speed_tolerance_abs ** 2)
-                    fixes += 1
-                    st.q_env[i] = max(st.q_env[i], peak)
+        # the wheel's speed against the accelerometer's (or model's): no drift
+        q = u - st.v_int
+        st.q_fast[i] += a_fast * (q - st.q_fast[i])
+        st.q_slow[i] += a_slow * (q - st.q_slow[i])
+        trend = st.q_fast[i] - st.q_slow[i]
+        steady = abs(trend) <= s.trend_threshold
+        st.q_env[i] -= env_decay
+        if trend > s.trend_threshold and lower_ok:
+            st.q_peak[i] = max(st.q_peak[i], st.q_fast[i])
+        elif st.q_peak[i] > -math.inf and trend < 0.0:
+            # the end of a re-acceleration under braking: at its peak the wheel rolled at
+            # the train speed (a speed fix) unless it re-applied before: a partial
+            # recovery peaks below the wheel's earlier full ones (its envelope; the
+            # accelerometer's integral moves it by at most the bias bound) and below
+            # the estimate's gate
+            peak = st.q_peak[i]
+            z = st.v_int + peak
+            st.q_peak[i] = -math.inf
+            if (lower_ok and z >= v_pred - gate
+                    and peak >= st.q_env[i] - s.speed_tolerance * z - s.speed_tolerance_abs):
+                _update_speed(st, z, (e * z) ** 2 / 3.0 + (s.speed_tolerance * z) ** 2
+                              + s.speed_tolerance_abs ** 2)
+                fixes += 1
+                st.q_env[i] = max(st.q_env[i], peak)
         # a rolling wheel while coasting: inside the innovation gate (its tolerances and the
         # prediction's uncertainty) and steady, for admit_time
         r = (e * u) ** 2 / 3.0 + (s.speed_tolerance * u) ** 2 + s.speed_tolerance_abs ** 2
