@@ -6,7 +6,7 @@ The WSP bench (:func:`railadhesion.braking.run_wsp_programme`, ``railadhesion ws
 runs a programme of low-adhesion emergency stops on a wheel slide protection (WSP)
 controller and reports, per stop, the distance against the adhesion-limited stop (the best
 any WSP can do with these brakes), wheel locks, creep and vented air, with pass/fail against
-the programme's criteria. Four of the 30 stops of the shipped programme run here on the
+the programme's criteria. Four of the 31 stops of the shipped programme run here on the
 package's default controller and on a naive threshold controller written in a few lines (the
 one of the guide :doc:`/guides/wsp-controller`); :doc:`/wsp` describes the bench.
 """
