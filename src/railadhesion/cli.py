@@ -20,7 +20,16 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from railadhesion.cli_checks import allow_untrusted_option, finish
+from railadhesion.cli_checks import (
+    allow_untrusted_option,
+    err_console,
+    fail,
+    finish,
+    note,
+    progress_disabled,
+    start_messages,
+    warn,
+)
 
 # rich_markup_mode=None: help texts are plain text, so units such as "[m]" and "[m/s]" are
 # shown as written (Rich markup would take them for tags and drop them).
@@ -66,10 +75,9 @@ def _version(value: bool) -> None:
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    """Print a Python warning as one plain line, without the source location."""
-    console.print(
-        f"[yellow]warning:[/yellow] {escape(str(message))}", highlight=False, soft_wrap=True
-    )
+    """Print a Python warning as one plain line on standard error, without the source
+    location; a message already printed in this run is not repeated."""
+    warn(str(message))
 
 
 @app.callback()
@@ -81,7 +89,9 @@ def _main(
 ) -> None:
     """Wheel-rail adhesion: contact mechanics, creep-force models, calibration."""
     # Warnings of the library (excluded CSV rows, an untrustworthy calibration) are shown to
-    # the user as plain lines: no file name and line number of our source.
+    # the user as plain lines on standard error: no file name and line number of our source,
+    # each distinct message once.
+    start_messages()
     catcher = warnings.catch_warnings()
     catcher.__enter__()
     warnings.simplefilter("default")
@@ -183,10 +193,8 @@ def _creep_percent(text: str) -> np.ndarray:
 
 
 def _fail(exc: Exception) -> None:
-    # escape(): messages hold brackets ("[low, high]", "[0, inf)") that Rich would otherwise
-    # take for markup and drop from the output.
-    console.print(f"[red]error:[/red] {escape(str(exc))}")
-    raise typer.Exit(code=2)
+    """``error: <exc>`` on standard error, exit code 2 (:func:`railadhesion.cli_checks.fail`)."""
+    fail(exc)
 
 
 def _save(fig, out: Path | None) -> None:
@@ -633,8 +641,7 @@ def fit_polach_cmd(
                 ", ".join(f"{n} = {result.params[n]:g}" for n in default)
                 + f" (model defaults; set them with --fixed {example})"
             )
-        console.print("note: not fitted, held at " + "; ".join(parts), markup=False,
-                      highlight=False, soft_wrap=True)  # fmt: skip
+        note("not fitted, held at " + "; ".join(parts))
     if figure is not None:
         from railadhesion.plotting import plot_fit
 
@@ -699,8 +706,8 @@ def fit_wilac_cmd(
     labels = {"fit": "Polach fit per curve", "regress": "regressions per condition",
               "check": "check between the data"}  # fmt: skip
     progress = Progress(TextColumn("{task.description}"), BarColumn(),
-                        TextColumn("{task.completed}/{task.total}"), console=console,
-                        transient=True)  # fmt: skip
+                        TextColumn("{task.completed}/{task.total}"), console=err_console,
+                        transient=True, disable=progress_disabled())  # fmt: skip
     tasks = {}
 
     def report(stage: str, done: int, total: int) -> None:

@@ -11,7 +11,15 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from railadhesion.cli_checks import allow_untrusted_option, braking_findings, finish
+from railadhesion.cli_checks import (
+    allow_untrusted_option,
+    braking_findings,
+    err_console,
+    fail,
+    finish,
+    progress_disabled,
+    warn,
+)
 from railadhesion.plausibility import RailadhesionWarning
 
 console = Console()
@@ -85,15 +93,14 @@ def register(app: typer.Typer) -> None:
         try:
             sc = load_scenario(scenario)
         except ValueError as exc:
-            console.print(f"[red]error:[/red] {escape(str(exc))}")
-            raise typer.Exit(code=2) from None
+            fail(exc)
         try:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", RailadhesionWarning)
-                if quiet:
+                if quiet or progress_disabled():
                     result, dry = run_scenario(sc, dt=dt)
-                else:
-                    with Progress(console=console, transient=True) as bar:
+                else:  # a live bar on standard error (off a terminal it would leave a line)
+                    with Progress(console=err_console, transient=True) as bar:
                         task = bar.add_task("braking (speed lost)", total=1.0)
                         result, dry = run_scenario(
                             sc, dt=dt, progress=lambda f: bar.update(task, completed=f))
@@ -102,14 +109,13 @@ def register(app: typer.Typer) -> None:
                 findings += braking_findings(dry, "the dry-rail comparison")
             write_outputs(result, out, figures=figures, log=log, findings=findings)
         except (SimulationError, ValueError) as exc:
-            console.print(f"[red]error:[/red] {escape(str(exc))}")
-            raise typer.Exit(code=2) from None
+            fail(exc)
         for w in caught:  # the package's warnings, each once; others as Python shows them
             if not issubclass(w.category, RailadhesionWarning):
                 warnings.showwarning(w.message, w.category, w.filename, w.lineno)
-        for message in dict.fromkeys(str(w.message) for w in caught
-                                     if issubclass(w.category, RailadhesionWarning)):
-            console.print(f"[yellow]warning:[/yellow] {escape(message)}")
+        for w in caught:
+            if issubclass(w.category, RailadhesionWarning):
+                warn(str(w.message))
         s = result.summary
         table = Table(title=escape(sc.name or str(scenario)))
         table.add_column("quantity")

@@ -14,6 +14,10 @@ code   meaning
 3      done, but a result is not trustworthy (the message gives the first reason); outputs
        are written, so that they can be inspected
 =====  ======================================================================================
+
+Messages (``warning:``, ``note:``, ``error:``, the ``not trusted`` verdict, progress bars) go
+to standard error through :data:`err_console`: standard output holds only what the command
+was asked for (a table, CSV, JSON), so ``--format csv > file`` and pipes read clean output.
 """
 
 from __future__ import annotations
@@ -23,6 +27,61 @@ import math
 import typer
 from rich.console import Console
 from rich.markup import escape
+
+#: Where messages go (standard error); ``console.print`` of the commands is their output.
+err_console = Console(stderr=True)
+
+# The messages printed in this run of a command: each distinct one is printed once.
+_printed: set[str] = set()
+
+
+def start_messages() -> None:
+    """Forget the messages printed so far (called when a command starts: one run of the
+    CLI, or one ``CliRunner.invoke`` of the tests, prints each distinct message once)."""
+    _printed.clear()
+
+
+def message(kind: str, text: str, style: str = "yellow") -> None:
+    """Print ``<kind>: <text>`` on standard error, once per command run, as one line.
+
+    Parameters
+    ----------
+    kind : str
+        The label: ``warning``, ``note`` or ``error``.
+    text : str
+        The message, plain text (brackets such as ``[0, 100]`` are printed as written).
+    style : str
+        Rich style of the label.
+    """
+    line = f"{kind}: {text}"
+    if line in _printed:
+        return
+    _printed.add(line)
+    err_console.print(f"[{style}]{kind}:[/{style}] {escape(text)}", highlight=False,
+                      soft_wrap=True)
+
+
+def warn(text: str) -> None:
+    """Print ``warning: <text>`` on standard error, once per command run."""
+    message("warning", text)
+
+
+def note(text: str) -> None:
+    """Print ``note: <text>`` on standard error, once per command run."""
+    message("note", text, style="cyan")
+
+
+def fail(exc) -> None:
+    """Print ``error: <exc>`` on standard error and exit with :data:`EXIT_ERROR`."""
+    message("error", str(exc), style="red")
+    raise typer.Exit(code=EXIT_ERROR)
+
+
+def progress_disabled() -> bool:
+    """True when progress bars would not be live (standard error is not a terminal): a
+    finished bar would leave a blank or stale line among the messages."""
+    return not err_console.is_terminal
+
 
 #: Exit code of an error (bad option, file or input).
 EXIT_ERROR = 2
@@ -60,12 +119,14 @@ def braking_findings(result, label: str = "") -> list[str]:
     return found
 
 
-def finish(console: Console, findings, *, allow: bool, what: str = "result") -> None:
+def finish(console: Console | None, findings, *, allow: bool, what: str = "result") -> None:
     """Report findings (reasons a result is not trustworthy) and exit accordingly.
 
-    Prints ``<what> not trusted: <first reason>`` (and how many more) and exits with
+    Prints ``<what> not trusted: <first reason>`` (and how many more) on standard error
+    (:data:`err_console`; ``console`` is not used, kept for the callers) and exits with
     :data:`EXIT_UNTRUSTED`, or only the message when ``allow`` (``--allow-untrusted``).
     """
+    console = err_console
     findings = [str(f) for f in findings if f]
     if not findings:
         return

@@ -12,6 +12,8 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
+from railadhesion.cli_checks import err_console, fail, warn
+
 export_app = typer.Typer(
     no_args_is_help=True,
     help="Use the models from other tools: FMI 2.0 co-simulation FMUs and creep-force tables.",
@@ -32,8 +34,8 @@ _NATIVE_HELP = (
 
 
 def _fail(message) -> None:
-    console.print(f"[red]error:[/red] {escape(str(message))}")
-    raise typer.Exit(code=2)
+    """``error: ...`` on standard error, exit code 2."""
+    fail(message)
 
 
 def _floats(text: str | None, name: str, scale: float = 1.0):
@@ -140,9 +142,10 @@ def _write_either(native, native_build, python_build, out, *args, **kwargs):
                 return _write_fmu(native_build, out, *args, fallback=True, **kwargs), True
             except NativeBuildError as exc:
                 problem = str(exc)
-        console.print(f"[yellow]no native FMU:[/yellow] {escape(problem)}")
-        console.print("writing the Python FMU instead: the host needs Python with railadhesion "
-                      "(--python asks for it, --native makes this an error)")  # fmt: skip
+        warn(f"no native FMU: {problem}")
+        err_console.print("writing the Python FMU instead: the host needs Python with "
+                          "railadhesion (--python asks for it, --native makes this an error)",
+                          highlight=False, soft_wrap=True)  # fmt: skip
         native = False
     build = native_build if native else python_build
     return _write_fmu(build, out, *args, **kwargs), native

@@ -11,14 +11,20 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
-from railadhesion.cli_checks import allow_untrusted_option, finish
+from railadhesion.cli_checks import (
+    allow_untrusted_option,
+    err_console,
+    fail,
+    finish,
+    progress_disabled,
+)
 
 console = Console()
 
 
 def _fail(exc) -> None:
-    console.print(f"[red]error:[/red] {escape(str(exc))}")
-    raise typer.Exit(code=2)
+    """``error: ...`` on standard error, exit code 2."""
+    fail(exc)
 
 
 def detect(
@@ -105,7 +111,7 @@ def identify(
         _fail(exc)
     error = None
     with Progress(TextColumn("{task.description:<42}"), BarColumn(), TimeElapsedColumn(),
-                  console=console, transient=False) as bar:
+                  console=err_console, transient=False, disable=progress_disabled()) as bar:
         task = bar.add_task(STAGES[0], total=len(STAGES))
 
         def step(name):

@@ -11,12 +11,14 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
+from railadhesion.cli_checks import fail, warn
+
 console = Console()
 
 
 def _fail(exc) -> None:
-    console.print(f"[red]error:[/red] {escape(str(exc))}", soft_wrap=True)
-    raise typer.Exit(code=2)
+    """``error: ...`` on standard error, exit code 2."""
+    fail(exc)
 
 
 def monitor(
@@ -60,9 +62,8 @@ def monitor(
         console.print(f"axle {ax['axle']}: {share}; {low}; radius {ax['radius_m']:.5f} m "
                       f"{radius}", markup=False, highlight=False, soft_wrap=True)
     if not any(ax["radius_learned"] for ax in s["axles"]) and learn_radius:
-        console.print("[yellow]warning:[/yellow] no wheel radius was learned (the log has no "
-                      "coasting): every level stays unknown; --no-learn-radius takes the "
-                      "vehicle file's radius as exact")
+        warn("no wheel radius was learned (the log has no coasting): every level stays "
+             "unknown; --no-learn-radius takes the vehicle file's radius as exact")
     console.print(f"outputs written to {escape(str(out))}", soft_wrap=True)
 
 

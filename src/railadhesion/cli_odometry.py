@@ -10,7 +10,7 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from railadhesion.cli_checks import EXIT_CHECKS_FAILED
+from railadhesion.cli_checks import EXIT_CHECKS_FAILED, err_console, fail
 
 console = Console()
 _ROUTINE = ("slide", "spin", "dead_reckoning")
@@ -57,8 +57,7 @@ def register(app: typer.Typer) -> None:
                 prog = prog.select(case)
             odo = load_odometry(odometry, period=period)
         except (ValueError, ImportError, OdometryInterfaceError) as exc:
-            console.print(f"[red]error:[/red] {escape(str(exc))}")
-            raise typer.Exit(code=2) from None
+            fail(exc)
 
         def progress(k, n, name):
             if not quiet:
@@ -98,11 +97,12 @@ def register(app: typer.Typer) -> None:
                 console.print(f"  flagged {escape(line)}", highlight=False)
         for c in result.cases:
             if c.get("status") == "error":
-                console.print(f"[red]{escape(c['name'])}:[/red] {escape(c['message'])}")
+                err_console.print(f"[red]{escape(c['name'])}:[/red] {escape(c['message'])}",
+                                  soft_wrap=True)
             for f in c.get("fits", []):
                 if f.get("status") == "error":
-                    console.print(f"[red]{escape(c['name'])} / {escape(f['fit'])}:[/red] "
-                                  f"{escape(f['message'])}")
+                    err_console.print(f"[red]{escape(c['name'])} / {escape(f['fit'])}:[/red] "
+                                      f"{escape(f['message'])}", soft_wrap=True)
                 for e in f.get("violations", [])[:20]:
                     console.print(f"[red]violation[/red] {escape(c['name'])} / "
                                   f"{escape(f['fit'])}: {e['side']} from {e['start_s']:.3f} to "

@@ -14,14 +14,20 @@ from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-from railadhesion.cli_checks import allow_untrusted_option, finish
+from railadhesion.cli_checks import (
+    allow_untrusted_option,
+    err_console,
+    fail,
+    finish,
+    progress_disabled,
+)
 
 console = Console()
 
 
 def _fail(message) -> None:
-    console.print(f"[red]error:[/red] {escape(str(message))}")
-    raise typer.Exit(code=2)
+    """``error: ...`` on standard error, exit code 2."""
+    fail(message)
 
 
 def _failures(result, what: str) -> tuple[str, list[str]]:
@@ -94,7 +100,7 @@ def sweep(
                   f"{plan.n_chunks} chunks", highlight=False)  # fmt: skip
     progress = Progress(
         TextColumn("chunks"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
-        console=console, transient=False,
+        console=err_console, transient=False, disable=progress_disabled(),
     )
     task = {"id": None}
 
@@ -116,7 +122,7 @@ def sweep(
         ), f"cannot write {out}")  # fmt: skip
     except KeyboardInterrupt:
         progress.stop()
-        console.print("interrupted: chunks already written are kept; re-run the same command "
+        err_console.print("interrupted: chunks already written are kept; re-run the same command "
                       "to resume")  # fmt: skip
         raise typer.Exit(code=130) from None
     progress.update(task["id"], completed=result.chunks_computed)
@@ -154,7 +160,8 @@ def study(
     study_spec, plan, dims = _plan(load_study_spec, spec)
     console.print(f"braking study over {escape(dims)} = {plan.size:,} stops", highlight=False)
     progress = Progress(TextColumn("stops"), BarColumn(), MofNCompleteColumn(),
-                        TimeRemainingColumn(), console=console)  # fmt: skip
+                        TimeRemainingColumn(), console=err_console,
+                        disable=progress_disabled())  # fmt: skip
     task = {"id": None}
 
     def on_start(result):

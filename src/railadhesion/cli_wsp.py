@@ -10,7 +10,7 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from railadhesion.cli_checks import EXIT_CHECKS_FAILED
+from railadhesion.cli_checks import EXIT_CHECKS_FAILED, err_console, fail
 
 console = Console()
 
@@ -57,8 +57,7 @@ def register(app: typer.Typer) -> None:
             ctrl = load_controller(controller, control_period=period,
                                    wsp_settings=prog.wsp or None)
         except (ValueError, ImportError, WSPControllerError) as exc:
-            console.print(f"[red]error:[/red] {escape(str(exc))}")
-            raise typer.Exit(code=2) from None
+            fail(exc)
 
         def progress(k, n, name):
             if not quiet:
@@ -88,7 +87,8 @@ def register(app: typer.Typer) -> None:
         console.print(table)
         for c in result.cases:
             if c.get("status") == "error":
-                console.print(f"[red]{escape(c['name'])}:[/red] {escape(c['message'])}")
+                err_console.print(f"[red]{escape(c['name'])}:[/red] {escape(c['message'])}",
+                                  soft_wrap=True)
         o = result.overall
         console.print(
             f"{o['passed']}/{o['cases']} cases passed; worst longest lock "

@@ -1,0 +1,79 @@
+"""What the command line prints where: output on stdout, messages on stderr, each once."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+from typer.testing import CliRunner
+
+from railadhesion.cli import app
+
+runner = CliRunner()
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _run(*args: str):
+    return runner.invoke(app, list(args))
+
+
+def test_warnings_go_to_stderr_so_csv_output_parses():
+    result = _run("polach", "--speed", "200", "--creep-percent", "1", "--format", "csv")
+    assert result.exit_code == 0, result.output
+    rows = list(csv.reader(io.StringIO(result.stdout)))
+    assert rows[0] == ["creep_percent", "fx_kN", "adhesion"] and len(rows) == 2
+    assert "warning" not in result.stdout
+    assert result.stderr.startswith("warning: speed = 200 m/s is outside")
+
+
+def test_warnings_go_to_stderr_so_json_output_parses():
+    result = _run("polach", "--speed", "200", "--creep-percent", "1,2", "--format", "json")
+    assert result.exit_code == 0, result.output
+    assert [r["creep_percent"] for r in json.loads(result.stdout)] == [1.0, 2.0]
+    assert "given in km/h?" in result.stderr
+
+
+def test_errors_go_to_stderr_on_one_line():
+    result = _run("polach", "--set", "no_such_set")
+    assert result.exit_code == 2
+    assert result.stdout == ""
+    assert result.stderr.startswith("error: ") and result.stderr.count("\n") == 1
+
+
+def test_each_warning_is_printed_once():
+    result = _run("wilac", "table", "--normal-force", "4.2", "--format", "csv")
+    assert result.exit_code == 0, result.output
+    assert result.stderr.count("normal_force = 4.2 N is outside the plausible range") == 1
+    assert "warning" not in result.stdout
+    # the next run of the same command (same process) prints its warning again
+    again = _run("wilac", "table", "--normal-force", "4.2", "--format", "csv")
+    assert again.stderr.count("normal_force = 4.2 N is outside the plausible range") == 1
+
+
+def test_fit_polach_warns_once_of_an_implausible_speed_in_the_file(tmp_path):
+    from railadhesion.models.parameters import polach_parameters
+    from railadhesion.models.polach import Polach
+
+    creep = -np.geomspace(0.002, 0.4, 20)
+    q, a, b = 4500.0, 0.004, 0.003
+    fx, _ = Polach(polach_parameters("polach2005_dry")).forces(creep, 0.0, 0.0, q, 10.0, a, b)
+    path = tmp_path / "kmh.csv"
+    path.write_text(f"# normal_force_N = {q}\n# speed_m_s = 300\n# a_m = {a}\n# b_m = {b}\n"
+                    "creep,adhesion\n"
+                    + "".join(f"{c},{abs(f) / q}\n" for c, f in zip(creep, fx, strict=True)))
+    result = _run("fit", "polach", str(path), "--format", "csv", "--allow-untrusted")
+    assert result.exit_code == 0, result.output
+    assert result.stderr.count("speed = 300 m/s is outside") == 1
+    assert list(csv.reader(io.StringIO(result.stdout)))[0] == ["parameter", "value", "stderr",
+                                                                "fitted"]
+
+
+def test_brake_error_has_no_blank_line_before_it(tmp_path):
+    scenario = ROOT / "examples" / "brake_dry.toml"
+    result = _run("brake", str(scenario), "--out", str(tmp_path / "o"), "--dt", "0.1")
+    assert result.exit_code == 2, result.output
+    assert "error: the control period" in result.stderr
+    assert "\n\n" not in "\n" + result.output and not result.output.startswith("\n")
