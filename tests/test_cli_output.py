@@ -5,6 +5,9 @@ from __future__ import annotations
 import csv
 import io
 import json
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -77,3 +80,13 @@ def test_brake_error_has_no_blank_line_before_it(tmp_path):
     assert result.exit_code == 2, result.output
     assert "error: the control period" in result.stderr
     assert "\n\n" not in "\n" + result.output and not result.output.startswith("\n")
+
+
+def test_a_closed_pipe_ends_quietly_with_code_141():
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
+    proc = subprocess.Popen([sys.executable, "-m", "railadhesion", "params", "list"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
+    proc.stdout.close()  # the reader goes away before the first line (| head -0)
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=300) == 141, err
+    assert "Traceback" not in err and "Exception ignored" not in err

@@ -11,6 +11,7 @@ import csv
 import io
 import json
 import math
+import sys
 import warnings
 from pathlib import Path
 
@@ -19,8 +20,10 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
+from typer.core import TyperGroup
 
 from railadhesion.cli_checks import (
+    OutputConsole,
     allow_untrusted_option,
     err_console,
     fail,
@@ -28,12 +31,29 @@ from railadhesion.cli_checks import (
     note,
     progress_disabled,
     start_messages,
+    stop_on_broken_pipe,
     warn,
 )
+
+
+class _Group(TyperGroup):
+    """The command group of the app: a command whose standard output is closed by its reader
+    (``railadhesion polach --format csv | head -1``) stops quietly with
+    :data:`~railadhesion.cli_checks.EXIT_BROKEN_PIPE`, not with click's code 1 (a bug)."""
+
+    def invoke(self, ctx):
+        try:
+            value = super().invoke(ctx)
+            sys.stdout.flush()  # a closed pipe shows here, not in Python's flush at exit
+            return value
+        except BrokenPipeError:  # a write outside Rich (OutputConsole stops on its own)
+            stop_on_broken_pipe()
+
 
 # rich_markup_mode=None: help texts are plain text, so units such as "[m]" and "[m/s]" are
 # shown as written (Rich markup would take them for tags and drop them).
 app = typer.Typer(
+    cls=_Group,
     no_args_is_help=True,
     add_completion=False,
     rich_markup_mode=None,
@@ -54,7 +74,7 @@ app.add_typer(wilac_app, name="wilac")
 app.add_typer(params_app, name="params")
 app.add_typer(fit_app, name="fit")
 
-console = Console()
+console = OutputConsole()
 
 #: Output formats of the table commands.
 FORMATS = ("table", "csv", "json")

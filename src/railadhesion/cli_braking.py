@@ -7,11 +7,11 @@ import warnings
 from pathlib import Path
 
 import typer
-from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
 from railadhesion.cli_checks import (
+    OutputConsole,
     allow_untrusted_option,
     braking_findings,
     err_console,
@@ -22,7 +22,7 @@ from railadhesion.cli_checks import (
 )
 from railadhesion.plausibility import RailadhesionWarning
 
-console = Console()
+console = OutputConsole()
 
 
 def write_outputs(result, out: Path, *, figures: bool = True, parquet: bool = True,

@@ -13,6 +13,9 @@ code   meaning
 2      an error: a bad option, file or input (the message names it); nothing was computed
 3      done, but a result is not trustworthy (the message gives the first reason); outputs
        are written, so that they can be inspected
+4      a test bench (``wsp-test``, ``odometry-test``): a case or fit failed its checks
+141    the reader of standard output went away (``| head``): the command stopped quietly, as
+       a program ended by SIGPIPE (128 + 13)
 =====  ======================================================================================
 
 Messages (``warning:``, ``note:``, ``error:``, the ``not trusted`` verdict, progress bars) go
@@ -23,13 +26,37 @@ was asked for (a table, CSV, JSON), so ``--format csv > file`` and pipes read cl
 from __future__ import annotations
 
 import math
+import os
+import sys
 
 import typer
 from rich.console import Console
 from rich.markup import escape
 
+
+def stop_on_broken_pipe() -> None:
+    """Stop the command quietly with :data:`EXIT_BROKEN_PIPE`: the reader of standard output
+    went away (``| head``). Standard output is pointed at devnull first (Python docs, "Note
+    on SIGPIPE"), so that the flush at exit does not fail again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):  # no file descriptor (a test's captured output)
+        pass
+    raise typer.Exit(code=EXIT_BROKEN_PIPE)
+
+
+class OutputConsole(Console):
+    """The commands' Rich console: a closed pipe stops the command with
+    :data:`EXIT_BROKEN_PIPE` (Rich itself would exit with code 1, which means a bug)."""
+
+    def on_broken_pipe(self) -> None:
+        self.quiet = True
+        stop_on_broken_pipe()
+
+
 #: Where messages go (standard error); ``console.print`` of the commands is their output.
-err_console = Console(stderr=True)
+err_console = OutputConsole(stderr=True)
 
 # The messages printed in this run of a command: each distinct one is printed once.
 _printed: set[str] = set()
@@ -87,6 +114,9 @@ def progress_disabled() -> bool:
 EXIT_ERROR = 2
 #: Exit code when a result is not trustworthy (and ``--allow-untrusted`` was not given).
 EXIT_UNTRUSTED = 3
+#: Exit code when the reader of standard output closed the pipe (``railadhesion ... | head``):
+#: 128 + SIGPIPE, what a shell reports for a program that SIGPIPE ended.
+EXIT_BROKEN_PIPE = 141
 #: Exit code of a test bench (``wsp-test``, ``odometry-test``) when a case or fit failed its
 #: checks or could not run: the unit under test failed, not the program (code 1 stays "a bug").
 EXIT_CHECKS_FAILED = 4

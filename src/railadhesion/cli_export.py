@@ -9,16 +9,15 @@ from __future__ import annotations
 from pathlib import Path
 
 import typer
-from rich.console import Console
 from rich.markup import escape
 
-from railadhesion.cli_checks import err_console, fail, warn
+from railadhesion.cli_checks import OutputConsole, err_console, fail, warn
 
 export_app = typer.Typer(
     no_args_is_help=True,
     help="Use the models from other tools: FMI 2.0 co-simulation FMUs and creep-force tables.",
 )
-console = Console()
+console = OutputConsole()
 
 _MODEL_HELP = "Creep-force model: wilac or polach."
 _FMU_MODEL_HELP = ("Creep-force model: wilac, polach, or table (the table model of Kalker's exact "

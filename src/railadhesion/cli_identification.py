@@ -8,10 +8,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import typer
-from rich.console import Console
 from rich.markup import escape
 
 from railadhesion.cli_checks import (
+    OutputConsole,
     allow_untrusted_option,
     err_console,
     fail,
@@ -19,7 +19,7 @@ from railadhesion.cli_checks import (
     progress_disabled,
 )
 
-console = Console()
+console = OutputConsole()
 
 
 def _fail(exc) -> None:

@@ -8,12 +8,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import typer
-from rich.console import Console
 from rich.markup import escape
 
-from railadhesion.cli_checks import fail, warn
+from railadhesion.cli_checks import OutputConsole, fail, warn
 
-console = Console()
+console = OutputConsole()
 
 
 def _fail(exc) -> None:

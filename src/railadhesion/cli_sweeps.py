@@ -10,11 +10,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import typer
-from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from railadhesion.cli_checks import (
+    OutputConsole,
     allow_untrusted_option,
     err_console,
     fail,
@@ -22,7 +22,7 @@ from railadhesion.cli_checks import (
     progress_disabled,
 )
 
-console = Console()
+console = OutputConsole()
 
 
 def _fail(message) -> None:

@@ -6,13 +6,12 @@ import math
 from pathlib import Path
 
 import typer
-from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from railadhesion.cli_checks import EXIT_CHECKS_FAILED, err_console, fail
+from railadhesion.cli_checks import EXIT_CHECKS_FAILED, OutputConsole, err_console, fail
 
-console = Console()
+console = OutputConsole()
 
 
 def _fmt(value, spec):
