@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from rich.console import Console
 from typer.testing import CliRunner
 
 from railadhesion.cli import app
@@ -90,3 +91,28 @@ def test_a_closed_pipe_ends_quietly_with_code_141():
     err = proc.stderr.read().decode()
     assert proc.wait(timeout=300) == 141, err
     assert "Traceback" not in err and "Exception ignored" not in err
+
+
+def test_wsp_results_table_keeps_every_number_at_80_columns():
+    from railadhesion.cli_wsp import results_tables
+
+    case = {"name": "mu050-040-noisy", "status": "ok", "stopping_distance_m": 126.8637,
+            "distance_ratio": 0.99642, "distance_vs_no_wsp": 1.00315,
+            "extension_vs_dry_percent": 271.85, "longest_lock_s": 1.114,
+            "deep_slide_s": 15.872, "mean_creep": 0.64115, "vented_air_l": 746.23,
+            "passed": False}
+    longer = dict(case, name="a-much-longer-case-name-of-a-user-programme",
+                  stopping_distance_m=12345.67)
+    error = {"name": "broken", "status": "error", "message": "x"}
+    for width in (80, 60):
+        console = Console(file=io.StringIO(), width=width)
+        for table in results_tables("default — ThresholdWSP", [case, longer, error], console):
+            console.print(table)
+        text = console.file.getvalue()
+        assert "…" not in text
+        for number in ("126.9", "12345.7", "0.996", "1.003", "272", "1.11", "15.87", "0.641",
+                       "746"):
+            assert number in text, (width, number, text)
+        assert max(len(line) for line in text.splitlines()) <= width
+    wide = Console(file=io.StringIO(), width=200)
+    assert len(results_tables("t", [case], wide)) == 1

@@ -6,6 +6,7 @@ import math
 from pathlib import Path
 
 import typer
+from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
@@ -17,6 +18,61 @@ console = OutputConsole()
 def _fmt(value, spec):
     return "-" if not isinstance(value, int | float) or not math.isfinite(value) else (
         format(value, spec))
+
+
+# The columns of the results table: (header, the case's key, format). Stop; its
+# adhesion-limited distance; the stop without WSP; extension over the dry stop; longest lock;
+# time in deep slide; mean braking creepage; vented free air; the checks passed.
+_COLUMNS = (("stop [m]", "stopping_distance_m", ".1f"), ("/ideal", "distance_ratio", ".3f"),
+            ("/no WSP", "distance_vs_no_wsp", ".3f"),
+            ("dry+%", "extension_vs_dry_percent", ".0f"), ("lock [s]", "longest_lock_s", ".2f"),
+            ("deep [s]", "deep_slide_s", ".2f"), ("creep", "mean_creep", ".3f"),
+            ("air [l]", "vented_air_l", ".0f"))
+# Where the table is split in two when it is wider than the console.
+_SPLIT = 4
+
+
+def _table(title: str, cases, columns, *, ok: bool) -> Table:
+    table = Table(title=escape(title) if title else None)
+    # the names and statuses may wrap (fold); numbers never: they keep their full width
+    table.add_column("case", overflow="fold")
+    table.add_column("status", overflow="fold")
+    for header, _, _ in columns:
+        table.add_column(escape(header), justify="right", no_wrap=True)
+    if ok:
+        table.add_column("ok", no_wrap=True)
+    for c in cases:
+        if c.get("status") == "error":
+            cells = [""] * len(columns) + (["no"] if ok else [])
+            table.add_row(escape(c["name"]), "[red]error[/red]", *cells)
+            continue
+        cells = [_fmt(c.get(key), spec) for _, key, spec in columns]
+        if ok:
+            cells.append("yes" if c.get("passed") else "[red]no[/red]")
+        table.add_row(escape(c["name"]), escape(c["status"]), *cells)
+    return table
+
+
+def results_tables(title: str, cases, console: Console) -> list[Table]:
+    """The results table of ``wsp-test``: one table, or two (the stops, then locks, slides,
+    creep and air) when one is wider than ``console`` (80 columns when standard output is
+    not a terminal), so that no number is cut.
+
+    Parameters
+    ----------
+    title : str
+        Title of the (first) table.
+    cases : sequence of dict
+        The programme's per-case results (``WSPProgrammeResult.cases``).
+    console : rich.console.Console
+        The console the tables are printed on (its width decides).
+    """
+    table = _table(title, cases, _COLUMNS, ok=True)
+    natural = console.measure(table, options=console.options.update_width(10_000)).maximum
+    if natural <= console.width:
+        return [table]
+    return [_table(title, cases, _COLUMNS[:_SPLIT], ok=True),
+            _table("", cases, _COLUMNS[_SPLIT:], ok=False)]
 
 
 def register(app: typer.Typer) -> None:
@@ -64,26 +120,9 @@ def register(app: typer.Typer) -> None:
 
         result = run_wsp_programme(prog, ctrl, out=out, figures=figures, histories=histories,
                                    progress=progress)
-        table = Table(title=escape(f"{prog.name or programme} — {result.controller}"))
-        # stop / its adhesion-limited distance; / the stop without WSP; extension over the
-        # dry stop; longest lock; time in deep slide; mean braking creepage; vented free air
-        for col in ("case", "status", "stop [m]", "/ideal", "/no WSP", "dry+%", "lock [s]",
-                    "deep [s]", "creep", "air [l]", "ok"):
-            table.add_column(escape(col), justify="left" if col in ("case", "status") else
-                             "right", no_wrap=col == "case")
-        for c in result.cases:
-            if c.get("status") == "error":
-                table.add_row(escape(c["name"]), "[red]error[/red]", "", "", "", "", "", "",
-                              "", "", "no")
-                continue
-            table.add_row(escape(c["name"]), escape(c["status"]),
-                          _fmt(c["stopping_distance_m"], ".1f"), _fmt(c["distance_ratio"], ".3f"),
-                          _fmt(c["distance_vs_no_wsp"], ".3f"),
-                          _fmt(c["extension_vs_dry_percent"], ".0f"),
-                          _fmt(c["longest_lock_s"], ".2f"), _fmt(c["deep_slide_s"], ".2f"),
-                          _fmt(c["mean_creep"], ".3f"), _fmt(c["vented_air_l"], ".0f"),
-                          "yes" if c.get("passed") else "[red]no[/red]")
-        console.print(table)
+        for table in results_tables(f"{prog.name or programme} — {result.controller}",
+                                    result.cases, console):
+            console.print(table)
         for c in result.cases:
             if c.get("status") == "error":
                 err_console.print(f"[red]{escape(c['name'])}:[/red] {escape(c['message'])}",
