@@ -1,4 +1,5 @@
-"""What the command line prints where: output on stdout, messages on stderr, each once."""
+"""What the command line prints where: output on stdout, messages on stderr, each once; a
+closed pipe; tables that fit a narrow terminal; short help lines."""
 
 from __future__ import annotations
 
@@ -116,3 +117,17 @@ def test_wsp_results_table_keeps_every_number_at_80_columns():
         assert max(len(line) for line in text.splitlines()) <= width
     wide = Console(file=io.StringIO(), width=200)
     assert len(results_tables("t", [case], wide)) == 1
+
+
+def test_wilac_help_lists_whole_summaries():
+    result = _run("wilac", "--help")
+    assert result.exit_code == 0
+    text = " ".join(result.output.split())
+    assert "(paper Fig." + " " not in text.replace("(paper Fig. 7)", "").replace(
+        "(paper Fig. 8)", "")
+    for summary in ("Creep curves at several water flow rates (paper Fig. 7).",
+                    "Blending weights f_i(w) and transitions e_i(w) (paper Figs. 5, 6).",
+                    "Adhesion against water flow rate at fixed creepages (paper Fig. 8).",
+                    "Creep curves at several speeds (paper Figs. 9 and 11).",
+                    "WILAC adhesion over water flow rate and creep (tram rig)."):
+        assert summary in text, (summary, result.output)

@@ -364,7 +364,7 @@ def polach(
         _save(fig, out)
 
 
-@wilac_app.command("curves")
+@wilac_app.command("curves", short_help="Creep curves at several water flow rates (paper Fig. 7).")
 def wilac_curves(
     water: str = typer.Option("0,25,35,60,350", help="Water flow rates [µl/s], comma-separated."),
     normal_force: float = typer.Option(4200.0, help="Normal force Q [N] (tram rig: 4.2 kN)."),
@@ -381,7 +381,9 @@ def wilac_curves(
     ))  # fmt: skip
 
 
-@wilac_app.command("weights")
+@wilac_app.command(
+    "weights", short_help="Blending weights f_i(w) and transitions e_i(w) (paper Figs. 5, 6)."
+)
 def wilac_weights_cmd(
     params_file: Path | None = _WILAC_PARAMS_OPTION,
     out: Path = typer.Option(Path("wilac_weights.png"), help="Figure file."),
@@ -392,7 +394,9 @@ def wilac_weights_cmd(
     _figure(out, lambda: plot_wilac_weights(params=_load_wilac(params_file)))
 
 
-@wilac_app.command("water")
+@wilac_app.command(
+    "water", short_help="Adhesion against water flow rate at fixed creepages (paper Fig. 8)."
+)
 def wilac_water(
     creep_percent: str = typer.Option("3,10,30,60", help="Fixed creepages [%], comma-separated."),
     normal_force: float = _TRAM_NORMAL_FORCE_OPTION,
@@ -409,7 +413,7 @@ def wilac_water(
     ))  # fmt: skip
 
 
-@wilac_app.command("speeds")
+@wilac_app.command("speeds", short_help="Creep curves at several speeds (paper Figs. 9 and 11).")
 def wilac_speeds(
     speeds: str = typer.Option("5,10,20", help="Rolling speeds [m/s], comma-separated."),
     water: float = typer.Option(0.0, help="Water flow rate [µl/s]."),
@@ -426,7 +430,9 @@ def wilac_speeds(
     ))  # fmt: skip
 
 
-@wilac_app.command("table")
+@wilac_app.command(
+    "table", short_help="WILAC adhesion over water flow rate and creep (tram rig)."
+)
 def wilac_table(
     water: str = typer.Option("0,25,35,60,350", help="Water flow rates [µl/s]."),
     creep_percent: str = typer.Option("1,3,10,30,60,90", help="Creepages [%] (braking sign)."),
