@@ -131,3 +131,33 @@ def test_wilac_help_lists_whole_summaries():
                     "Creep curves at several speeds (paper Figs. 9 and 11).",
                     "WILAC adhesion over water flow rate and creep (tram rig)."):
         assert summary in text, (summary, result.output)
+
+
+def test_polach_set_takes_the_file_fit_polach_writes(tmp_path):
+    from railadhesion.io.paramfiles import save_polach_parameters
+    from railadhesion.models.parameters import polach_parameters
+
+    mine = polach_parameters("polach2005_wet").replace(name="", mu0=0.2)
+    path = tmp_path / "fitted.toml"
+    save_polach_parameters(mine, path)
+    result = _run("polach", "--set", str(path), "--creep-percent", "40", "--format", "json")
+    assert result.exit_code == 0, result.output
+    named = _run("polach", "--set", "polach2005_wet", "--creep-percent", "40", "--format",
+                 "json")
+    mu_file = json.loads(result.stdout)[0]["adhesion"]
+    mu_named = json.loads(named.stdout)[0]["adhesion"]
+    assert mu_file < mu_named  # mu0 0.2 against the wet set's own
+    table = _run("polach", "--set", str(path), "--creep-percent", "40")
+    assert "Polach 'fitted.toml' at Q = 110000 N" in table.stdout
+
+
+def test_polach_set_errors_say_how_to_give_ones_own_parameters(tmp_path):
+    unknown = _run("polach", "--set", "my_set")
+    assert unknown.exit_code == 2
+    assert "or give a Polach parameter file" in unknown.stderr
+    missing = _run("polach", "--set", str(tmp_path / "missing.toml"))
+    assert missing.exit_code == 2 and "--set: cannot read" in missing.stderr
+    wilac = tmp_path / "w.toml"
+    wilac.write_text((ROOT / "tests" / "io" / "data" / "wilac_example.toml").read_text())
+    wrong = _run("polach", "--set", str(wilac))
+    assert wrong.exit_code == 2 and "expected 'railadhesion-polach'" in wrong.stderr

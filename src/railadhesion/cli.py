@@ -298,7 +298,10 @@ def hertz(
 
 @app.command()
 def polach(
-    parameter_set: str = typer.Option("polach2005_dry", "--set", help="Named Polach set."),
+    parameter_set: str = typer.Option(
+        "polach2005_dry", "--set", help="Named Polach set ('railadhesion params list'), or a "
+        "Polach parameter file (TOML, e.g. written by 'railadhesion fit polach --out').",
+    ),
     creep_percent: str = typer.Option(
         "0.1,0.2,0.5,1,2,5,10,20,40", help="Longitudinal creepages [%], comma-separated."
     ),
@@ -320,14 +323,14 @@ def polach(
         ".json, or any file with --format csv|json).",
     ),
 ) -> None:
-    """Polach creep curve (adhesion against longitudinal creep) for a named parameter set."""
+    """Polach creep curve (adhesion against longitudinal creep) for a named parameter set or
+    a parameter file."""
     from railadhesion import adhesion
     from railadhesion.contact.geometry import contact_semi_axes, geometry_description
-    from railadhesion.models.parameters import polach_parameters
     from railadhesion.models.polach import Polach
 
     try:
-        params = polach_parameters(parameter_set)
+        params = _polach_set(parameter_set)
         creep = _creep_percent(creep_percent)
         if (a is None) != (b is None):
             raise ValueError("give both --a and --b (the contact semi-axes in m), or neither")
@@ -340,7 +343,8 @@ def polach(
     where = "given semi-axes" if a is not None else geometry_description(geo)
     contact = f"contact: {where}\nHertz at Q = {normal_force:g} N: a = {ca * 1e3:.3g} mm, " \
         f"b = {cb * 1e3:.3g} mm"
-    title = f"Polach '{params.name}' at Q = {normal_force:g} N, V = {speed:g} m/s"
+    label = params.name or Path(parameter_set).name  # a file's set may have no name
+    title = f"Polach '{label}' at Q = {normal_force:g} N, V = {speed:g} m/s"
     table_out = out is not None and (
         fmt != "table" or out.suffix.lower() in (".csv", ".json")
     )
@@ -359,9 +363,29 @@ def polach(
         ax.plot(creep * 100, mu, marker="o")
         ax.set_xlabel("longitudinal creep [%]")
         ax.set_ylabel("adhesion |T|/Q [-]")
-        ax.set_title(f"Polach {params.name}, {geo if isinstance(geo, str) else 'given a, b'}")
+        shown = geo if isinstance(geo, str) else "given a, b"
+        ax.set_title(f"Polach {label}, {shown}")
         ax.grid(True, alpha=0.3)
         _save(fig, out)
+
+
+def _polach_set(value: str):
+    """The Polach parameters of ``--set``: a named set, or a Polach parameter file (a path
+    ending in .toml, or an existing file; e.g. the file ``fit polach --out`` writes)."""
+    from railadhesion.io.paramfiles import load_polach_parameters
+    from railadhesion.models.parameters import POLACH_PARAMETER_SETS, polach_parameters
+
+    path = Path(value)
+    if value not in POLACH_PARAMETER_SETS and (path.suffix.lower() == ".toml" or path.is_file()):
+        try:
+            return load_polach_parameters(path)
+        except OSError as exc:  # missing file, a folder, no permission: a user error
+            raise ValueError(f"--set: cannot read {path}: {exc.strerror or exc}") from exc
+    try:
+        return polach_parameters(value)
+    except ValueError as exc:
+        raise ValueError(f"--set: {exc}; or give a Polach parameter file (TOML, as written by "
+                         "'railadhesion fit polach --out')") from None
 
 
 @wilac_app.command("curves", short_help="Creep curves at several water flow rates (paper Fig. 7).")
