@@ -174,11 +174,15 @@ def run_identification(
                               vehicle_cutoff=vehicle_cutoff, wheel_cutoff=wheel_cutoff,
                               progress=step, threads=workers)
     lap("identify (filters, eq. 14, loads, mu, windows)")
-    findings = [*getattr(log, "warnings", ()), *_brake_coefficient_check(ident, vehicle)]
+    findings = list(getattr(log, "warnings", ()))
     if not any("train_speed" in w for w in findings):  # against the vehicle's own radius
         found = sniff_speed_ratio(log.train_speed, log.wheel_speed, vehicle.wheel_radius,
                                   where=f"{log.source or 'log'}: train_speed")  # fmt: skip
         findings += [found] if found else []
+    # a speed in another unit scales the deceleration eq. 14 takes, hence c: no unit guess
+    # for the pressures then (km/h gives c x 3.6, which would read as "MPa?")
+    findings += _brake_coefficient_check(
+        ident, vehicle, speed_flagged=any("train_speed" in w for w in findings))
     bands = [float(x) for x in speed_bands]
     step("surface")
     paths: dict[str, Path] = {}
@@ -262,10 +266,15 @@ def run_identification(
 _PRESSURE_SLIPS = {"Pa": 1e-5, "kPa": 1e-2, "psi": 1.0 / 14.503774, "MPa": 10.0}
 
 
-def _brake_coefficient_check(ident, vehicle) -> list[str]:
+def _brake_coefficient_check(ident, vehicle, *, speed_flagged: bool = False) -> list[str]:
     """The identified c against the vehicle's (eq. 14 is c = brake torque / pressure): a
     factor of 1e-5 means pressures in Pa under the bar column names, 1e-2 kPa, 0.069 psi.
-    Returns the finding (a :class:`~railadhesion.plausibility.UnitWarning` issued) or []."""
+    Returns the finding (a :class:`~railadhesion.plausibility.UnitWarning` issued) or [].
+
+    ``speed_flagged``: the train speed's unit is already flagged; it scales the deceleration
+    and so c (km/h: x 3.6), so the finding names it as the likely cause (a
+    :class:`~railadhesion.plausibility.PlausibilityWarning`) instead of guessing a pressure
+    unit."""
     c_vehicle = float(getattr(vehicle, "brake_coefficient", math.nan))
     c = float(ident.brake.mean)
     if not (c_vehicle > 0 and math.isfinite(c)):
@@ -275,6 +284,9 @@ def _brake_coefficient_check(ident, vehicle) -> list[str]:
         return []
     text = (f"brake coefficient: the identified c = {c:.3g} N m/Pa is {c / c_vehicle:.3g} x the "
             f"vehicle's {c_vehicle:.3g} N m/Pa")  # fmt: skip
+    if speed_flagged:
+        return [warn(text + ": the train_speed unit flagged above scales the deceleration "
+                     "eq. 14 uses; fix it first", PlausibilityWarning)]  # fmt: skip
     if unit is not None:
         return [warn(text + f": brake_pressure_i in {unit}? (the braking-log format records "
                      "bar)", UnitWarning)]  # fmt: skip
