@@ -10,7 +10,7 @@ from pathlib import Path
 import typer
 from rich.markup import escape
 
-from railadhesion.cli_checks import OutputConsole, fail, warn
+from railadhesion.cli_checks import OutputConsole, allow_untrusted_option, fail, finish, warn
 
 console = OutputConsole()
 
@@ -32,8 +32,13 @@ def monitor(
     shapes: str = typer.Option("both", help="Curve shapes of the estimator: both, fletcher or "
                                "polach."),
     figures: bool = typer.Option(True, help="Write the figures (PNG)."),
+    allow_untrusted: bool = allow_untrusted_option(),
 ) -> None:
-    """Run the adhesion monitor over a log: levels, estimates and reasons as a time series."""
+    """Run the adhesion monitor over a log: levels, estimates and reasons as a time series.
+
+    Exit code 3, unless --allow-untrusted, when the replay cannot be trusted: log columns
+    that look like another unit (a train speed in km/h, a time in ms, pressures in Pa;
+    docs/checks.md). The outputs are written either way."""
     from railadhesion.monitor import MonitorSettings, read_monitor_log, replay_log
     from railadhesion.monitor.figures import replay_figures
 
@@ -64,6 +69,7 @@ def monitor(
         warn("no wheel radius was learned (the log has no coasting): every level stays "
              "unknown; --no-learn-radius takes the vehicle file's radius as exact")
     console.print(f"outputs written to {escape(str(out))}", soft_wrap=True)
+    finish(console, rep.warnings, allow=allow_untrusted, what="monitor replay")
 
 
 def monitor_fmu(

@@ -74,3 +74,35 @@ def test_monitor_errors(tmp_path):
     res = runner.invoke(app, ["monitor", str(log), "--vehicle", "coach_default", "--threshold",
                               "-1"])
     assert res.exit_code == 2 and "threshold must be in" in res.output
+
+
+def test_monitor_sniffs_units_and_exits_3(tmp_path, low_run):
+    """A train speed in km/h: the warning identify gives, the replay not trusted (exit 3,
+    outputs written), --allow-untrusted accepts it."""
+    log = tmp_path / "kmh.csv"
+    sub = dict(low_run, train_speed=low_run["train_speed"] * 3.6)
+    _csv(sub, log, stop=3000)
+    out = tmp_path / "out"
+    args = ["monitor", str(log), "--vehicle", "coach_default", "--out", str(out), "--no-figures"]
+    res = runner.invoke(app, args)
+    assert res.exit_code == 3, res.output
+    assert "train_speed in km/h" in res.stderr and "warning" not in res.stdout
+    assert "monitor replay not trusted: " in res.stderr and "kmh.csv: train_speed" in res.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["trusted"] is False and "km/h" in summary["warnings"][0]
+    res = runner.invoke(app, [*args, "--allow-untrusted"])
+    assert res.exit_code == 0 and "accepted with --allow-untrusted" in res.stderr
+
+
+def test_monitor_time_in_ms_and_empty_log(tmp_path, low_run):
+    log = tmp_path / "ms.csv"
+    _csv(dict(low_run, time=low_run["time"] * 1e3), log, stop=3000)
+    res = runner.invoke(app, ["monitor", str(log), "--vehicle", "coach_default", "--out",
+                              str(tmp_path / "o"), "--no-figures"])
+    assert res.exit_code == 3 and "time in ms?" in res.stderr
+    empty = tmp_path / "empty.csv"
+    empty.write_text("time,train_speed,wheel_speed_1,brake_pressure_1\n")
+    res = runner.invoke(app, ["monitor", str(empty), "--vehicle", "coach_default", "--out",
+                              str(tmp_path / "e")])
+    assert res.exit_code == 2
+    assert res.stderr.startswith("error: ") and "the log has no samples" in res.stderr

@@ -152,7 +152,8 @@ def test_bad_files_and_vehicles(tmp_path):
     pd.DataFrame({"time": [0.0], "wheel_speed_1": [1.0]}).to_csv(tmp_path / "a.csv", index=False)
     with pytest.raises(ValueError, match="'train_speed'"):
         read_monitor_log(tmp_path / "a.csv")
-    frame = pd.DataFrame({"time": [0.0, 1.0], "train_speed": [1.0, 1.0],
+    # sampled every 2.4 ms: a step of 1 s would (rightly) be sniffed as a time in ms
+    frame = pd.DataFrame({"time": [0.0, 0.0024], "train_speed": [1.0, 1.0],
                           "wheel_speed_1": [1.0, 1.0], "brake_pressure_1": [0.0, 0.0]})
     with pytest.raises(ValueError, match="log has 1 axles but the vehicle"):
         replay_log(monitor_log_frame(frame), "coach_default")
@@ -162,3 +163,60 @@ def test_bad_files_and_vehicles(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert monitor_log_frame(frame).n_axles == 1
+
+
+def test_clean_log_is_trusted(log_files):
+    folder, _ = log_files
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        rep = replay_log(folder / "log.csv", "coach_default")
+    assert rep.trusted and rep.warnings == () and rep.log.warnings == ()
+    assert rep.summary["trusted"] is True and rep.summary["warnings"] == []
+
+
+@pytest.mark.parametrize(("column", "factor", "match"), [
+    ("train_speed", 3.6, "train_speed in km/h"),
+    ("time", 1e3, "time in ms"),
+])  # fmt: skip
+def test_units_are_sniffed_as_identify_does(low_run, tmp_path, column, factor, match):
+    """A train speed in km/h, a time in ms: a UnitWarning naming the column at reading, on
+    the log and on the replay (not trusted), as the identification's reader does."""
+    frame = _frame(low_run, stop=3000)
+    frame[column] *= factor
+    path = tmp_path / "log.csv"
+    frame.to_csv(path, index=False)
+    with pytest.warns(UnitWarning, match=match):
+        log = read_monitor_log(path)
+    assert any(match.split(" in ")[0] in w for w in log.warnings)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rep = replay_log(log, "coach_default")
+    assert not rep.trusted and rep.warnings == log.warnings
+    assert rep.summary["trusted"] is False and rep.summary["warnings"] == list(log.warnings)
+    with pytest.warns(UnitWarning, match=match):  # the file given straight to the replay
+        assert not replay_log(path, "coach_default").trusted
+
+
+def test_speed_against_the_vehicle_wheel_radius(low_run):
+    """A rolling radius v / omega of 0.69 m is plausible for a railway wheel but not for the
+    vehicle's 0.46 m: replay_log checks the speed against the vehicle's wheel radius too."""
+    from railadhesion.plausibility import PlausibilityWarning
+
+    frame = _frame(low_run, stop=3000)
+    frame["train_speed"] *= 1.5
+    log = monitor_log_frame(frame)
+    assert log.warnings == ()
+    with pytest.warns(PlausibilityWarning, match="not the vehicle's wheel radius 0.46 m"):
+        rep = replay_log(log, "coach_default")
+    assert not rep.trusted and "train_speed" in rep.warnings[0]
+
+
+def test_log_without_samples_is_an_error(tmp_path):
+    path = tmp_path / "empty.csv"
+    path.write_text("time,train_speed,wheel_speed_1,wheel_speed_2,wheel_speed_3,"
+                    "wheel_speed_4,brake_pressure_1,brake_pressure_2,brake_pressure_3,"
+                    "brake_pressure_4\n")
+    with pytest.raises(ValueError, match="empty.csv: the log has no samples"):
+        read_monitor_log(path)
+    with pytest.raises(ValueError, match="no samples"):
+        monitor_log_frame(pd.read_csv(path))

@@ -9,6 +9,14 @@ train would: missing values, times out of order or repeated, gaps and stuck chan
 the monitor, which reports them in its levels and reasons. No row is dropped; what the reader
 itself notices (missing channels, cells that are not numbers, unknown columns) is listed in
 :attr:`MonitorLog.issues` and the replay's summary.
+
+Units are sniffed as the identification's reader does (``docs/checks.md``): a train speed in
+km/h or mph (against the wheels' angular speeds, and in :func:`replay_log` against the
+vehicle's wheel radius), a time in ms, pressures in Pa. Each finding is a
+:class:`~railadhesion.plausibility.UnitWarning` (or a
+:class:`~railadhesion.plausibility.PlausibilityWarning`), recorded in
+:attr:`MonitorLog.warnings` and :attr:`MonitorReplay.warnings`: a replay with findings is not
+trusted. A log without samples is an error.
 """
 
 from __future__ import annotations
@@ -25,7 +33,12 @@ from railadhesion.io.axle_log import AxleLog
 from railadhesion.monitor import layout
 from railadhesion.monitor.estimator import AdhesionMonitor
 from railadhesion.monitor.settings import MonitorSettings
-from railadhesion.plausibility import UnitWarning, warn
+from railadhesion.plausibility import (
+    UnitWarning,
+    sniff_sample_period,
+    sniff_speed_ratio,
+    warn,
+)
 
 __all__ = ["MonitorLog", "MonitorReplay", "read_monitor_log", "replay_log", "monitor_log_frame"]
 
@@ -57,6 +70,9 @@ class MonitorLog(AxleLog):
         What the reader noticed (missing channels, cells not numbers, unknown columns).
     source : str
         The file read ("" if built in memory).
+    warnings : tuple of str
+        Columns that look like another unit (a train speed in km/h, a time in ms, pressures
+        in Pa): the messages of the warnings issued (``docs/checks.md``).
     """
 
     torque: np.ndarray
@@ -64,6 +80,7 @@ class MonitorLog(AxleLog):
     has_torque: np.ndarray
     issues: tuple = ()
     source: str = ""
+    warnings: tuple = ()
 
 
 def _numbers(col, name, issues):
@@ -105,11 +122,21 @@ def monitor_log_frame(frame, *, source: str = "") -> MonitorLog:
     return _from_columns(names, lambda name: frame[columns[name]], len(frame), source)
 
 
+def _median_period(t) -> float:
+    """Median step between successive finite, increasing times (NaN if there is none)."""
+    t = np.asarray(t, dtype=float)
+    dt = np.diff(t[np.isfinite(t)])
+    dt = dt[dt > 0]
+    return float(np.median(dt)) if dt.size else math.nan
+
+
 def _from_columns(names, get, n_rows, source) -> MonitorLog:
     where = f"{source}: " if source else ""
     for req in ("time", "train_speed"):
         if req not in names:
             raise ValueError(f"{where}the log has no {req!r} column (columns: {names[:12]})")
+    if n_rows == 0:
+        raise ValueError(f"{where}the log has no samples (a header only)")
     channels = {}
     unknown = []
     for name in names:
@@ -124,6 +151,7 @@ def _from_columns(names, get, n_rows, source) -> MonitorLog:
     if n_ax > layout.MAX_AXLES:
         raise ValueError(f"{where}the log has axle {n_ax}; at most {layout.MAX_AXLES} axles")
     issues: list[str] = []
+    found: list[str | None] = []  # unit findings (warnings issued)
     if unknown:
         issues.append(f"columns {', '.join(unknown)} ignored (not channels of the log format)")
     t = _numbers(get("time"), "time", issues)
@@ -144,10 +172,11 @@ def _from_columns(names, get, n_rows, source) -> MonitorLog:
             x = _numbers(get(name), name, issues)
             top = np.nanmax(np.abs(x)) if np.isfinite(x).any() else 0.0
             if top > _BAR_LIMIT:
-                issues.append(warn(
+                found.append(warn(
                     f"{where}{name} reaches {top:.4g}: the log format has bar; values this "
                     "large look like Pa (the monitor will call them implausible)", UnitWarning,
                     stacklevel=4))
+                issues.append(found[-1])
             press[:, i - 1] = x * BAR
             has_p[i - 1] = True
         name = channels.get(("torque", i))
@@ -157,9 +186,13 @@ def _from_columns(names, get, n_rows, source) -> MonitorLog:
         if not (has_p[i - 1] or has_t[i - 1]):
             issues.append(f"axle {i} has neither brake_pressure_{i} nor torque_{i}: its adhesion "
                           "in use is unknown")
+    # units, as the identification's reader sniffs them (the speed against the wheels' angular
+    # speeds; replay_log checks it again against the vehicle's wheel radius)
+    found += [sniff_speed_ratio(v, wheel, where=f"{where}train_speed"),
+              sniff_sample_period(_median_period(t), where=f"{where}time")]
     return MonitorLog(time=t, train_speed=v, wheel_speed=wheel, brake_pressure=press,
                       torque=torque, has_pressure=has_p, has_torque=has_t, issues=tuple(issues),
-                      source=source)
+                      source=source, warnings=tuple(w for w in found if w))
 
 
 def read_monitor_log(path) -> MonitorLog:
@@ -222,6 +255,10 @@ class MonitorReplay:
     log : MonitorLog
     monitor : AdhesionMonitor
         The monitor after the last sample.
+    warnings : tuple of str
+        Why the replay is not trusted: the log's columns that look like another unit
+        (:attr:`MonitorLog.warnings`, and a train speed that does not fit the vehicle's wheel
+        radius). Also in the summary, with ``trusted``.
     """
 
     columns: dict = field(repr=False)
@@ -229,7 +266,13 @@ class MonitorReplay:
     summary: dict
     log: MonitorLog = field(repr=False)
     monitor: AdhesionMonitor = field(repr=False)
+    warnings: tuple = ()
     _frame: object = field(default=None, repr=False)
+
+    @property
+    def trusted(self) -> bool:
+        """False when the log's units look wrong (:attr:`warnings`)."""
+        return not self.warnings
 
     @property
     def frame(self):
@@ -320,6 +363,13 @@ def replay_log(log, vehicle, settings: MonitorSettings | None = None) -> Monitor
     if vehicle.n_axles != log.n_axles:
         raise ValueError(f"the log has {log.n_axles} axles but the vehicle {vehicle.name!r} has "
                          f"{vehicle.n_axles}")
+    if log.n_samples == 0:
+        raise ValueError(f"{log.source or 'log'}: the log has no samples")
+    findings = list(log.warnings)
+    if not any("train_speed" in w for w in findings):  # against the vehicle's own radius
+        found = sniff_speed_ratio(log.train_speed, log.wheel_speed, vehicle.wheel_radius,
+                                  where=f"{log.source or 'log'}: train_speed")  # fmt: skip
+        findings += [found] if found else []
     settings = settings if settings is not None else MonitorSettings()
     mon = AdhesionMonitor(vehicle, settings, pressure=log.has_pressure, torque=log.has_torque)
     n, n_ax = log.n_samples, log.n_axles
@@ -357,7 +407,10 @@ def replay_log(log, vehicle, settings: MonitorSettings | None = None) -> Monitor
         columns[f"reason_{k}"] = (dense[reason[:, i]], labels)
     events = _events(log.time, level, reason, v1, v2, settings.threshold)
     summary = _summary(log, mon, level, status, events, settings, vehicle)
-    return MonitorReplay(columns=columns, events=events, summary=summary, log=log, monitor=mon)
+    summary["trusted"] = not findings
+    summary["warnings"] = findings
+    return MonitorReplay(columns=columns, events=events, summary=summary, log=log, monitor=mon,
+                         warnings=tuple(findings))
 
 
 def _events(time, level, reason, v1, v2, threshold):
