@@ -161,3 +161,24 @@ def test_polach_set_errors_say_how_to_give_ones_own_parameters(tmp_path):
     wilac.write_text((ROOT / "tests" / "io" / "data" / "wilac_example.toml").read_text())
     wrong = _run("polach", "--set", str(wilac))
     assert wrong.exit_code == 2 and "expected 'railadhesion-polach'" in wrong.stderr
+
+
+def test_files_written_are_said_on_stderr_so_stdout_stays_csv(tmp_path):
+    from railadhesion.models.parameters import polach_parameters
+    from railadhesion.models.polach import Polach
+
+    creep = -np.geomspace(0.002, 0.4, 20)
+    q, a, b = 50e3, 0.006, 0.005
+    fx, _ = Polach(polach_parameters("polach2005_dry")).forces(creep, 0.0, 0.0, q, 10.0, a, b)
+    curve = tmp_path / "curve.csv"
+    curve.write_text(f"# normal_force_N = {q}\n# speed_m_s = 10\n# a_m = {a}\n# b_m = {b}\n"
+                     "creep,adhesion\n"
+                     + "".join(f"{c},{abs(f) / q}\n" for c, f in zip(creep, fx, strict=True)))
+    params, figure = tmp_path / "fitted.toml", tmp_path / "fit.png"
+    result = _run("fit", "polach", str(curve), "--format", "csv", "--out", str(params),
+                  "--figure", str(figure), "--allow-untrusted")
+    assert result.exit_code == 0, result.output
+    rows = list(csv.reader(io.StringIO(result.stdout)))
+    assert rows[0] == ["parameter", "value", "stderr", "fitted"] and len(rows) == 6
+    assert "figure written to" in result.stderr and figure.is_file()
+    assert "parameters written to" in result.stderr and params.is_file()

@@ -171,7 +171,7 @@ def _emit(title: str, columns, rows, fmt: str, out: Path | None, note: str = "")
         out.write_text(text, encoding="utf-8")
     except OSError as exc:
         _fail(f"cannot write the table to {out}: {exc}")
-    console.print(f"{title}: {fmt} written to {escape(str(out))}", highlight=False)
+    err_console.print(f"{title}: {fmt} written to {escape(str(out))}", highlight=False)
 
 
 def _plain(value):
@@ -227,7 +227,7 @@ def _save(fig, out: Path | None) -> None:
         fig.savefig(out, dpi=110, bbox_inches="tight")
     except (OSError, ValueError) as exc:  # unwritable folder, unknown image format
         _fail(f"cannot write the figure to {out}: {exc}")
-    console.print(f"figure written to {escape(str(out))}")
+    err_console.print(f"figure written to {escape(str(out))}")  # stdout may hold CSV/JSON
 
 
 def _figure(out: Path | None, draw) -> None:
@@ -537,7 +537,7 @@ def params_list(
                 out.write_text(text, encoding="utf-8")
             except OSError as exc:
                 _fail(f"cannot write the table to {out}: {exc}")
-            console.print(f"parameter sets: json written to {escape(str(out))}")
+            err_console.print(f"parameter sets: json written to {escape(str(out))}")
         return
     if as_format == "table" and out is not None and len(chosen) > 1:
         _fail("a text file holds one table: choose --kind, or write --format json")
@@ -701,8 +701,8 @@ def fit_polach_cmd(
             save_polach_parameters(result.as_polach_parameters(), out)
         except (OSError, ValueError) as exc:
             _fail(f"cannot write the parameter file {out}: {exc}")
-        console.print(f"parameters written to {escape(str(out))}"
-                      + (" (its notes say it is not trusted)" if result.warnings else ""))
+        err_console.print(f"parameters written to {escape(str(out))}"
+                          + (" (its notes say it is not trusted)" if result.warnings else ""))
     finish(console, result.warnings, allow=allow_untrusted, what="Polach fit")
 
 
@@ -779,7 +779,7 @@ def fit_wilac_cmd(
         keys = list(rows[0]) if rows else []
         _emit("WILAC calibration per curve", [(k, k, ".4g") for k in keys],
               [[r[k] for k in keys] for r in rows], fmt, table)  # fmt: skip
-    console.print(f"WILAC parameters written to {escape(str(out))}")
+    err_console.print(f"WILAC parameters written to {escape(str(out))}")
     finish(console, calibration.warnings, allow=allow_untrusted, what="WILAC calibration")
 
 
