@@ -147,6 +147,21 @@ class AxleAdhesion:
     def describe(self) -> dict:
         return {"model": self.name}
 
+    def calibrated_ranges(self) -> tuple:
+        """The ranges the model was calibrated for, outside which it holds its parameters at
+        their boundary values (an extrapolation the simulator reports: docs/checks.md).
+
+        Returns
+        -------
+        tuple of (str, float, float, str, str)
+            ``(quantity, low, high, unit, what)`` with quantity ``"speed"`` [m/s] (checked
+            against the initial speed) or ``"wheel_load"`` [N] (against the vehicle's
+            static wheel loads), ``what`` naming the calibrated set for messages. Empty
+            (the default): the model declares no calibrated range (Polach sets, the table
+            model and user laws do not).
+        """
+        return ()
+
 
 class WaterFlowProfile:
     """Water flow rate w [µl/s] along the track (``over="distance"``, x in m) or in time (s).
@@ -418,6 +433,14 @@ class WilacAdhesion(_PolachFamily):
         wilac_axle_parameters(self.packed, q, max(float(speed), 0.0), w, self.weights,
                               self.params, np.empty((8, MAX_AXLES)))
         self.stiffness = self.contact.stiffness_over_load(q)
+
+    def calibrated_ranges(self):
+        """The WILAC set's ``speed_range`` and ``normal_force_range`` (the parameters are
+        held at their values at the nearest end outside them)."""
+        p = self.parameters
+        what = f"the WILAC set {p.name or '(unnamed)'!r}"
+        return (("speed", *map(float, p.speed_range), "m/s", what),
+                ("wheel_load", *map(float, p.normal_force_range), "N", what))
 
     def describe(self):
         return {"model": "wilac", "parameters": self.parameters.name,
