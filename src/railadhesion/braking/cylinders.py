@@ -30,6 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from railadhesion.plausibility import check_plausible
+
 __all__ = ["BrakeCylinders", "APPLY", "HOLD", "VENT", "VALVE_STATES", "ATMOSPHERIC_PRESSURE",
            "lag_factors", "cylinder_step", "set_valves"]
 
@@ -103,7 +105,10 @@ class BrakeCylinders:
         Time constant of the pressure fall [s] (default 0.15 s, an assumption).
     max_pressure : float
         Pressure limit [Pa] (default 3.8 bar). A command above it is clipped to it (the
-        simulation reports it: ``BrakingResult.summary["pressure_clipped"]``).
+        simulation reports it: ``BrakingResult.summary["pressure_clipped"]``). A limit
+        outside the plausible brake-cylinder pressures, 0.05-20 bar, warns (a
+        :class:`~railadhesion.plausibility.UnitWarning` when it looks like bar, kPa, psi or
+        MPa: ``max_pressure=6.0`` is 6 Pa; docs/checks.md).
     cylinder_volume : float
         Brake-cylinder volume per axle [m³], for the vented air (default 2e-3).
     valves : {"axle", "bogie"}
@@ -125,6 +130,15 @@ class BrakeCylinders:
                 raise ValueError(f"{name} must be in (0, inf), got {x!r}")
         if self.valves not in ("axle", "bogie"):
             raise ValueError(f"valves must be 'axle' or 'bogie', got {self.valves!r}")
+        self.max_pressure_note()
+
+    def max_pressure_note(self, *, emit: bool = True) -> str | None:
+        """The warning for an implausible ``max_pressure`` (bar for Pa?), or None; issued
+        unless ``emit`` is False (the simulator records it on its result without warning a
+        second time)."""
+        return check_plausible(self.max_pressure, "max_pressure", quantity="brake_pressure",
+                               where="BrakeCylinders.max_pressure",
+                               what="brake-cylinder pressure limit", emit=emit)
 
     def group_valves(self, valves: np.ndarray, n_axles: int) -> np.ndarray:
         """Per-axle valve states after the per-bogie grouping (if any)."""
