@@ -92,6 +92,7 @@ from railadhesion.braking.records import (
     machine_dtype,
 )
 from railadhesion.braking.vehicle import GRAVITY, Vehicle
+from railadhesion.plausibility import check_calibrated, check_plausible
 
 __all__ = ["BrakingSimulator", "BrakingState", "LiveState", "StepInputs", "SimulationError",
            "largest_stable_step"]
@@ -212,6 +213,8 @@ class StepInputs:
 
 _FIXED = frozenset(("vehicle", "adhesion", "cylinders", "gradient", "refresh_period",
                     "stop_speed", "max_step", "record", "wsp", "sensors"))
+# parameters whose values _check_inputs checks
+_CHECKED = frozenset(("vehicle", "adhesion", "cylinders"))
 
 # simulator attribute -> field of the state record
 _STATE_ARRAYS = {"omega": "omega", "pressure": "pressure", "valves": "valve",
@@ -473,6 +476,18 @@ class BrakingSimulator:
     sensors : SensorModel, optional
         The sensor model between the vehicle and the built-in WSP (default
         :func:`~railadhesion.braking.sensors.ideal_sensors`).
+
+    Attributes
+    ----------
+    warnings : list of str
+        What the inputs were warned for (each also issued as a warning, docs/checks.md): at
+        construction an implausible ``initial_speed`` (a
+        :class:`~railadhesion.plausibility.UnitWarning` when it looks like km/h) or
+        cylinders' ``max_pressure`` (bar for Pa?), an initial speed or static wheel load
+        outside the adhesion model's calibrated ranges (an
+        :class:`~railadhesion.plausibility.AlteredResultWarning`); later, an implausible
+        ``pressure_command`` given to :meth:`step` (:meth:`advance` checks nothing of the
+        kind: it stays as fast as it is).
     """
 
     def __init__(self, vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float, *,
@@ -513,6 +528,33 @@ class BrakingSimulator:
         self.sensors = sensors
         self._want_compiled = bool(compiled)
         self._build()
+        self._check_inputs()
+
+    def _check_inputs(self):
+        """Warn for implausible inputs and for the calibrated ranges of the adhesion model
+        that the run leaves (docs/checks.md); record the messages in :attr:`warnings`.
+
+        Checked: the initial speed against the plausible speeds (km/h for m/s?); the
+        cylinders' ``max_pressure`` against the plausible brake pressures (bar for Pa?;
+        warned when the cylinders were made, recorded here); the initial speed and the
+        static wheel loads against the model's ``calibrated_ranges()``
+        (:meth:`railadhesion.braking.adhesion.AxleAdhesion.calibrated_ranges`), an
+        :class:`~railadhesion.plausibility.AlteredResultWarning` since the model holds its
+        parameters at the end of the range. Speeds below the calibrated range at the end of
+        a stop are not reported (every stop passes through them).
+        """
+        found = [check_plausible(self.initial_speed, "initial_speed"),
+                 self.cylinders.max_pressure_note(emit=False)]
+        for quantity, low, high, unit, what in self.adhesion.calibrated_ranges():
+            if quantity == "speed":
+                value, name = self.initial_speed, "initial_speed"
+            elif quantity == "wheel_load":
+                value = np.unique(0.5 * self.vehicle.axle_normal_loads(0.0))
+                name = f"{self.vehicle.name or 'vehicle'}: static wheel load"
+            else:  # pragma: no cover - a model's own quantity: not checked
+                continue
+            found.append(check_calibrated(value, name, low, high, unit=unit, what=what))
+        self.__dict__["warnings"] = [f for f in found if f]
 
     # -- the records ------------------------------------------------------------------------
     def _build(self):
@@ -728,6 +770,8 @@ class BrakingSimulator:
                     f"{name} is a parameter; it cannot change after the first step")
             super().__setattr__(name, value)
             self._build()  # before the first step: start again with the new parameter
+            if name in _CHECKED:
+                self._check_inputs()
             return
         super().__setattr__(name, value)
 
@@ -889,6 +933,7 @@ class BrakingSimulator:
             except (ValueError, TypeError):
                 raise ValueError(f"pressure_command must be a number or {n} numbers in "
                                  f"[0, inf) Pa, got {cmd!r}") from None
+            self._check_command(u.pressure_command)
         if torque is not None:
             try:
                 u.torque[:] = torque
@@ -909,6 +954,18 @@ class BrakingSimulator:
                                  f"each 0 (apply), 1 (hold) or 2 (vent), got {valves!r}") from None
         self.advance(float(dt))
         return self._live.snapshot()
+
+    def _check_command(self, command):
+        """Warn (once per message) for an implausible commanded pressure given to
+        :meth:`step` (bar for Pa?; 0, brakes released, is plausible), recorded in
+        :attr:`warnings`."""
+        applied = command[command > 0.0]
+        if applied.size == 0:
+            return
+        args = (applied, "pressure_command")
+        text = check_plausible(*args, quantity="brake_pressure", emit=False)
+        if text is not None and text not in self.warnings:  # new: warn (UnitWarning if bar?)
+            self.warnings.append(check_plausible(*args, quantity="brake_pressure"))
 
     # -- whole runs (used by simulate) ------------------------------------------------------
     def configure_run(self, demand) -> None:
