@@ -16,7 +16,12 @@ from railadhesion.braking.metrics import slide_metrics
 from railadhesion.braking.simulator import BrakingSimulator
 from railadhesion.braking.vehicle import Vehicle
 from railadhesion.braking.wsp import WheelSlideProtection, as_controller, call_controller
-from railadhesion.plausibility import AlteredResultWarning, UntrustedResultWarning, warn
+from railadhesion.plausibility import (
+    AlteredResultWarning,
+    UntrustedResultWarning,
+    check_plausible,
+    warn,
+)
 
 __all__ = ["BrakeDemand", "BrakingResult", "simulate", "summarise"]
 
@@ -45,11 +50,16 @@ class BrakingResult:
     settings : dict
         What was simulated (vehicle, adhesion model, step, WSP).
     warnings : list of str
-        What was altered or cannot be trusted (each also issued as a warning:
-        :class:`~railadhesion.plausibility.AlteredResultWarning`,
+        What was implausible, altered or cannot be trusted (each also issued as a warning:
+        :class:`~railadhesion.plausibility.PlausibilityWarning` or
+        :class:`~railadhesion.plausibility.UnitWarning` for an implausible input,
+        :class:`~railadhesion.plausibility.AlteredResultWarning` for a clipped pressure or an
+        adhesion model run outside its calibrated range,
         :class:`~railadhesion.plausibility.UntrustedResultWarning`).
     trusted : bool
-        False when the train did not stop within ``max_time`` or a result is NaN.
+        False when the train did not stop within ``max_time`` or a result is NaN (an
+        implausible input or an altered result is reported in ``warnings`` but leaves it
+        True, as a clipped pressure does).
     """
 
     histories: pd.DataFrame
@@ -177,13 +187,20 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
     adhesion : AxleAdhesion
         E.g. ``PolachAdhesion("polach2005_wet")`` or ``WilacAdhesion(profile)``.
     initial_speed : float
-        [m/s].
+        [m/s]. Above 100 m/s a :class:`~railadhesion.plausibility.UnitWarning` (km/h?);
+        outside the adhesion model's calibrated speed range (WILAC's default set: 2-40 m/s)
+        an :class:`~railadhesion.plausibility.AlteredResultWarning` (the model's parameters
+        are held at the end of the range). Both are recorded in the result's ``warnings``.
     brake : float or callable
         Commanded brake-cylinder pressure [Pa]: a constant applied at t = 0, a
         :class:`BrakeDemand`, or a function of time. A command above the cylinders'
         ``max_pressure`` is clipped to it: an
         :class:`~railadhesion.plausibility.AlteredResultWarning` says so, and the summary
-        flags it (``pressure_clipped``).
+        flags it (``pressure_clipped``). A demand outside the plausible brake-cylinder
+        pressures (0.05-20 bar; 0 is no brake) gives a
+        :class:`~railadhesion.plausibility.UnitWarning` when it looks like bar, kPa, psi or
+        MPa (``5.5`` is 5.5 Pa, not 5.5 bar), recorded in ``warnings`` (a function of time:
+        its highest command, checked after the run).
     cylinders : BrakeCylinders, optional
     wsp : None, True, WheelSlideProtection, or controller
         ``None``: no WSP (valves always apply); ``True``: the default
@@ -221,6 +238,7 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
     demand = BrakeDemand(float(brake)) if isinstance(brake, int | float) else brake
     if not callable(demand):
         raise ValueError(f"brake must be a pressure [Pa] or a function of time, got {brake!r}")
+    notes = []
     if wsp is True:
         wsp = WheelSlideProtection()
     if isinstance(wsp, WheelSlideProtection):
@@ -244,9 +262,14 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
                            gradient=gradient, refresh_period=refresh_period,
                            stop_speed=stop_speed, max_step=dt, record=True,
                            compiled=compiled, wsp=controller if compiled_loop else None)
-    notes = []
+    if isinstance(demand, BrakeDemand) and demand.pressure > 0:  # 0: brakes released
+        where = "brake" if demand is not brake else "brake (BrakeDemand.pressure)"
+        notes.append(check_plausible(demand.pressure, "brake", quantity="brake_pressure",
+                                     where=where, what="brake demand"))
+    notes += sim.warnings  # implausible inputs, calibrated ranges left (docs/checks.md)
     cap = sim.cylinders.max_pressure
-    if isinstance(demand, BrakeDemand) and demand.pressure > cap:
+    capped = isinstance(demand, BrakeDemand) and demand.pressure > cap  # said before the run
+    if capped:
         notes.append(warn(
             f"the brake demand {demand.pressure:.6g} Pa ({demand.pressure / 1e5:.3g} bar) is "
             f"above the brake cylinders' max_pressure {cap:.6g} Pa ({cap / 1e5:.3g} bar): the "
@@ -261,7 +284,13 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
             controller.reset(vehicle.n_axles, vehicle.wheel_radius)
         _run_python(sim, demand, controller, ratio, nmax, dt, progress, initial_speed)
     report = sim.command_report
-    if report["clipped_steps"] and not notes:
+    highest = report["highest_command_Pa"]
+    if not isinstance(demand, BrakeDemand) and highest > 0:  # a function of time: its peak
+        notes.append(check_plausible(highest, "brake", quantity="brake_pressure",
+                                     where="brake (the highest command of the demand)",
+                                     what="brake demand"))
+    notes = [note for note in notes if note]
+    if report["clipped_steps"] and not capped:
         notes.append(warn(
             f"the brake demand reached {report['highest_command_Pa']:.6g} Pa, above the brake "
             f"cylinders' max_pressure {cap:.6g} Pa: clipped to it in "
