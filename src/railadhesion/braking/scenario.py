@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -48,7 +49,12 @@ from railadhesion.braking.run import BrakeDemand, BrakingResult, simulate
 from railadhesion.braking.vehicle import Vehicle, vehicle_from_field
 from railadhesion.braking.wsp import WheelSlideProtection, WSPSettings, settings_file_keys
 from railadhesion.models.parameters import POLACH_PARAMETER_SETS
-from railadhesion.plausibility import AlteredResultWarning, check_plausible, warn
+from railadhesion.plausibility import (
+    AlteredResultWarning,
+    PlausibilityWarning,
+    check_plausible,
+    warn,
+)
 
 __all__ = ["BrakeScenario", "load_scenario", "run_scenario", "SCENARIO_FORMAT",
            "polach_set_name", "wsp_settings_fields"]
@@ -363,7 +369,7 @@ def _scenario_from_document(doc: Mapping, base: Path, label: str = "") -> BrakeS
     valves = string(bt.get("valves", "axle"), "brake.valves")
     if valves not in ("axle", "bogie"):
         raise FieldError("brake.valves", f"must be 'axle' or 'bogie', got {valves!r}")
-    cylinders = BrakeCylinders(
+    cylinder_fields = (
         number(bt.get("fill_time_constant_s", 0.3), "brake.fill_time_constant_s", 0.0, 100.0,
                low_open=True),
         number(bt.get("vent_time_constant_s", 0.15), "brake.vent_time_constant_s", 0.0, 100.0,
@@ -374,6 +380,9 @@ def _scenario_from_document(doc: Mapping, base: Path, label: str = "") -> BrakeS
                low_open=True),
         valves,
     )
+    with warnings.catch_warnings():  # the field's own warning, naming it, follows
+        warnings.simplefilter("ignore", PlausibilityWarning)
+        cylinders = BrakeCylinders(*cylinder_fields)
     adhesion, dry, adhesion_info = _adhesion(doc["adhesion"], base, vehicle.wheel_radius)
     found = _plausible_fields(
         label or "scenario", v0, demand.pressure, cylinders.max_pressure,
