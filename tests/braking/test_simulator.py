@@ -19,6 +19,7 @@ from railadhesion.braking import (
 )
 from railadhesion.models import polach_forces, wilac_forces
 from railadhesion.models.wilac import default_wilac_parameters
+from railadhesion.plausibility import AlteredResultWarning
 
 VEHICLE = Vehicle(name="test coach")  # no running resistance, level track
 
@@ -285,10 +286,12 @@ def test_a_step_too_large_for_the_wheel_dynamics_is_refused_with_the_largest_sta
             simulate(coach, WilacAdhesion(COACH_DAMP), 44.44, 5.5e5, dt=dt)
     # just below it the stop is computed, and close to the 1 ms stop
     step = math.floor(tau * 1e3) / 1e3
-    a = simulate(coach, WilacAdhesion(COACH_DAMP), 44.44, 5.5e5, dt=step,
-                 cylinders=BrakeCylinders(max_pressure=6e5))
-    b = simulate(coach, WilacAdhesion(COACH_DAMP), 44.44, 5.5e5, dt=1e-3,
-                 cylinders=BrakeCylinders(max_pressure=6e5))
+    with pytest.warns(AlteredResultWarning, match="outside the calibrated range"):  # 160 km/h
+        a = simulate(coach, WilacAdhesion(COACH_DAMP), 44.44, 5.5e5, dt=step,
+                     cylinders=BrakeCylinders(max_pressure=6e5))
+    with pytest.warns(AlteredResultWarning, match="outside the calibrated range"):
+        b = simulate(coach, WilacAdhesion(COACH_DAMP), 44.44, 5.5e5, dt=1e-3,
+                     cylinders=BrakeCylinders(max_pressure=6e5))
     assert a.stopping_distance == pytest.approx(b.stopping_distance, rel=2e-3)
     # a curve that never falls allows any step
     assert largest_stable_step(coach, CallableAdhesion(ample), 44.44)[0] == math.inf
@@ -301,22 +304,31 @@ def test_demand_above_the_cylinder_limit_is_reported_not_silently_clipped():
     from railadhesion.plausibility import AlteredResultWarning
 
     coach = load_vehicle("coach_default")
-    with pytest.warns(AlteredResultWarning, match=r"550000 Pa \(5.5 bar\).*380000 Pa"):
+    with pytest.warns(AlteredResultWarning, match="outside the calibrated range"), \
+            pytest.warns(AlteredResultWarning, match=r"550000 Pa \(5.5 bar\).*380000 Pa"):
         res = simulate(coach, WilacAdhesion(COACH_DAMP), 44.44, 5.5e5,
                        wsp=WheelSlideProtection())
     assert res.summary["pressure_clipped"] and res.summary["max_pressure_Pa"] == 3.8e5
-    assert res.warnings and "5.5 bar" in res.warnings[0] and res.summary["warnings"]
+    # the extrapolation beyond WILAC's calibrated 40 m/s (160 km/h), then the clipped demand
+    assert len(res.warnings) == 2 and "outside the calibrated range" in res.warnings[0]
+    assert "5.5 bar" in res.warnings[1] and res.summary["warnings"] == res.warnings
     assert res.trusted  # altered, not untrusted: the stop at 3.8 bar is computed correctly
     assert res.stopping_distance == pytest.approx(728.3, abs=0.05)  # the number
     # a function of time above the limit: reported after the run
     with pytest.warns(AlteredResultWarning, match="clipped to it in"):
         simulate(VEHICLE, PolachAdhesion(), 5.0, lambda t: 4e5 if t > 0.5 else 1e5,
                  dt=4e-3)
-    with warnings.catch_warnings():  # within the limit: no warning, no flag
-        warnings.simplefilter("error")
+    # within the limit: no pressure warning, no flag; only the extrapolation of WILAC beyond
+    # its calibrated 40 m/s (160 km/h = 44.44 m/s), reported as such
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         res = simulate(coach, WilacAdhesion(COACH_DAMP), 44.44, 5.5e5,
                        cylinders=BrakeCylinders(max_pressure=6e5), wsp=WheelSlideProtection())
-    assert not res.summary["pressure_clipped"] and res.warnings == []
+    calibrated = ("initial_speed = 44.44 m/s is outside the calibrated range [2, 40] m/s of "
+                  "the WILAC set 'wilac_default_reconstruction'")
+    assert [type(w.message) for w in caught] == [AlteredResultWarning]
+    assert not res.summary["pressure_clipped"] and len(res.warnings) == 1
+    assert res.warnings[0].startswith(calibrated) and str(caught[0].message) == res.warnings[0]
 
 
 def test_a_stop_that_does_not_end_is_untrusted():
