@@ -306,16 +306,20 @@ def simulate(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed: float,
     if progress is not None:
         progress(1.0)
     summary = summarise(sim, h)
+    untrusted = []  # why the result cannot be trusted
     if not sim.stopped:
         note = (f"the train did not stop within max_time = {max_time:g} s (speed "
                 f"{sim.speed:.4g} m/s left): the stopping distance and time are unknown (NaN); "
                 "the result is untrusted")
-        notes.append(warn(note, UntrustedResultWarning) if expected_stop else note)
+        untrusted.append(warn(note, UntrustedResultWarning) if expected_stop else note)
     elif not (math.isfinite(summary["stopping_distance_m"]) and np.all(np.isfinite(
             h[["time", "distance", "train_speed"]].to_numpy()))):
-        notes.append(warn("the simulation gave NaN results; the result is untrusted",
-                          UntrustedResultWarning))
-    trusted = not any("untrusted" in note for note in notes)
+        untrusted.append(warn("the simulation gave NaN results; the result is untrusted",
+                              UntrustedResultWarning))
+    trusted = not untrusted
+    # the reasons it is not trusted first (first_reason, a study's failed stop), then what
+    # was implausible or altered
+    notes = untrusted + notes
     summary["pressure_clipped"] = bool(report["clipped_steps"])
     summary["highest_command_Pa"] = report["highest_command_Pa"]
     summary["max_pressure_Pa"] = cap
