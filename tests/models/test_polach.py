@@ -18,6 +18,7 @@ from hypothesis import strategies as st
 from railadhesion.contact.kalker import kalker_coefficients
 from railadhesion.models.parameters import PolachParameters, polach_parameters
 from railadhesion.models.polach import Polach, polach_forces
+from railadhesion.plausibility import PlausibilityWarning
 
 #: Numerics over the whole input domain, implausible inputs included: the policy's warnings
 #: (docs/checks.md) are what tests/test_plausibility.py checks, not these tests.
@@ -307,7 +308,7 @@ def test_zero_creepage_is_zero_force_without_warnings():
         fx, fy = polach_forces(0.0, 0.0, 0.0, 1e5, 10.0, 6e-3, 8e-3, mu0=0.3)
         assert fx == 0.0 and fy == 0.0
         fx, fy = polach_forces(np.zeros(4), 0.0, np.array([0.0, 0.0, 0.1, -0.1]), 1e5, 10.0,
-                               6e-3, 8e-3, mu0=0.3, A=0.0, B=1e3)  # fmt: skip
+                               6e-3, 8e-3, mu0=0.3, A=0.0, B=100.0)  # fmt: skip (B <= 100)
         assert np.all(np.isfinite(fx)) and np.all(np.isfinite(fy))
         assert fx[0] == 0.0 and fy[0] == 0.0 and fy[1] == 0.0
         assert fy[2] == -fy[3] != 0.0
@@ -626,3 +627,48 @@ def test_reinforcing_spin_limit_is_as_documented():
     r = fastsim(0.0, 0.01, psi, CONTACT_FN, CONTACT_A, CONTACT_B, 0.33, flexibility="blended")
     assert fy / (0.33 * CONTACT_FN) == pytest.approx(-0.51, abs=0.005)
     assert float(r.fy) / (0.33 * CONTACT_FN) == pytest.approx(-0.83, abs=0.005)
+
+
+@pytest.mark.parametrize("as_array", [False, True])
+def test_mu0_a_b_outside_the_parameter_sets_ranges_are_rejected(as_array):
+    """polach_forces accepts what PolachParameters accepts: mu0 = 30 (percent) gave |F| =
+    1.15 Q without a word while PolachParameters(mu0=30) is an error."""
+    xi = np.array([1e-2, 2e-2]) if as_array else 1e-2
+    dry = polach_parameters("polach2005_dry").as_dict()
+    for name, value, rng in (("mu0", 30.0, r"\(0, 1.5\]"), ("A", 11.0, r"\[0, 10\]"),
+                             ("B", 101.0, r"\[0, 100\]")):  # fmt: skip
+        with pytest.raises(ValueError, match=rf"^{name} must be in {rng}, got {value}") as info:
+            polach_forces(xi, 0.0, 0.0, 110e3, 10.0, 8.6e-3, 5.3e-3, **{**dry, name: value})
+        with pytest.raises(ValueError) as of_the_set:
+            polach_parameters("polach2005_dry").replace(**{name: value})
+        assert str(info.value) == str(of_the_set.value)
+    with pytest.raises(ValueError, match=r"given in percent\? \(30 percent = 0.3"):
+        polach_forces(xi, 0.0, 0.0, 110e3, 10.0, 8.6e-3, 5.3e-3, **{**dry, "mu0": 30.0})
+    # a parameter array with one bad value names it
+    with pytest.raises(ValueError, match=r"^B must be in \[0, 100\], got 200.0"):
+        polach_forces(xi, 0.0, 0.0, 110e3, 10.0, 8.6e-3, 5.3e-3, mu0=0.3, B=np.array([1.0, 200.0]))
+    # the ends of the ranges are accepted (with a warning for mu0 = 1.5, above 1)
+    with pytest.warns(PlausibilityWarning, match=r"^mu0 = 1.5 is outside the plausible range"):
+        fx, _ = polach_forces(xi, 0.0, 0.0, 110e3, 10.0, 8.6e-3, 5.3e-3, mu0=1.5, A=10.0, B=100.0)
+    assert np.all(np.isfinite(fx))
+
+
+@pytest.mark.parametrize("as_array", [False, True])
+def test_mu0_above_one_warns_in_the_function_the_contact_and_the_set(as_array):
+    """Above 1 a friction coefficient is no wheel-rail value (PLAUSIBLE, friction_coefficient):
+    possible in the model, so a warning, not an error; mu0 <= 1 stays silent."""
+    from railadhesion.models.polach import PolachContact
+
+    xi = np.array([1e-2]) if as_array else 1e-2
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        polach_forces(xi, 0.0, 0.0, 110e3, 10.0, 8.6e-3, 5.3e-3, mu0=1.0)
+    mu0 = np.array([0.3, 1.2]) if as_array else 1.2
+    with pytest.warns(PlausibilityWarning, match=r"^mu0 = 1.2 is outside .* no wheel-rail value"):
+        polach_forces(xi, 0.0, 0.0, 110e3, 10.0, 8.6e-3, 5.3e-3, mu0=mu0)
+    with pytest.warns(PlausibilityWarning, match=r"^mu0 = 1.2"):
+        PolachContact(110e3, 10.0, 8.6e-3, 5.3e-3, mu0=1.2)
+    with pytest.raises(ValueError, match=r"^mu0 must be in \(0, 1.5\], got 30.0; given in perc"):
+        PolachContact(110e3, 10.0, 8.6e-3, 5.3e-3, mu0=30.0)
+    with pytest.warns(PlausibilityWarning, match=r"^polach2005_dry: mu0 = 1.2 is outside"):
+        polach_parameters("polach2005_dry").replace(mu0=1.2)

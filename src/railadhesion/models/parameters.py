@@ -33,10 +33,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from railadhesion.plausibility import PLAUSIBLE, PlausibilityWarning, warn
+
 __all__ = [
+    "MU0_PLAUSIBLE_MAX",
     "PARAMETER_RANGES",
     "POLACH_PARAMETER_SETS",
     "PolachParameters",
+    "mu0_message",
+    "parameter_range_error",
     "polach_parameters",
 ]
 
@@ -54,6 +59,44 @@ def _range_text(low: float, high: float, low_closed: bool, high_closed: bool) ->
     return f"{'[' if low_closed else '('}{low:g}, {high:g}{']' if high_closed else ')'}"
 
 
+def _in_range(value: float, field: str) -> bool:
+    low, high, low_closed, high_closed = PARAMETER_RANGES[field]
+    ok = value >= low if low_closed else value > low
+    return bool(ok and (value <= high if high_closed else value < high))
+
+
+def parameter_range_error(field: str, value: float) -> ValueError:
+    """The ``ValueError`` of a Polach parameter ``field`` whose ``value`` is outside its range
+    (:data:`PARAMETER_RANGES`), as :class:`PolachParameters` and
+    :func:`~railadhesion.models.polach.polach_forces` raise it: it names the field and the
+    range and, for ``mu0`` (a fraction) whose value / 100 is in range, the likely unit.
+
+    >>> print(parameter_range_error("mu0", 30.0))
+    mu0 must be in (0, 1.5], got 30.0; given in percent? (30 percent = 0.3; mu0 is a fraction)
+    """
+    rng = _range_text(*PARAMETER_RANGES[field])
+    text = f"{field} must be in {rng}, got {value!r}"
+    if field == "mu0" and math.isfinite(value) and _in_range(value / 100.0, field):
+        text += f"; given in percent? ({value:g} percent = {value / 100.0:g}; mu0 is a fraction)"
+    return ValueError(text)
+
+
+#: Largest plausible mu0: the upper end of the plausible coefficient of friction
+#: (:data:`railadhesion.plausibility.PLAUSIBLE`, ``friction_coefficient``).
+MU0_PLAUSIBLE_MAX = PLAUSIBLE["friction_coefficient"].high
+
+
+def mu0_message(mu0) -> str | None:
+    """The message of a mu0 (a number or an array, already in its range (0, 1.5]) above
+    :data:`MU0_PLAUSIBLE_MAX`, or None: possible in the model, but no wheel-rail value."""
+    high = float(np.nanmax(mu0)) if np.ndim(mu0) else float(mu0)
+    if not high > MU0_PLAUSIBLE_MAX:
+        return None
+    return (f"mu0 = {high:.4g} is outside the plausible range [0, {MU0_PLAUSIBLE_MAX:g}] of a "
+            "coefficient of friction (a fraction) (docs/checks.md): above 1 it is no "
+            "wheel-rail value (dry rails about 0.4-0.6); check the value")  # fmt: skip
+
+
 @dataclass(frozen=True)
 class PolachParameters:
     """One set of the five parameters of Polach's extended creep-force model.
@@ -68,7 +111,8 @@ class PolachParameters:
     k_S : float
         Reduction factor in the area of slip [-], (0, 1]. Polach recommends k_S <= k_A.
     mu0 : float
-        Maximum (static) friction coefficient [-], (0, 1.5].
+        Maximum (static) friction coefficient [-], (0, 1.5]; above 1 (no wheel-rail value) a
+        :class:`~railadhesion.plausibility.PlausibilityWarning`.
     A : float
         mu_inf / mu0, ratio of the friction coefficient at infinite slip velocity to mu0 [-],
         [0, 10]. ``A = 1`` (or ``B = 0``) means friction independent of slip velocity.
@@ -113,12 +157,12 @@ class PolachParameters:
                 value = float(raw)
             except (TypeError, ValueError) as exc:
                 raise ValueError(f"{field} must be a real number in {rng}, got {raw!r}") from exc
-            ok = math.isfinite(value)
-            ok = ok and (value >= low if low_closed else value > low)
-            ok = ok and (value <= high if high_closed else value < high)
-            if not ok:
-                raise ValueError(f"{field} must be in {rng}, got {value!r}")
+            if not (math.isfinite(value) and _in_range(value, field)):
+                raise parameter_range_error(field, value)
             object.__setattr__(self, field, value)
+        text = mu0_message(self.mu0)
+        if text is not None:
+            warn(f"{self.name or 'PolachParameters'}: {text}", PlausibilityWarning)
         for field in ("name", "source", "notes"):
             if not isinstance(getattr(self, field), str):
                 raise ValueError(f"{field} must be a string, got {getattr(self, field)!r}")

@@ -43,7 +43,13 @@ from railadhesion.contact.kalker import (
     kalker_rows,
     kalker_scalar,
 )
-from railadhesion.models.parameters import PolachParameters, polach_parameters
+from railadhesion.models.parameters import (
+    PARAMETER_RANGES,
+    PolachParameters,
+    mu0_message,
+    parameter_range_error,
+    polach_parameters,
+)
 from railadhesion.numerics import (
     CHUNK,
     FINITE,
@@ -65,7 +71,7 @@ from railadhesion.numerics import (
     output_chunk,
     run_chunks,
 )
-from railadhesion.plausibility import input_checker
+from railadhesion.plausibility import PlausibilityWarning, input_checker, warn
 
 __all__ = [
     "Polach",
@@ -88,6 +94,15 @@ _PI_OVER_4 = math.pi / 4.0
 # eps_psi would let F_yS grow without bound at huge creepages; (1 + eps_psi^2) = inf gives 0.
 _EPS_MAX = 1e50
 _INF = math.inf
+# Upper ends of the ranges of mu0, A and B (PolachParameters' PARAMETER_RANGES, all closed):
+# polach_forces accepts what a parameter set accepts.
+_MU0_MAX = PARAMETER_RANGES["mu0"][1]
+_A_MAX = PARAMETER_RANGES["A"][1]
+_B_MAX = PARAMETER_RANGES["B"][1]
+# the same ranges for the batch loop's count_outside (railadhesion.numerics.FINITE and the like)
+_MU0_RANGE = (0.0, math.nan, _MU0_MAX, _MU0_MAX)
+_A_RANGE = (0.0, 0.0, _A_MAX, _A_MAX)
+_B_RANGE = (0.0, 0.0, _B_MAX, _B_MAX)
 
 
 # --- the law (plain functions compiled where compiled code calls them) ----------------------
@@ -268,11 +283,11 @@ def polach_bad_input(sx, sy, psi, q, v, a, b, g, nu, k_a, k_s, mu0, big_a, big_b
         return 12
     if not 0.0 < k_s <= 1.0:
         return 13
-    if not 0.0 < mu0 < _INF:
+    if not 0.0 < mu0 <= _MU0_MAX:
         return 14
-    if not 0.0 <= big_a < _INF:
+    if not 0.0 <= big_a <= _A_MAX:
         return 15
-    if not 0.0 <= big_b < _INF:
+    if not 0.0 <= big_b <= _B_MAX:
         return 16
     if not AOB_MIN <= a / b <= AOB_MAX:
         return 17
@@ -470,9 +485,9 @@ def _polach_chunks(sx, sy, psi, q, v, a, b, g, nu, mu0, k_a, k_s, big_a, big_b, 
         lo = c * CHUNK
         m = min(CHUNK, n - lo)
         bad = polach_count_bad(sx, sy, psi, q, v, a, b, g, nu, lo, m) + (
-            count_outside(mu0, POSITIVE, lo, m) + count_outside(k_a, FRACTION, lo, m)
-            + count_outside(k_s, FRACTION, lo, m) + count_outside(big_a, NONNEGATIVE, lo, m)
-            + count_outside(big_b, NONNEGATIVE, lo, m))  # fmt: skip
+            count_outside(mu0, _MU0_RANGE, lo, m) + count_outside(k_a, FRACTION, lo, m)
+            + count_outside(k_s, FRACTION, lo, m) + count_outside(big_a, _A_RANGE, lo, m)
+            + count_outside(big_b, _B_RANGE, lo, m))  # fmt: skip
         for j in range(14):
             load_row(buf, _INPUT_ROWS[j], inputs[j], lo, m)
         # one shape (a, b, G, nu) over the chunk: Kalker's coefficients looked up once and
@@ -536,7 +551,10 @@ def polach_forces(
     b : array_like
         Lateral contact semi-axis [m], > 0.
     mu0 : array_like
-        Maximum friction coefficient mu0 [-], > 0.
+        Maximum friction coefficient mu0 [-], in (0, 1.5] (the range of
+        :class:`~railadhesion.models.parameters.PolachParameters`; a value in percent is an
+        error saying so). Above 1, no wheel-rail value: a
+        :class:`~railadhesion.plausibility.PlausibilityWarning`.
     k_A : array_like, optional
         Stiffness reduction factor in the area of adhesion [-], in (0, 1] (Polach 2005:
         k_S <= k_A <= 1).
@@ -544,9 +562,10 @@ def polach_forces(
         Stiffness reduction factor in the area of slip [-], in (0, 1]. Polach recommends
         k_S <= k_A; k_S > k_A is accepted and evaluated as published (see Notes, Bounds).
     A : array_like, optional
-        mu_inf/mu0 [-], >= 0. ``A = 1`` gives constant friction.
+        mu_inf/mu0 [-], in [0, 10]. ``A = 1`` gives constant friction.
     B : array_like, optional
-        Exponential friction decrease rate [s/m], >= 0. ``B = 0`` gives constant friction.
+        Exponential friction decrease rate [s/m], in [0, 100]. ``B = 0`` gives constant
+        friction.
     shear_modulus : array_like, optional
         Combined shear modulus G [Pa], > 0.
     poisson : array_like, optional
@@ -674,6 +693,7 @@ def polach_forces(
     if scalars is None:
         out = _polach_array(*args)
         _PLAUSIBLE(args)  # implausible inputs warn (docs/checks.md); errors were raised above
+        _check_mu0(mu0)
         return out
     sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu = scalars
     fx, fy, bad = polach_checked.dispatcher(
@@ -683,6 +703,8 @@ def polach_forces(
         check_polach_inputs(*scalars)  # raises the error naming the argument
         raise AssertionError("polach kernel flagged an input the checks accept")
     _PLAUSIBLE(scalars)  # implausible inputs warn (docs/checks.md)
+    if mu0 > 1.0:
+        _check_mu0(mu0)
     return np.float64(fx), np.float64(fy)
 
 
@@ -696,6 +718,12 @@ _ARG_NAMES = (
 )  # fmt: skip
 #: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
 _PLAUSIBLE = input_checker(_ARG_NAMES)
+
+def _check_mu0(mu0) -> str | None:
+    """Warn (:class:`~railadhesion.plausibility.PlausibilityWarning`) for :func:`mu0_message`;
+    returns the message or None."""
+    text = mu0_message(mu0)
+    return None if text is None else warn(text, PlausibilityWarning)
 
 
 def _polach_array(*args):
@@ -729,15 +757,26 @@ def check_polach_inputs(sx, sy, psi, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g,
         check_nonnegative(v, "speed")
         check_positive(a, "a")
         check_positive(b, "b")
-    check_positive(mu0, "mu0")
+    _check_parameter(mu0, "mu0")
     check_range(k_a, "k_A", 0.0, 1.0, closed="right")
     check_range(k_s, "k_S", 0.0, 1.0, closed="right")
-    check_nonnegative(big_a, "A")
-    check_nonnegative(big_b, "B")
+    _check_parameter(big_a, "A")
+    _check_parameter(big_b, "B")
     if contact:
         check_positive(g, "shear_modulus")
         check_range(nu, "poisson", 0.0, 0.5)
         axis_ratio(np.asarray(a, float), np.asarray(b, float))
+
+
+def _check_parameter(value, name: str) -> None:
+    """Raise the error of :class:`PolachParameters` (:func:`parameter_range_error`) if a value
+    of ``value`` (a number or an array) is outside the range of parameter ``name``."""
+    arr = as_float_array(value, name).ravel()
+    low, high, low_closed, _ = PARAMETER_RANGES[name]
+    with np.errstate(invalid="ignore"):
+        ok = ((arr >= low) if low_closed else (arr > low)) & (arr <= high)
+    if not np.all(ok):
+        raise parameter_range_error(name, float(arr[np.argmin(ok)]))
 
 
 @dataclass(frozen=True)
@@ -866,6 +905,7 @@ class PolachContact:
             raise ValueError("PolachContact holds one contact: every argument must be a scalar")
         check_polach_inputs(*scalars)  # validates every argument, errors name it
         _PLAUSIBLE(scalars)  # implausible inputs warn (docs/checks.md), once per contact
+        _check_mu0(scalars[7])
         (_, _, _, q, v, a, b, mu0, k_a, k_s, big_a, big_b, g, nu) = (float(x) for x in scalars)
         self.normal_force, self.speed, self.a, self.b = q, v, a, b
         self.mu0, self.k_A, self.k_S, self.A, self.B = mu0, k_a, k_s, big_a, big_b
