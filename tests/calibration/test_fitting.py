@@ -316,3 +316,55 @@ def test_fletcher_fixed_k_s_zero_is_a_value_error():
     with pytest.raises(ValueError, match=r"bounds\['k_a'\]: low must be >= 0"):
         fit_fletcher(xi, y, half_width=FLETCHER_A, radius=FLETCHER_R, mu=0.2,
                      bounds={"k_a": (-1.0, 5.0)})
+
+
+def test_polach_implausible_speed_is_checked_once_and_makes_the_fit_untrusted():
+    """A curve at 'speed_m_s = 300' (km/h) gave trusted True, warnings (), B 100 x too small,
+    and the same UnitWarning at each of ~780 optimiser evaluations."""
+    import warnings as _warnings
+
+    from railadhesion.plausibility import UnitWarning
+
+    creep = -np.geomspace(2e-4, 0.6, 40)
+    true = dict(k_A=1.0, k_S=0.4, mu0=0.45, A=0.4, B=0.6)
+    fx, _ = polach_forces(creep, 0.0, 0.0, 4500.0, 3.0, 4.1e-3, 3.1e-3, **true)  # 3 m/s
+    with _warnings.catch_warnings(record=True) as caught:
+        _warnings.simplefilter("always")
+        res = fit_polach(creep, fx / 4500.0, normal_force=4500.0, speed=300.0, a=4.1e-3,
+                         b=3.1e-3)  # fmt: skip
+    units = [w for w in caught if issubclass(w.category, UnitWarning)]
+    assert len(units) == 1, [str(w.message) for w in caught]
+    assert "speed = 300 m/s" in str(units[0].message) and "km/h" in str(units[0].message)
+    assert not res.trusted
+    assert res.warnings[0] == str(units[0].message) == res.implausible_inputs[0]
+    untrusted = [w for w in caught if issubclass(w.category, UntrustedResultWarning)]
+    assert len(untrusted) == 1 and "speed = 300 m/s" in str(untrusted[0].message)
+    assert res.params["B"] == pytest.approx(0.006, rel=0.05)  # 100 x too small: 300 / 3
+    # the same data at their true speed: trusted, no input finding, B recovered
+    good = fit_polach(creep, fx / 4500.0, normal_force=4500.0, speed=3.0, a=4.1e-3, b=3.1e-3)
+    assert good.trusted and good.implausible_inputs == ()
+    assert good.params["B"] == pytest.approx(0.6, rel=1e-3)
+
+
+def test_polach_adhesion_in_percent_and_fletcher_creep_in_percent_are_flagged_once():
+    import warnings as _warnings
+
+    from railadhesion.plausibility import UnitWarning
+
+    creep = -np.geomspace(0.002, 0.3, 25)
+    fx, _ = polach_forces(creep, 0.0, 0.0, 4200.0, 5.0, 4e-3, 3e-3, mu0=0.4, k_S=0.4)
+    with pytest.warns(UnitWarning, match=r"^adhesion = from .* given in percent\?") as rec:
+        res = fit_polach(creep, 100 * np.abs(fx) / 4200.0, normal_force=4200.0, speed=5.0,
+                         a=4e-3, b=3e-3, fit=("k_A", "k_S"), initial={"mu0": 40.0 / 100},
+                         warn_untrusted=False)  # fmt: skip
+    assert sum(issubclass(w.category, UnitWarning) for w in rec) == 1
+    assert not res.trusted and res.implausible_inputs[0].startswith("adhesion = ")
+    xi = np.linspace(0.0002, 0.05, 30)  # 0.02 % to 5 %
+    y = np.abs(fletcher(xi, 1.0, 0.204e-3, 11.75e-3, 0.055, k_a=0.193).traction)
+    with _warnings.catch_warnings(record=True) as caught:
+        _warnings.simplefilter("always")
+        res = fit_fletcher(100 * xi, y, half_width=0.204e-3, radius=11.75e-3, fit=("k_a",),
+                           mu=0.055, warn_untrusted=False)  # fmt: skip
+    units = [w for w in caught if issubclass(w.category, UnitWarning)]
+    assert len(units) == 1 and str(units[0].message).startswith("creep = from 0.02 to 5 is outside")
+    assert not res.trusted and res.warnings[0] == str(units[0].message)

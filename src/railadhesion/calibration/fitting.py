@@ -20,7 +20,13 @@ from scipy.optimize import least_squares
 
 from railadhesion._docstrings import docstring_entries
 from railadhesion._validate import check_finite, check_nonnegative, check_positive, check_range
-from railadhesion.plausibility import UntrustedResultWarning, fit_warnings, noise_rms, warn
+from railadhesion.plausibility import (
+    UntrustedResultWarning,
+    check_plausible,
+    fit_warnings,
+    noise_rms,
+    warn,
+)
 
 __all__ = [
     "FLETCHER_DEFAULT_BOUNDS",
@@ -103,12 +109,17 @@ class FitResult:
     nfev : int
         Number of model evaluations (all starts together).
     warnings : tuple of str
-        Why the fit should not be trusted (empty if nothing was found): the quality gate
+        Why the fit should not be trusted (empty if nothing was found): first the implausible
+        data or conditions (a speed of 300 m/s, adhesion in percent: each also warned once, a
+        :class:`~railadhesion.plausibility.UnitWarning` or
+        :class:`~railadhesion.plausibility.PlausibilityWarning`), then the quality gate
         :func:`railadhesion.plausibility.fit_warnings` (low R², a parameter on a bound of the
         search that is not a limit of the model, non-finite or very large standard errors, too
         few points where a parameter shows; ``docs/checks.md``).
     trusted : bool
         ``not warnings``.
+    implausible_inputs : tuple of str
+        The implausible data or conditions among :attr:`warnings` (empty if none).
     """
 
     model: str
@@ -129,6 +140,7 @@ class FitResult:
     nfev: int = 0
     warnings: tuple[str, ...] = ()
     _predict: Callable | None = field(default=None, repr=False, compare=False)
+    implausible_inputs: tuple[str, ...] = ()
 
     @property
     def trusted(self) -> bool:
@@ -334,8 +346,31 @@ def _through_origin_slope(x: np.ndarray, y: np.ndarray) -> float | None:
     return float(np.sum(x[sel] * y[sel]) / np.sum(x[sel] ** 2))
 
 
+def _check_inputs(values: Mapping) -> tuple[str, ...]:
+    """Check a fit's data and conditions once, before the optimiser (which evaluates the
+    model unchecked): a :class:`~railadhesion.plausibility.PlausibilityWarning` or
+    :class:`~railadhesion.plausibility.UnitWarning` for each implausible one
+    (:func:`~railadhesion.plausibility.check_plausible`; ``docs/checks.md``), and their
+    messages, which the fit records as reasons it is not trusted: a model fitted to data in a
+    wrong unit has fitted its parameters to a wrong scale (B, the rate of the falling
+    friction per slip velocity, 100 times too small for a speed in km/h read as m/s).
+
+    ``values``: ``{argument name: value}``, ``adhesion`` checked as a coefficient of friction
+    (measured |T|/Q, a fraction)."""
+    found = []
+    for name, value in values.items():
+        if name == "adhesion":
+            what = "measured adhesion coefficient |T|/Q (a fraction)"
+            text = check_plausible(value, name, quantity="friction_coefficient", what=what)
+        else:
+            text = check_plausible(value, name)
+        if text is not None:
+            found.append(text)
+    return tuple(found)
+
+
 def _run_fit(model_name, names, residual, starts, lo, hi, fitted, fixed, s, y, conditions, predict,
-             *, domain, gate=None, warn_untrusted=True):  # fmt: skip
+             *, domain, gate=None, warn_untrusted=True, inputs=()):  # fmt: skip
     """Least squares from each start; keep the lowest cost; build the FitResult.
 
     ``domain``: ``{name: (low, high)}`` limits of each parameter in the model (a parameter
@@ -344,7 +379,8 @@ def _run_fit(model_name, names, residual, starts, lo, hi, fitted, fixed, s, y, c
     ``gate(params)``: extra arguments of :func:`~railadhesion.plausibility.fit_warnings`
     (``region_points``, ``ignore_stderr``) for the fitted values. ``warn_untrusted``: issue
     an :class:`~railadhesion.plausibility.UntrustedResultWarning` when the gate finds
-    anything.
+    anything. ``inputs``: the messages of :func:`_check_inputs` (implausible data or
+    conditions), the first reasons the fit is not trusted.
     """
 
     def solve(x0, max_nfev):
@@ -408,7 +444,7 @@ def _run_fit(model_name, names, residual, starts, lo, hi, fitted, fixed, s, y, c
         name for i, name in enumerate(fitted) if name in at_bound
         and not any(abs(x[i] - lim) <= 1e-6 * span[i] for lim in domain.get(name, ()))
     )  # fmt: skip
-    flags = fit_warnings(
+    flags = tuple(inputs) + fit_warnings(
         r_squared=float(r2), params=params, fitted=fitted, stderr=stderr, at_bound=outside,
         success=bool(best.success), residual_rms=float(np.sqrt(ssr / n)),
         noise=noise_rms(np.abs(s), y), **(gate(params) if gate is not None else {}),
@@ -434,6 +470,7 @@ def _run_fit(model_name, names, residual, starts, lo, hi, fitted, fixed, s, y, c
         nfev=int(nfev),
         warnings=flags,
         _predict=lambda c: predict(c, params),
+        implausible_inputs=tuple(inputs),
     )
 
 
@@ -535,11 +572,14 @@ def fit_polach(
     pair is not identifiable.
 
     Quality gate (:func:`railadhesion.plausibility.fit_warnings`, ``docs/checks.md``): the
-    fit is not trusted if R² < 0.9, a fitted parameter ends on a bound of the search that is
-    not a limit of the model (k_A = 1, k_S = 1, A = 0 or 1 and B = 0 are legitimate values),
-    a standard error is not finite or larger than its value, or fewer than 3 points lie
-    where a parameter shows: k_A, k_S on the rising part (below the peak), A and B beyond
-    the peak (not required when the fitted friction falls by less than 1 % over the data).
+    fit is not trusted if an input is implausible (the data's creep or adhesion, the normal
+    force, speed, semi-axes... outside :data:`railadhesion.plausibility.PLAUSIBLE`: checked
+    once, before the optimiser, which then evaluates the model without re-checking), R² < 0.9, a
+    fitted parameter ends on a bound of the search that is not a limit of the model (k_A = 1,
+    k_S = 1, A = 0 or 1 and B = 0 are legitimate values), a standard error is not finite or
+    larger than its value, or fewer than 3 points lie where a parameter shows: k_A, k_S on the
+    rising part (below the peak), A and B beyond the peak (not required when the fitted friction
+    falls by less than 1 % over the data).
 
     References
     ----------
@@ -559,7 +599,7 @@ def fit_polach(
     >>> {k: round(v, 3) for k, v in res.params.items()}
     {'k_A': 0.6, 'k_S': 0.2, 'mu0': 0.4, 'A': 0.4, 'B': 0.5}
     """
-    from railadhesion.models.polach import polach_forces
+    from railadhesion.models.polach import polach_forces_quiet
 
     fitted = _check_fit_names(fit, POLACH_NAMES, "Polach")
     s, y = _data(creep, adhesion)
@@ -605,8 +645,15 @@ def fit_polach(
         else:
             raise ValueError("mu0 is not fitted: give its value in initial, e.g. {'mu0': 0.4}")
 
+    # implausible inputs warn once, here, and make the fit untrusted; the optimiser then
+    # evaluates the model without re-checking them (it would warn at every evaluation)
+    inputs = _check_inputs({"creep": s, "adhesion": y, "creep_lat": eta, "spin": phi,
+                            "normal_force": q, "speed": v, "a": aa, "b": bb,
+                            "shear_modulus": g, "poisson": nu})  # fmt: skip
+
     def model(c, params):
-        fx, fy = polach_forces(c, eta, phi, q, v, aa, bb, shear_modulus=g, poisson=nu, **params)
+        fx, fy = polach_forces_quiet(c, eta, phi, q, v, aa, bb, shear_modulus=g, poisson=nu,
+                                     **params)  # fmt: skip
         return np.hypot(fx, fy) / q
 
     def residual(x):
@@ -676,7 +723,7 @@ def fit_polach(
 
     return _run_fit(
         "polach", POLACH_NAMES, residual, starts, lo, hi, fitted, fixed, s, y, conditions, model,
-        domain=_POLACH_DOMAIN, gate=gate, warn_untrusted=warn_untrusted,
+        domain=_POLACH_DOMAIN, gate=gate, warn_untrusted=warn_untrusted, inputs=inputs,
     )
 
 
@@ -756,7 +803,7 @@ def fit_fletcher(
     >>> round(res.params["k_a"], 4), res.params["k_s"]
     (0.193, 1.0)
     """
-    from railadhesion.models.twod import fletcher
+    from railadhesion.models.twod import fletcher_quiet
 
     fitted = _check_fit_names(fit, FLETCHER_NAMES, "Fletcher")
     if "k_s" in fitted and "mu" in fitted:
@@ -785,8 +832,11 @@ def fit_fletcher(
     bnd = _bounds(bounds, FLETCHER_DEFAULT_BOUNDS, FLETCHER_NAMES, _FLETCHER_POSITIVE)
     fixed = {n: float(init.get(n, 1.0)) for n in FLETCHER_NAMES if n not in fitted}
 
+    # checked once (warn, not trusted); the optimiser's evaluations are not re-checked
+    inputs = _check_inputs({"creep": s, "adhesion": y, "half_width": a, "radius": r})
+
     def model(c, params):
-        res = fletcher(c, 1.0, a, r, params["mu"], k_a=params["k_a"], k_s=params["k_s"])
+        res = fletcher_quiet(c, 1.0, a, r, params["mu"], k_a=params["k_a"], k_s=params["k_s"])
         return np.abs(res.traction)
 
     def residual(x):
@@ -825,5 +875,5 @@ def fit_fletcher(
 
     return _run_fit(
         "fletcher", FLETCHER_NAMES, residual, starts, lo, hi, fitted, fixed, s, y, conditions,
-        model, domain={}, gate=gate, warn_untrusted=warn_untrusted,
+        model, domain={}, gate=gate, warn_untrusted=warn_untrusted, inputs=inputs,
     )

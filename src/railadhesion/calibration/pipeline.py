@@ -180,10 +180,12 @@ class WilacCalibration:
     checks : dict of str to ConditionCheck
         The check of each condition on a grid between the data points.
     warnings : tuple of str
-        Every problem found: the checks between the data points, and curves whose own Polach
+        Every problem found: the checks between the data points, curves whose own Polach
         fit does not describe them (R² below :data:`railadhesion.plausibility.MIN_R_SQUARED`
-        with a residual above the curve's noise: :func:`railadhesion.plausibility.explains_data`);
-        empty when the set can be trusted over its calibrated range.
+        with a residual above the curve's noise: :func:`railadhesion.plausibility.explains_data`),
+        and curves with implausible data or conditions (their fits'
+        :attr:`~railadhesion.calibration.fitting.FitResult.implausible_inputs`); empty when the
+        set can be trusted over its calibrated range.
     """
 
     parameters: object
@@ -662,6 +664,12 @@ def run_wilac_calibration(
         )  # fmt: skip
         report("check", k_cond + 1, len(WILAC_CONDITIONS))
     problems = tuple(msg for chk in checks.values() for msg in chk.problems)
+    # curves with implausible data or conditions (each warned once by its fit): the set's
+    # parameters are fitted to a wrong scale
+    problems += tuple(
+        f"curve {cf.curve.name or Path(cf.curve.source).name} ({cf.condition}): {msg}"
+        for cf in curve_fits for msg in cf.fit.implausible_inputs
+    )  # fmt: skip
     # curves the Polach model does not describe: their parameters entered the regressions
     problems += tuple(
         f"curve {cf.curve.name or Path(cf.curve.source).name} ({cf.condition}): its own Polach "

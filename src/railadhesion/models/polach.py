@@ -708,6 +708,18 @@ def polach_forces(
     return np.float64(fx), np.float64(fy)
 
 
+def polach_forces_quiet(creep_long, creep_lat, spin, normal_force, speed, a, b, *, mu0,
+                       k_A=1.0, k_S=1.0, A=1.0, B=0.0, shear_modulus=8.2e10,
+                       poisson=0.28):  # fmt: skip
+    """:func:`polach_forces` (the same law, Polach 2005, and the same errors for impossible
+    inputs) without its plausibility warnings: for a caller that checked its inputs once
+    (a fit, whose optimiser evaluates the model hundreds of times and would warn each time;
+    :func:`railadhesion.calibration.fitting.fit_polach`). Returns arrays (or NumPy scalars
+    for scalar inputs), unlabelled."""
+    return _polach_array(creep_long, creep_lat, spin, normal_force, speed, a, b, mu0, k_A,
+                         k_S, A, B, shear_modulus, poisson)  # fmt: skip
+
+
 def _bad(name: str, rng: str, value) -> ValueError:
     return ValueError(f"{name} must be in {rng}, got {float(value)!r}")
 

@@ -187,8 +187,11 @@ def _twod_into(fletcher, xi, load, a, r, m, ka, ks, out):
         out[0, k], out[1, k], out[2, k], out[3, k] = res
 
 
-def _evaluate(fletcher, creep, normal_load, half_width, radius, mu, k_a, k_s) -> TwoDTraction:
-    """Validate the inputs (errors name them), then the compiled law over their broadcast."""
+def _evaluate(fletcher, creep, normal_load, half_width, radius, mu, k_a, k_s, *,
+              plausible=True) -> TwoDTraction:  # fmt: skip
+    """Validate the inputs (errors name them), then the compiled law over their broadcast;
+    ``plausible``: warn for implausible inputs too (a caller that checked them once, a fit's
+    optimiser, passes False)."""
     inputs = [
         check_finite(creep, "creep"),
         check_nonnegative(normal_load, "normal_load"),
@@ -201,7 +204,8 @@ def _evaluate(fletcher, creep, normal_load, half_width, radius, mu, k_a, k_s) ->
     shape, n, flat = flatten(inputs)
     out = np.empty((4, n))
     _twod_into(fletcher, *flat, out)
-    _PLAUSIBLE((inputs[0], inputs[2], inputs[3]))  # implausible inputs warn (docs/checks.md)
+    if plausible:  # implausible inputs warn (docs/checks.md)
+        _PLAUSIBLE((inputs[0], inputs[2], inputs[3]))
     return TwoDTraction(*(x.reshape(shape)[()] for x in out))
 
 
@@ -335,6 +339,15 @@ def fletcher(creep, normal_load, half_width, radius, mu, k_a=1.0, k_s=1.0) -> Tw
     0.0
     """
     return _evaluate(True, creep, normal_load, half_width, radius, mu, k_a, k_s)
+
+
+def fletcher_quiet(creep, normal_load, half_width, radius, mu, k_a=1.0, k_s=1.0) -> TwoDTraction:
+    """:func:`fletcher` (Fletcher 2013, eqs. (8)-(12), the same errors for impossible inputs)
+    without its plausibility warnings, unlabelled: for a caller that checked its inputs once
+    (:func:`railadhesion.calibration.fitting.fit_fletcher`, whose optimiser evaluates it
+    hundreds of times)."""
+    return _evaluate(True, creep, normal_load, half_width, radius, mu, k_a, k_s,
+                     plausible=False)  # fmt: skip
 
 
 @labelled(units=TWOD_UNITS)
