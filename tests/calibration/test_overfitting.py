@@ -16,7 +16,11 @@ import warnings
 import numpy as np
 import pytest
 
-from railadhesion.calibration import CalibrationWarning, run_wilac_calibration
+from railadhesion.calibration import (
+    CalibrationWarning,
+    UndeterminedParameterWarning,
+    run_wilac_calibration,
+)
 from railadhesion.calibration.regression import build_regression
 from railadhesion.contact import contact_semi_axes
 from railadhesion.io import CreepCurve
@@ -90,12 +94,16 @@ def curves():
 def test_default_calibration_stays_close_between_the_data(curves):
     with warnings.catch_warnings():
         warnings.simplefilter("error", CalibrationWarning)  # a warning would fail loudly too
+        # damp1's B is hardly determined by these curves (A near 1 hides it): noted, not a
+        # reason to distrust the set
+        warnings.simplefilter("ignore", UndeterminedParameterWarning)
         try:
             result = run_wilac_calibration(curves)
         except CalibrationWarning:  # pragma: no cover - allowed by the issue, then checked
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", CalibrationWarning)
                 result = run_wilac_calibration(curves)
+    assert all(note.split(" ")[0] == "damp1.B" for note in result.notes)
     worst = _check_trusted_or_loud(result)
     # measured here: 0.004-0.011 over seeds 1-3 (0.09 before the fix, 20-point curves)
     if result.trusted:
@@ -116,7 +124,8 @@ def test_default_calibration_stays_close_between_the_data(curves):
 def test_paper_rule_overfits_and_the_check_says_so(curves):
     """The paper's R² rule without the guards (many terms, no refinement) goes wrong between
     the data; the check must announce it."""
-    with pytest.warns(CalibrationWarning, match="cannot be trusted"):
+    with pytest.warns(UndeterminedParameterWarning, match=r"^damp1\.B is hardly determined"), \
+            pytest.warns(CalibrationWarning, match="cannot be trusted"):  # fmt: skip
         result = run_wilac_calibration(
             curves, criterion="r2", max_terms=8, refine=False, regression_atol=None
         )

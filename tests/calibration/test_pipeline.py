@@ -254,3 +254,56 @@ def test_contact_function_returning_bad_semi_axes_is_named():
         calibrate_wilac(curves, contact=lambda q: (0.0, 3e-3))
     with pytest.raises(ValueError, match=r"contact\(normal_force\) must return the semi-axes"):
         calibrate_wilac(curves, contact=lambda q: 4e-3)
+
+
+def test_a_parameter_the_curves_hardly_determine_is_noted_not_regressed_silently(tmp_path):
+    """The user's rig (guides: fitting WILAC): the wet condition's A = 0.9 hides B, whose
+    per-curve fits scatter from 0.005 to 28 s/m; the set regressed it as -1.666 + 3.332 Q/v^2
+    (0 to 11.7 s/m, true 0.1) and said nothing. Now a warning naming wet.B, recorded on the
+    result and in the file's provenance; the set stays trusted (its adhesion is checked)."""
+    from railadhesion.calibration import UndeterminedParameterWarning
+    from railadhesion.io.paramfiles import save_wilac_parameters
+
+    rng = np.random.default_rng(1)
+    truth = {0.0: dict(k_A=1.0, k_S=0.4, mu0=0.45, A=0.4, B=0.6),
+             25.0: dict(k_A=0.3, k_S=0.1, mu0=0.15, A=0.4, B=0.4),
+             40.0: dict(k_A=0.3, k_S=0.1, mu0=0.2, A=0.8, B=0.2),
+             350.0: dict(k_A=0.2, k_S=0.1, mu0=0.15, A=0.9, B=0.1)}  # fmt: skip
+    creep = np.geomspace(0.002, 0.6, 20)
+    curves = []
+    for water, params in truth.items():
+        for q in (3000.0, 4500.0, 6000.0):
+            a, b = 4e-3 * (q / 4200) ** (1 / 3), 3e-3 * (q / 4200) ** (1 / 3)
+            for v in (3.0, 6.0):
+                fx, _ = polach_forces(creep, 0.0, 0.0, q, v, a, b, **params)
+                mu = np.abs(fx) / q + rng.normal(0.0, 0.004, creep.size)
+                curves.append(CreepCurve(creep, mu, normal_force=q, speed=v, water_flow=water,
+                                         a=a, b=b, name=f"w{water:g}_Q{q:g}_v{v:g}"))  # fmt: skip
+    with pytest.warns(UndeterminedParameterWarning, match=r"^wet\.B is hardly determined") as rec:
+        result = run_wilac_calibration(curves)
+    assert len([w for w in rec if issubclass(w.category, UndeterminedParameterWarning)]) == 1
+    assert result.trusted
+    assert len(result.notes) == 1 and result.notes[0].startswith("wet.B is hardly determined")
+    assert "-1.666 + 3.332*Q*1/v*1/v" in result.notes[0]
+    assert result.checks["wet"].undetermined["B"] >= 3
+    assert "HARDLY DETERMINED" in result.parameters.provenance["notes"]
+    assert "NOTE: 1 parameter(s) hardly determined" in result.summary()
+    save_wilac_parameters(result.parameters, tmp_path / "site.toml")
+    assert "wet.B is hardly determined" in read_provenance(tmp_path / "site.toml")["notes"]
+
+
+def test_a_curve_with_an_implausible_speed_makes_the_calibration_untrusted():
+    """speed_m_s = 300 (km/h) in one file: its fit is untrusted and so is the set, naming it."""
+    from railadhesion.calibration import CalibrationWarning
+    from railadhesion.plausibility import UnitWarning
+
+    curves = _curves()
+    bad = curves[0]
+    curves[0] = CreepCurve(bad.creep, bad.adhesion, normal_force=bad.normal_force, speed=300.0,
+                           water_flow=bad.water_flow, a=bad.a, b=bad.b, name=bad.name)  # fmt: skip
+    with pytest.warns(UnitWarning, match=r"^speed = 300 m/s"), \
+            pytest.warns(CalibrationWarning, match="speed = 300 m/s"):  # fmt: skip
+        result = run_wilac_calibration(curves)
+    assert not result.trusted
+    assert any(w.startswith(f"curve {bad.name} (dry): speed = 300 m/s") for w in result.warnings)
+

@@ -5,7 +5,11 @@ The functions most used are importable from here::
     from railadhesion.calibration import fit_polach, calibrate_wilac
 """
 
-from railadhesion.calibration.checks import CalibrationWarning, ConditionCheck
+from railadhesion.calibration.checks import (
+    CalibrationWarning,
+    ConditionCheck,
+    UndeterminedParameterWarning,
+)
 from railadhesion.calibration.fitting import (
     FLETCHER_DEFAULT_BOUNDS,
     POLACH_DEFAULT_BOUNDS,
@@ -27,6 +31,7 @@ __all__ = [
     "FLETCHER_DEFAULT_BOUNDS",
     "POLACH_DEFAULT_BOUNDS",
     "CalibrationWarning",
+    "UndeterminedParameterWarning",
     "ConditionCheck",
     "CurveFit",
     "FitResult",

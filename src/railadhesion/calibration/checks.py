@@ -8,8 +8,9 @@ condition together against the measured adhesion (the parameters' physical bound
 penalty on a grid); :func:`check_condition` evaluates the calibrated set on a grid over the
 calibrated (Q, v) range and reports parameters that leave their physical bounds, parameters
 that vary far beyond the range of the per-curve fits, and adhesion curves outside the envelope
-of the measured ones. Both are used by :func:`railadhesion.calibration.pipeline.
-run_wilac_calibration`.
+of the measured ones; it also notes regressions on Q and v of a parameter the curves hardly
+determine (:class:`UndeterminedParameterWarning`). Both are used by
+:func:`railadhesion.calibration.pipeline.run_wilac_calibration`.
 """
 
 from __future__ import annotations
@@ -21,9 +22,19 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from railadhesion.models.regression import ParameterRegression, design_matrix
-from railadhesion.plausibility import UntrustedResultWarning
+from railadhesion.plausibility import (
+    MAX_RELATIVE_STDERR,
+    RailadhesionWarning,
+    UntrustedResultWarning,
+)
 
-__all__ = ["CalibrationWarning", "ConditionCheck", "check_condition", "refine_condition"]
+__all__ = [
+    "CalibrationWarning",
+    "ConditionCheck",
+    "UndeterminedParameterWarning",
+    "check_condition",
+    "refine_condition",
+]
 
 _NAMES = ("k_A", "k_S", "mu0", "A", "B")
 
@@ -31,6 +42,19 @@ _NAMES = ("k_A", "k_S", "mu0", "A", "B")
 class CalibrationWarning(UntrustedResultWarning):
     """A calibrated parameter set that should not be trusted somewhere in its range (an
     :class:`~railadhesion.plausibility.UntrustedResultWarning`)."""
+
+
+class UndeterminedParameterWarning(RailadhesionWarning):
+    """A calibrated parameter that the measured curves hardly determine, regressed on Q and v
+    all the same: the dependence its regression shows is not supported by the data (the
+    calibrated adhesion may still reproduce the curves; the set stays trusted)."""
+
+
+def _expression(regression: ParameterRegression) -> str:
+    """A regression as text: ``-1.666 + 3.332*Q*1/v*1/v``."""
+    parts = [f"{c:.4g}" if t == "1" else f"{c:.4g}*{t}"
+             for t, c in zip(regression.terms, regression.coefficients, strict=True)]  # fmt: skip
+    return " + ".join(parts).replace("+ -", "- ")
 
 
 @dataclass(frozen=True, eq=False)
@@ -59,6 +83,14 @@ class ConditionCheck:
         ``(Q [N], v [m/s], |creep| [-])`` where ``adhesion_excursion`` occurs.
     problems : tuple of str
         Readable findings; empty when the set passed every check.
+    undetermined : dict of str to int
+        Per parameter, the number of the condition's curves whose own fit hardly determines
+        it (standard error not finite or above :data:`~railadhesion.plausibility.
+        MAX_RELATIVE_STDERR` times the value; only with ``fitted_stderr``).
+    notes : tuple of str
+        Parameters the curves hardly determine (in at least half of them) whose regression
+        depends on Q or v all the same: the dependence is not supported by the data. Not a
+        reason to distrust the set's adhesion, which the checks above compare with the curves.
     """
 
     condition: str
@@ -71,6 +103,8 @@ class ConditionCheck:
     adhesion_excursion: float
     adhesion_worst: tuple
     problems: tuple[str, ...] = field(default=())
+    undetermined: dict = field(default_factory=dict)
+    notes: tuple[str, ...] = field(default=())
 
     @property
     def ok(self) -> bool:
@@ -130,7 +164,8 @@ def refine_condition(
     (dict, float, float)
         The refined regressions, and the RMS adhesion residual before and after.
     """
-    from railadhesion.models.polach import polach_forces
+    # quiet: the curves' inputs were checked once, by their fits (no warning per evaluation)
+    from railadhesion.models.polach import polach_forces_quiet as polach_forces
 
     creep = np.concatenate([np.asarray(c[0], float) for c in curves])
     y = np.concatenate([np.asarray(c[1], float) for c in curves])
@@ -209,6 +244,7 @@ def check_condition(
     max_excursion: float = 1.0,
     adhesion_tolerance: float = 0.02,
     contact: Callable | None = None,
+    fitted_stderr: Mapping[str, np.ndarray] | None = None,
 ) -> ConditionCheck:
     """Check one calibrated condition on a grid between the data points.
 
@@ -235,12 +271,20 @@ def check_condition(
         condition's own curves (outside it the set extrapolates; no curve to compare with).
     contact : callable, optional
         ``contact(Q) -> (a, b)`` [m]; default the Hertz scaling a, b ∝ Q^(1/3) of the curves.
+    fitted_stderr : mapping of str to array, optional
+        The standard errors of the per-curve fitted values (``inf`` where a fit does not
+        estimate one, NaN where the parameter was not fitted): a parameter whose standard
+        error is infinite or above
+        :data:`~railadhesion.plausibility.MAX_RELATIVE_STDERR` times its value in at least
+        half of the curves (e.g. B when A is near 1: the friction hardly falls) and whose
+        regression has a Q or v term gets a note (:attr:`ConditionCheck.notes`).
 
     Returns
     -------
     ConditionCheck
     """
-    from railadhesion.models.polach import polach_forces
+    # quiet: the curves' inputs were checked once, by their fits (no warning per evaluation)
+    from railadhesion.models.polach import polach_forces_quiet as polach_forces
 
     gq, gv = np.meshgrid(
         np.linspace(q_range[0], q_range[1], n_grid) / q_ref,
@@ -274,6 +318,26 @@ def check_condition(
             problems.append(
                 f"{condition}.{n} varies wildly between the data: {raw[n].min():.4g} to "
                 f"{raw[n].max():.4g} on the grid, per-curve fits {lo_f:.4g} to {hi_f:.4g}"
+            )
+    # parameters the curves hardly determine, regressed on Q and v all the same
+    undetermined, notes = {}, []
+    for n in _NAMES if fitted_stderr is not None else ():
+        vals = np.asarray(fitted_values[n], float)
+        err = np.asarray(fitted_stderr[n], float)
+        with np.errstate(invalid="ignore"):  # NaN: not fitted, not judged
+            loose = np.isinf(err) | (err > MAX_RELATIVE_STDERR * np.abs(vals))
+        count = int(np.count_nonzero(loose))
+        undetermined[n] = count
+        if vals.size >= 2 and 2 * count >= vals.size and tuple(regressions[n].terms) != ("1",):
+            lo_f, hi_f = fitted_range[n]
+            notes.append(
+                f"{condition}.{n} is hardly determined by the data (standard error above "
+                f"{MAX_RELATIVE_STDERR:g} x the value in {count} of {vals.size} curves; per-curve "
+                f"fits {lo_f:.4g} to {hi_f:.4g}), yet regressed on Q and v: "
+                f"{_expression(regressions[n])} gives {raw[n].min():.4g} to "
+                f"{raw[n].max():.4g} over the calibrated range, a dependence the data do not "
+                "support; the adhesion is checked against the curves, the parameter's values "
+                "are not physical information"
             )
     # adhesion against the envelope of the measured (per-curve fitted) curves
     mags = np.concatenate([np.abs(np.asarray(c[0], float)) for c in curves])
@@ -331,4 +395,6 @@ def check_condition(
         adhesion_excursion=adh_exc,
         adhesion_worst=worst,
         problems=tuple(problems),
+        undetermined=undetermined,
+        notes=tuple(notes),
     )

@@ -20,7 +20,10 @@ Steps (Trummer et al., seed 000, sections 5.2 and 5.4):
    (:func:`railadhesion.calibration.checks.check_condition`): parameters leaving their
    physical bounds or the range of the per-curve fits, adhesion outside the envelope of the
    measured curves. Findings raise a :class:`CalibrationWarning` and are kept in
-   :attr:`WilacCalibration.warnings`.
+   :attr:`WilacCalibration.warnings`. Parameters the curves hardly determine but regressed
+   on Q and v all the same raise an
+   :class:`~railadhesion.calibration.checks.UndeterminedParameterWarning` and are kept in
+   :attr:`WilacCalibration.notes` (the set stays trusted: its adhesion is checked).
 7. Assemble :class:`~railadhesion.models.wilac.WilacParameters` with provenance and, if asked,
    write the TOML file (:func:`railadhesion.io.paramfiles.save_wilac_parameters`).
 """
@@ -40,6 +43,7 @@ from railadhesion._validate import check_choice, check_nonnegative
 from railadhesion.calibration.checks import (
     CalibrationWarning,
     ConditionCheck,
+    UndeterminedParameterWarning,
     check_condition,
     refine_condition,
 )
@@ -47,10 +51,11 @@ from railadhesion.calibration.fitting import POLACH_NAMES, FitResult, fit_polach
 from railadhesion.calibration.regression import RegressionFit, build_regression
 from railadhesion.io.creepcurves import CreepCurve, read_creep_curves
 from railadhesion.models.regression import ParameterRegression
-from railadhesion.plausibility import MIN_R_SQUARED, explains_data, noise_rms
+from railadhesion.plausibility import MIN_R_SQUARED, explains_data, noise_rms, warn
 
 __all__ = [
     "CalibrationWarning",
+    "UndeterminedParameterWarning",
     "PAPER_WATER_FLOWS",
     "CurveFit",
     "WilacCalibration",
@@ -186,6 +191,13 @@ class WilacCalibration:
         and curves with implausible data or conditions (their fits'
         :attr:`~railadhesion.calibration.fitting.FitResult.implausible_inputs`); empty when the
         set can be trusted over its calibrated range.
+    notes : tuple of str
+        Parameters that the curves of a condition hardly determine (standard error above the
+        value in at least half of them: e.g. B when A is near 1) but whose regression depends
+        on Q or v all the same (:attr:`~railadhesion.calibration.checks.ConditionCheck.notes`):
+        that dependence is not supported by the data. Not a reason to distrust the set (its
+        adhesion is checked against the curves); the parameter file's ``provenance.notes``
+        records them.
     """
 
     parameters: object
@@ -193,6 +205,7 @@ class WilacCalibration:
     regressions: dict
     checks: dict = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
 
     @property
     def trusted(self) -> bool:
@@ -227,6 +240,7 @@ class WilacCalibration:
             "fit_rmse": "1", "calibrated_rmse": "1", "calibrated_max_error": "1",
         }  # fmt: skip
         df.attrs["warnings"] = list(self.warnings)
+        df.attrs["notes"] = list(self.notes)
         return df
 
     def summary(self) -> str:
@@ -271,7 +285,11 @@ class WilacCalibration:
                 "trust the calibrated set where they occur:"
             )
             lines.extend(f"    ! {w}" for w in self.warnings)
-        else:
+        if self.notes:
+            lines.append(f"  NOTE: {len(self.notes)} parameter(s) hardly determined by the "
+                         "curves, yet regressed on Q and v:")  # fmt: skip
+            lines.extend(f"    ~ {n}" for n in self.notes)
+        if not self.warnings:
             lines.append(
                 "  check between the data points: parameters within physical bounds and the "
                 "range of the per-curve fits; adhesion within the envelope of the curves"
@@ -452,7 +470,8 @@ def run_wilac_calibration(
     --------
     See :func:`calibrate_wilac`.
     """
-    from railadhesion.models.polach import polach_forces
+    # quiet: the curves' inputs were checked once, by their fits (no warning per evaluation)
+    from railadhesion.models.polach import polach_forces_quiet as polach_forces
     from railadhesion.models.wilac import (
         PAPER_TRANSITIONS,
         PHYSICAL_BOUNDS,
@@ -661,6 +680,8 @@ def run_wilac_calibration(
             q_ref=q_ref, v_ref=v_ref, q_range=q_range, v_range=v_range, bounds=PHYSICAL_BOUNDS,
             shear_modulus=shear_modulus, poisson=poisson, n_grid=check_grid,
             max_excursion=max_excursion, adhesion_tolerance=adhesion_tolerance, contact=contact,
+            fitted_stderr={p: np.array([cf.fit.stderr.get(p, np.nan) for cf in fits])
+                           for p in POLACH_NAMES},
         )  # fmt: skip
         report("check", k_cond + 1, len(WILAC_CONDITIONS))
     problems = tuple(msg for chk in checks.values() for msg in chk.problems)
@@ -689,12 +710,19 @@ def run_wilac_calibration(
             ),
             stacklevel=2,
         )
-    if problems:  # the file written from the set carries them (its provenance)
+    notes = tuple(msg for chk in checks.values() for msg in chk.notes)
+    for msg in notes:
+        warn(msg, UndeterminedParameterWarning)
+    if problems or notes:  # the file written from the set carries them (its provenance)
         prov = dict(params.provenance)
-        prov["notes"] = (prov.get("notes", "") + " NOT TRUSTED (railadhesion's checks): "
-                         + "; ".join(problems)).strip()  # fmt: skip
+        text = prov.get("notes", "")
+        if problems:
+            text += " NOT TRUSTED (railadhesion's checks): " + "; ".join(problems)
+        if notes:
+            text += " HARDLY DETERMINED (railadhesion's checks): " + "; ".join(notes)
+        prov["notes"] = text.strip()
         params = params.replace(provenance=prov)
-    return WilacCalibration(params, tuple(checked), regressions, checks, problems)
+    return WilacCalibration(params, tuple(checked), regressions, checks, problems, notes)
 
 
 def calibrate_wilac(source, **kwargs):
