@@ -307,3 +307,16 @@ def test_a_curve_with_an_implausible_speed_makes_the_calibration_untrusted():
     assert not result.trusted
     assert any(w.startswith(f"curve {bad.name} (dry): speed = 300 m/s") for w in result.warnings)
 
+
+def test_a_calibrated_set_without_a_name_is_named_after_its_curves(tmp_path):
+    """The saved file had name = "", and 'params check' printed WilacParameters ''."""
+    folder = tmp_path / "rig_curves"
+    folder.mkdir()
+    curves = _curves()
+    for i, c in enumerate(curves):
+        write_creep_curve(c, folder / f"c{i:02d}.csv")
+    out = tmp_path / "site.toml"
+    assert calibrate_wilac_to_toml(folder, out).parameters.name == "rig_curves"
+    assert load_wilac_parameters(out).name == "rig_curves"
+    assert run_wilac_calibration(curves, refine=False).parameters.name == "calibrated"
+    assert run_wilac_calibration(curves, refine=False, name="site").parameters.name == "site"

@@ -300,6 +300,17 @@ class WilacCalibration:
         return self.summary()
 
 
+def _default_name(source) -> str:
+    """The name of a calibrated set given none: the folder's (or file's) name of the curves,
+    or ``"calibrated"``."""
+    if isinstance(source, str | Path):
+        path = Path(source).resolve()
+        stem = path.stem if path.is_file() else path.name
+        if stem:
+            return stem
+    return "calibrated"
+
+
 def _curves(source) -> list[CreepCurve]:
     if isinstance(source, str | Path):
         return read_creep_curves(source)
@@ -418,8 +429,12 @@ def run_wilac_calibration(
         ``"check"``) as the work advances; the CLI shows a progress bar with it.
     transitions : optional
         WILAC water-flow transitions; default the paper's Table 1.
-    name, description : str
-        Name of the set and a description for its provenance.
+    name : str
+        Name of the set; default (``""``) the name of the folder (or file) the curves were
+        read from, or ``"calibrated"`` for curves given as a list (a saved file then names
+        its set, e.g. in ``railadhesion params check``).
+    description : str
+        A description for the set's provenance.
     shear_modulus, poisson : float
         Elastic constants used by the Polach fits [Pa], [-].
 
@@ -647,7 +662,7 @@ def run_wilac_calibration(
         normal_force_range=q_range,
         speed_range=v_range,
         transitions=PAPER_TRANSITIONS if transitions is None else transitions,
-        name=name,
+        name=name or _default_name(source),
         provenance=provenance,
     )
     # ---- how well the calibrated set reproduces each curve
