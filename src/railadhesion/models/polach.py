@@ -44,6 +44,7 @@ from railadhesion.contact.kalker import (
     kalker_scalar,
 )
 from railadhesion.models.parameters import (
+    MU0_PLAUSIBLE_MAX,
     PARAMETER_RANGES,
     PolachParameters,
     mu0_message,
@@ -703,7 +704,7 @@ def polach_forces(
         check_polach_inputs(*scalars)  # raises the error naming the argument
         raise AssertionError("polach kernel flagged an input the checks accept")
     _PLAUSIBLE(scalars)  # implausible inputs warn (docs/checks.md)
-    if mu0 > 1.0:
+    if mu0 > MU0_PLAUSIBLE_MAX:
         _check_mu0(mu0)
     return np.float64(fx), np.float64(fy)
 
@@ -730,6 +731,7 @@ _ARG_NAMES = (
 )  # fmt: skip
 #: Plausibility check of the inputs (:func:`railadhesion.plausibility.input_checker`).
 _PLAUSIBLE = input_checker(_ARG_NAMES)
+
 
 def _check_mu0(mu0) -> str | None:
     """Warn (:class:`~railadhesion.plausibility.PlausibilityWarning`) for :func:`mu0_message`;
