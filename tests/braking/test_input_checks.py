@@ -145,19 +145,24 @@ def test_brake_cylinders_sniff_bar_in_max_pressure_recorded_on_the_result_once()
     assert any(w.startswith("BrakeCylinders.max_pressure = 6 Pa") for w in res.warnings)
 
 
-def test_the_stepping_api_sniffs_the_pressure_command_of_step_once_and_not_in_advance():
+def test_the_stepping_api_judges_a_too_high_command_of_step_once_and_not_in_advance():
     sim = BrakingSimulator(VEHICLE, PolachAdhesion(), 30.0, max_step=4e-3)
-    with pytest.warns(UnitWarning, match=r"pressure_command = 5.5 Pa is outside the plausible "
-                      r"range .*given in bar\? \(5.5 bar = 5.5e\+05 Pa"):
-        sim.step(0.01, {"pressure_command": 5.5})
-    assert len(sim.warnings) == 1 and sim.warnings[0].startswith("pressure_command = 5.5 Pa")
+    with warnings.catch_warnings():  # a ramp passes through every small pressure: not judged
+        warnings.simplefilter("error")
+        for p in (0.0, 5.5, 2750.0, 3e5):
+            sim.step(0.01, {"pressure_command": p})
+    assert sim.warnings == []
+    with pytest.warns(PlausibilityWarning, match=r"pressure_command = 5.5e\+07 Pa is outside "
+                      r"the plausible range \[5000, 2e\+06\] Pa"):
+        sim.step(0.01, {"pressure_command": 5.5e7})
+    assert len(sim.warnings) == 1 and sim.warnings[0].startswith("pressure_command = 5.5e+07 Pa")
     with warnings.catch_warnings():  # the same command again: said once
         warnings.simplefilter("error")
-        sim.step(0.01, {"pressure_command": [5.5, 5.5, 5.5, 5.5]})
-        sim.inputs.pressure_command[:] = 5.5  # the fast path checks no plausibility
+        sim.step(0.01, {"pressure_command": [5.5e7] * 4})
+        sim.inputs.pressure_command[:] = 5.5e8  # the fast path checks no plausibility
         sim.advance(0.01)
     assert len(sim.warnings) == 1
-    np.testing.assert_array_equal(sim.inputs.pressure_command, 5.5)
+    np.testing.assert_array_equal(sim.inputs.pressure_command, 5.5e8)
 
 
 # -- the routes agree -------------------------------------------------------------------------

@@ -92,7 +92,7 @@ from railadhesion.braking.records import (
     machine_dtype,
 )
 from railadhesion.braking.vehicle import GRAVITY, Vehicle
-from railadhesion.plausibility import check_calibrated, check_plausible
+from railadhesion.plausibility import PLAUSIBLE, check_calibrated, check_plausible
 
 __all__ = ["BrakingSimulator", "BrakingState", "LiveState", "StepInputs", "SimulationError",
            "largest_stable_step"]
@@ -485,8 +485,9 @@ class BrakingSimulator:
         :class:`~railadhesion.plausibility.UnitWarning` when it looks like km/h) or
         cylinders' ``max_pressure`` (bar for Pa?), an initial speed or static wheel load
         outside the adhesion model's calibrated ranges (an
-        :class:`~railadhesion.plausibility.AlteredResultWarning`); later, an implausible
-        ``pressure_command`` given to :meth:`step` (:meth:`advance` checks nothing of the
+        :class:`~railadhesion.plausibility.AlteredResultWarning`); later, a
+        ``pressure_command`` given to :meth:`step` above the plausible range (not below it: a
+        command ramps through every small pressure; :meth:`advance` checks nothing of the
         kind: it stays as fast as it is).
     """
 
@@ -956,13 +957,15 @@ class BrakingSimulator:
         return self._live.snapshot()
 
     def _check_command(self, command):
-        """Warn (once per message) for an implausible commanded pressure given to
-        :meth:`step` (bar for Pa?; 0, brakes released, is plausible), recorded in
-        :attr:`warnings`."""
-        applied = command[command > 0.0]
-        if applied.size == 0:
+        """Warn (once per message) for a commanded pressure given to :meth:`step` above the
+        plausible range, recorded in :attr:`warnings`. Only the high side is judged: a command
+        ramps up through every small pressure (and 0 releases the brakes), so a small one at
+        a step is no sign of bar; the cylinders' ``max_pressure`` is sniffed for bar instead."""
+        rng = PLAUSIBLE["brake_pressure"]
+        highest = float(command.max())
+        if not highest > rng.high + rng.slack:
             return
-        args = (applied, "pressure_command")
+        args = (highest, "pressure_command")
         text = check_plausible(*args, quantity="brake_pressure", emit=False)
         if text is not None and text not in self.warnings:  # new: warn (UnitWarning if bar?)
             self.warnings.append(check_plausible(*args, quantity="brake_pressure"))
