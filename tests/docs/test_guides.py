@@ -8,6 +8,10 @@ ignored). A block of another language whose info string names a file after the l
 (```` ```c host.c ````) is written to that file before the python blocks that follow it run
 (a guide's C source, a TOML file). A page that needs a C compiler says so with the comment
 ``<!-- guide-requires: c-compiler -->`` and is skipped, with the reason, where there is none.
+A page whose code raises one of the package's warnings on purpose (an input outside a model's
+calibrated range, a parameter the data hardly determine) declares it, category and the start of
+the message, in a comment ``<!-- guide-warns: AlteredResultWarning: initial_speed = 44.44 m/s
+-->``: the page must then raise it, and any other warning of the package is still an error.
 After a change that alters the output on purpose, rewrite the text blocks with
 ``RAILADHESION_UPDATE_GUIDES=1 python3 -m pytest tests/docs/test_guides.py`` and review the
 diff. See docs/contributing-docs.md.
@@ -17,6 +21,7 @@ import contextlib
 import io
 import os
 import re
+import warnings
 from pathlib import Path
 
 import pytest
@@ -25,6 +30,7 @@ GUIDES = Path(__file__).resolve().parents[2] / "docs" / "guides"
 FENCE = re.compile(r"^```(\w*)([^\n]*)\n(.*?)^```[ \t]*$", re.M | re.S)
 FILE_NAME = re.compile(r"^[\w.-]+\.\w+$")
 REQUIRES_C = "<!-- guide-requires: c-compiler -->"
+WARNS = re.compile(r"<!-- guide-warns: (\w+): (.*?)\s*-->", re.S)
 UPDATE = os.environ.get("RAILADHESION_UPDATE_GUIDES") == "1"
 
 
@@ -73,6 +79,34 @@ def test_guide_runs_and_prints_what_it_shows(page, tmp_path, monkeypatch):
     assert found, f"{page.name} has no python block"
     namespace = {"__name__": f"guide_{page.stem}"}
     replacements = []
+    declared = [(getattr(_warning_classes(), category), " ".join(start.split()))
+                for category, start in WARNS.findall(text)]
+    with warnings.catch_warnings(record=True) as caught:
+        for category, start in declared:  # recorded, not errors (the pyproject's filter)
+            warnings.filterwarnings("always", message=re.escape(start), category=category)
+        _run_blocks(page, found, namespace, replacements, tmp_path)
+    for category, start in declared:
+        assert any(issubclass(w.category, category) and str(w.message).startswith(start)
+                   for w in caught), f"{page.name} declares a warning it does not raise: {start}"
+    if UPDATE and replacements:
+        for (start, end), output in sorted(replacements, reverse=True):
+            text = text[:start] + output.rstrip("\n") + "\n" + text[end:]
+        page.write_text(text, encoding="utf-8")
+
+
+def _warning_classes():
+    """A namespace of the package's warning classes, by name."""
+    import types
+
+    from railadhesion import plausibility
+    from railadhesion.calibration import checks
+
+    return types.SimpleNamespace(**{**vars(plausibility), **{
+        k: v for k, v in vars(checks).items() if k.endswith("Warning")}})
+
+
+def _run_blocks(page, found, namespace, replacements, tmp_path):
+    """Run a page's python blocks in order, comparing (or, updating, collecting) outputs."""
     for n, (code, expected, span, files) in enumerate(found, start=1):
         for name, content in files:
             (tmp_path / name).write_text(content, encoding="utf-8")
@@ -87,10 +121,6 @@ def test_guide_runs_and_prints_what_it_shows(page, tmp_path, monkeypatch):
             continue
         assert _clean(stdout.getvalue()) == _clean(expected), (
             f"{page.name}, python block {n}: the output differs from the page's text block")
-    if UPDATE and replacements:
-        for (start, end), output in sorted(replacements, reverse=True):
-            text = text[:start] + output.rstrip("\n") + "\n" + text[end:]
-        page.write_text(text, encoding="utf-8")
 
 
 def test_the_parser_pairs_code_and_output():
