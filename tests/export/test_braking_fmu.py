@@ -18,6 +18,12 @@ from railadhesion.braking import BrakingSimulator  # noqa: E402
 from railadhesion.braking.scenario import load_scenario  # noqa: E402
 from railadhesion.export import build_braking_fmu  # noqa: E402
 
+# the example stops run from 160 km/h, above the WILAC set's calibrated 40 m/s: the simulator
+# warns of it (docs/checks.md), which is not what these tests check
+pytestmark = pytest.mark.filterwarnings(
+    "ignore:initial_speed = .* is outside the calibrated range"
+    ":railadhesion.plausibility.AlteredResultWarning")
+
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 OUTPUTS = ["train_speed", "distance", "deceleration", "stopped"] + [
     f"{q}_{k}" for q in ("wheel_speed", "brake_pressure", "creep_force", "adhesion_used",

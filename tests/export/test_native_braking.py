@@ -22,10 +22,17 @@ from railadhesion.export import build_native_braking_fmu, native  # noqa: E402
 
 from .test_native import Unzipped, host  # noqa: E402, F401
 
-pytestmark = pytest.mark.skipif(
-    not sys.platform.startswith("linux") or native.find_c_compiler() is None,
-    reason="native FMUs are built for linux64 with a C compiler",
-)
+pytestmark = [
+    pytest.mark.skipif(
+        not sys.platform.startswith("linux") or native.find_c_compiler() is None,
+        reason="native FMUs are built for linux64 with a C compiler",
+    ),
+    # the example stops run from 160 km/h, above the WILAC set's calibrated 40 m/s: the
+    # simulator warns of it (docs/checks.md), which is not what these tests check
+    pytest.mark.filterwarnings(
+    "ignore:initial_speed = .* is outside the calibrated range"
+    ":railadhesion.plausibility.AlteredResultWarning"),
+]
 
 SCENARIO = Path(__file__).parents[2] / "examples" / "brake_damp.toml"
 N = 4

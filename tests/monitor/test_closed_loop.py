@@ -22,6 +22,12 @@ from railadhesion.monitor.evaluation import (
     run_traction_case,
 )
 
+# cases at 42-45 m/s on WILAC leave its set's calibrated 40 m/s: the simulator warns of it
+# (docs/checks.md), which is not what these tests check
+pytestmark = pytest.mark.filterwarnings(
+    "ignore:initial_speed = .* is outside the calibrated range"
+    ":railadhesion.plausibility.AlteredResultWarning")
+
 
 @pytest.fixture(scope="module")
 def low_case():
