@@ -58,17 +58,21 @@ def test_each_warning_is_printed_once():
     assert again.stderr.count("normal_force = 4.2 N is outside the plausible range") == 1
 
 
-def test_fit_polach_warns_once_of_an_implausible_speed_in_the_file(tmp_path):
+def _polach_curve_csv(path, q, a, b, speed_in_file):
+    """A creep-curve file of Polach's dry set at 10 m/s, whose header gives ``speed_in_file``."""
     from railadhesion.models.parameters import polach_parameters
     from railadhesion.models.polach import Polach
 
     creep = -np.geomspace(0.002, 0.4, 20)
-    q, a, b = 4500.0, 0.004, 0.003
     fx, _ = Polach(polach_parameters("polach2005_dry")).forces(creep, 0.0, 0.0, q, 10.0, a, b)
-    path = tmp_path / "kmh.csv"
-    path.write_text(f"# normal_force_N = {q}\n# speed_m_s = 300\n# a_m = {a}\n# b_m = {b}\n"
-                    "creep,adhesion\n"
+    path.write_text(f"# normal_force_N = {q}\n# speed_m_s = {speed_in_file}\n# a_m = {a}\n"
+                    f"# b_m = {b}\ncreep,adhesion\n"
                     + "".join(f"{c},{abs(f) / q}\n" for c, f in zip(creep, fx, strict=True)))
+    return path
+
+
+def test_fit_polach_warns_once_of_an_implausible_speed_in_the_file(tmp_path):
+    path = _polach_curve_csv(tmp_path / "kmh.csv", 4500.0, 0.004, 0.003, 300)
     result = _run("fit", "polach", str(path), "--format", "csv", "--allow-untrusted")
     assert result.exit_code == 0, result.output
     # once as a warning (the "not trusted" line then quotes it as the first reason)
@@ -165,16 +169,7 @@ def test_polach_set_errors_say_how_to_give_ones_own_parameters(tmp_path):
 
 
 def test_files_written_are_said_on_stderr_so_stdout_stays_csv(tmp_path):
-    from railadhesion.models.parameters import polach_parameters
-    from railadhesion.models.polach import Polach
-
-    creep = -np.geomspace(0.002, 0.4, 20)
-    q, a, b = 50e3, 0.006, 0.005
-    fx, _ = Polach(polach_parameters("polach2005_dry")).forces(creep, 0.0, 0.0, q, 10.0, a, b)
-    curve = tmp_path / "curve.csv"
-    curve.write_text(f"# normal_force_N = {q}\n# speed_m_s = 10\n# a_m = {a}\n# b_m = {b}\n"
-                     "creep,adhesion\n"
-                     + "".join(f"{c},{abs(f) / q}\n" for c, f in zip(creep, fx, strict=True)))
+    curve = _polach_curve_csv(tmp_path / "curve.csv", 50e3, 0.006, 0.005, 10)
     params, figure = tmp_path / "fitted.toml", tmp_path / "fit.png"
     result = _run("fit", "polach", str(curve), "--format", "csv", "--out", str(params),
                   "--figure", str(figure), "--allow-untrusted")
