@@ -13,6 +13,7 @@ from railadhesion.braking import (
     BrakingSimulator,
     PolachAdhesion,
     Vehicle,
+    WaterFlowProfile,
     WilacAdhesion,
     simulate,
 )
@@ -184,3 +185,14 @@ def test_an_implausible_initial_speed_warns_on_every_route_the_file_refuses_beyo
     with pytest.warns(UnitWarning, match="initial_speed = 160 m/s"):
         BrakingSimulator(VEHICLE, PolachAdhesion(), 160.0, max_step=4e-3)
 
+
+
+def test_a_water_flow_profile_above_the_plausible_range_warns_once_and_is_recorded():
+    # 25000 ul/s (seed 000 measured up to 350; the plausible range ends at 1000)
+    with pytest.warns(PlausibilityWarning, match=r"WaterFlowProfile values = from 0 to "
+                      r"2.5e\+04 .l/s is outside the plausible range \[0, 1000\]"):
+        profile = WaterFlowProfile.sections([(50.0, 900.0, 25000.0)])
+    res, caught = caught_warnings(lambda: simulate(VEHICLE, WilacAdhesion(profile), 30.0, 5.5e5,
+                                                   dt=4e-3, max_time=0.5))
+    assert not any("WaterFlowProfile" in str(w.message) for w in caught)  # said when made
+    assert any(w.startswith("WaterFlowProfile values = from 0 to 2.5e+04") for w in res.warnings)

@@ -53,6 +53,7 @@ from railadhesion.models.wilac import (
     WilacParameters,
     default_wilac_parameters,
 )
+from railadhesion.plausibility import check_plausible
 
 __all__ = [
     "AxleAdhesion",
@@ -185,6 +186,14 @@ class WaterFlowProfile:
         if not np.all(np.isfinite(values) & (values >= 0)):
             raise ValueError("water flow values must be in [0, inf) µl/s")
         self.x, self.values, self.over, self.kind = x, values, over, kind
+        self.water_flow_note()
+
+    def water_flow_note(self, *, emit: bool = True) -> str | None:
+        """The warning for water flows above the plausible range (docs/checks.md), or None;
+        issued unless ``emit`` is False (a simulator records it on its result without warning
+        a second time)."""
+        return check_plausible(self.values, "water_flow", where="WaterFlowProfile values",
+                               emit=emit)
 
     @classmethod
     def constant(cls, water_flow: float) -> WaterFlowProfile:

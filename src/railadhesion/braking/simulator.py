@@ -92,7 +92,12 @@ from railadhesion.braking.records import (
     machine_dtype,
 )
 from railadhesion.braking.vehicle import GRAVITY, Vehicle
-from railadhesion.plausibility import PLAUSIBLE, check_calibrated, check_plausible
+from railadhesion.plausibility import (
+    PLAUSIBLE,
+    PlausibilityWarning,
+    check_calibrated,
+    check_plausible,
+)
 
 __all__ = ["BrakingSimulator", "BrakingState", "LiveState", "StepInputs", "SimulationError",
            "largest_stable_step"]
@@ -388,9 +393,11 @@ def largest_stable_step(vehicle: Vehicle, adhesion: AxleAdhesion, initial_speed:
     if type(adhesion) is PolachAdhesion:
         probes = [(p.name, PolachAdhesion(p, contact=adhesion.contact)) for p in adhesion.sets]
     elif type(adhesion) is WilacAdhesion and isinstance(adhesion.water_flow, WaterFlowProfile):
-        probes = [(f"WILAC at {w:g} µl/s", WilacAdhesion(w, adhesion.parameters,
-                                                         contact=adhesion.contact))
-                  for w in sorted({0.0, *map(float, adhesion.water_flow.values)})]
+        with warnings.catch_warnings():  # the profile warned of its water flows when made
+            warnings.simplefilter("ignore", PlausibilityWarning)
+            probes = [(f"WILAC at {w:g} µl/s", WilacAdhesion(w, adhesion.parameters,
+                                                             contact=adhesion.contact))
+                      for w in sorted({0.0, *map(float, adhesion.water_flow.values)})]
     elif type(adhesion) is ExactTableAdhesion:
         probes = [("table model", ExactTableAdhesion(adhesion.mu, adhesion.friction_ratio,
                                                      adhesion.friction_decay, adhesion.contact))]
@@ -537,7 +544,8 @@ class BrakingSimulator:
 
         Checked: the initial speed against the plausible speeds (km/h for m/s?); the
         cylinders' ``max_pressure`` against the plausible brake pressures (bar for Pa?;
-        warned when the cylinders were made, recorded here); the initial speed and the
+        warned when the cylinders were made, recorded here); a ``WaterFlowProfile``'s water
+        flows above the plausible range (warned when it was made); the initial speed and the
         static wheel loads against the model's ``calibrated_ranges()``
         (:meth:`railadhesion.braking.adhesion.AxleAdhesion.calibrated_ranges`), an
         :class:`~railadhesion.plausibility.AlteredResultWarning` since the model holds its
@@ -546,6 +554,9 @@ class BrakingSimulator:
         """
         found = [check_plausible(self.initial_speed, "initial_speed"),
                  self.cylinders.max_pressure_note(emit=False)]
+        profile = getattr(self.adhesion, "water_flow", None)
+        if hasattr(profile, "water_flow_note"):  # a WaterFlowProfile: warned when it was made
+            found.append(profile.water_flow_note(emit=False))
         for quantity, low, high, unit, what in self.adhesion.calibrated_ranges():
             if quantity == "speed":
                 value, name = self.initial_speed, "initial_speed"
