@@ -50,13 +50,6 @@ class UndeterminedParameterWarning(RailadhesionWarning):
     calibrated adhesion may still reproduce the curves; the set stays trusted)."""
 
 
-def _expression(regression: ParameterRegression) -> str:
-    """A regression as text: ``-1.666 + 3.332*Q*1/v*1/v``."""
-    parts = [f"{c:.4g}" if t == "1" else f"{c:.4g}*{t}"
-             for t, c in zip(regression.terms, regression.coefficients, strict=True)]  # fmt: skip
-    return " + ".join(parts).replace("+ -", "- ")
-
-
 @dataclass(frozen=True, eq=False)
 class ConditionCheck:
     """Result of :func:`check_condition` for one WILAC condition.
@@ -334,7 +327,7 @@ def check_condition(
                 f"{condition}.{n} is hardly determined by the data (standard error above "
                 f"{MAX_RELATIVE_STDERR:g} x the value in {count} of {vals.size} curves; per-curve "
                 f"fits {lo_f:.4g} to {hi_f:.4g}), yet regressed on Q and v: "
-                f"{_expression(regressions[n])} gives {raw[n].min():.4g} to "
+                f"{regressions[n].formula()} gives {raw[n].min():.4g} to "
                 f"{raw[n].max():.4g} over the calibrated range, a dependence the data do not "
                 "support; the adhesion is checked against the curves, the parameter's values "
                 "are not physical information"

@@ -264,11 +264,7 @@ class WilacCalibration:
                     if reg is None
                     else f"selection R^2 = {reg.r_squared:.4f}"
                 )
-                terms = " + ".join(
-                    f"{c:.6g}" if t == "1" else f"{c:.4g}*{t}"
-                    for t, c in zip(p.terms, p.coefficients, strict=True)
-                )
-                lines.append(f"    {name:>4}: {kind}: {terms}")
+                lines.append(f"    {name:>4}: {kind}: {p.formula(intercept_digits=6)}")
         lines.append("  per curve (own Polach fit RMSE | calibrated set RMSE, max error):")
         for row in self.curve_table():
             flag = f"  [fit at bound: {row['at_bound']}]" if row["at_bound"] else ""

@@ -164,6 +164,17 @@ class ParameterRegression:
         """A regression that returns ``value`` everywhere."""
         return cls(terms=("1",), coefficients=(value,))
 
+    def formula(self, intercept_digits: int = 4) -> str:
+        """The regression as text, coefficients to 4 significant digits (the intercept to
+        ``intercept_digits``).
+
+        >>> ParameterRegression(("1", "Q*1/v*1/v"), (-1.6655, 3.3321)).formula()
+        '-1.665 + 3.332*Q*1/v*1/v'
+        """
+        parts = [f"{c:.{intercept_digits}g}" if t == "1" else f"{c:.4g}*{t}"
+                 for t, c in zip(self.terms, self.coefficients, strict=True)]  # fmt: skip
+        return " + ".join(parts).replace("+ -", "- ")
+
     def __call__(self, q_norm, v_norm):
         """Evaluate at normalised normal force and speed; scalars give a float."""
         q = np.asarray(q_norm, dtype=float)
