@@ -703,7 +703,7 @@ def fit_polach_cmd(
             _fail(f"cannot write the parameter file {out}: {exc}")
         err_console.print(f"parameters written to {escape(str(out))}"
                           + (" (its notes say it is not trusted)" if result.warnings else ""))
-    finish(console, result.warnings, allow=allow_untrusted, what="Polach fit")
+    finish(result.warnings, allow=allow_untrusted, what="Polach fit")
 
 
 @fit_app.command("wilac")
@@ -780,7 +780,7 @@ def fit_wilac_cmd(
         _emit("WILAC calibration per curve", [(k, k, ".4g") for k in keys],
               [[r[k] for k in keys] for r in rows], fmt, table)  # fmt: skip
     err_console.print(f"WILAC parameters written to {escape(str(out))}")
-    finish(console, calibration.warnings, allow=allow_untrusted, what="WILAC calibration")
+    finish(calibration.warnings, allow=allow_untrusted, what="WILAC calibration")
 
 
 # Commands of the other concerns, each in its own module.

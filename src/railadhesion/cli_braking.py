@@ -143,4 +143,4 @@ def register(app: typer.Typer) -> None:
         table.add_row("trusted", "yes" if not findings else f"NO ({len(findings)} finding(s))")
         console.print(table)
         console.print(f"outputs written to {escape(str(out))}")
-        finish(console, findings, allow=allow_untrusted, what="braking result")
+        finish(findings, allow=allow_untrusted, what="braking result")

@@ -149,12 +149,12 @@ def braking_findings(result, label: str = "") -> list[str]:
     return found
 
 
-def finish(console: Console | None, findings, *, allow: bool, what: str = "result") -> None:
+def finish(findings, *, allow: bool, what: str = "result") -> None:
     """Report findings (reasons a result is not trustworthy) and exit accordingly.
 
     Prints ``<what> not trusted: <first reason>`` (and how many more) on standard error
-    (:data:`err_console`; ``console`` is not used, kept for the callers) and exits with
-    :data:`EXIT_UNTRUSTED`, or only the message when ``allow`` (``--allow-untrusted``).
+    (:data:`err_console`) and exits with :data:`EXIT_UNTRUSTED`, or only the message when
+    ``allow`` (``--allow-untrusted``).
     """
     console = err_console
     findings = [str(f) for f in findings if f]

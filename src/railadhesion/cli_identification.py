@@ -75,7 +75,7 @@ def detect(
                       + "; ".join(str(e) for e in curve.excluded[:5]) + ")", markup=False)
     colour = {"low": "red", "caution": "yellow", "normal": "green", "unknown": "magenta"}
     console.print(f"[{colour[res.level]}]{res.level.upper()}[/{colour[res.level]}]")
-    finish(console, res.warnings, allow=allow_untrusted, what="detection")
+    finish(res.warnings, allow=allow_untrusted, what="detection")
 
 
 def identify(
@@ -145,7 +145,7 @@ def identify(
         f"slip {law.overall.slip_range[0]:.2f}-{law.overall.slip_range[1]:.2f} m/s",
         markup=False, highlight=False)
     console.print(f"outputs written to {escape(str(out))}")
-    finish(console, run.warnings, allow=allow_untrusted, what="identification")
+    finish(run.warnings, allow=allow_untrusted, what="identification")
 
 
 def register(app: typer.Typer) -> None:

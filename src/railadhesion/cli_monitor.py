@@ -69,7 +69,7 @@ def monitor(
         warn("no wheel radius was learned (the log has no coasting): every level stays "
              "unknown; --no-learn-radius takes the vehicle file's radius as exact")
     console.print(f"outputs written to {escape(str(out))}", soft_wrap=True)
-    finish(console, rep.warnings, allow=allow_untrusted, what="monitor replay")
+    finish(rep.warnings, allow=allow_untrusted, what="monitor replay")
 
 
 def monitor_fmu(

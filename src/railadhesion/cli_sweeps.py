@@ -135,7 +135,7 @@ def sweep(
         + f"; {escape(failed)}", highlight=False, soft_wrap=True,
     )  # fmt: skip
     console.print(f"map written to {escape(str(out))}")
-    finish(console, findings, allow=allow_untrusted, what="sweep")
+    finish(findings, allow=allow_untrusted, what="sweep")
 
 
 def study(
@@ -191,7 +191,7 @@ def study(
     console.print(f"{result.chunks_computed} chunks computed, {result.chunks_skipped} already "
                   f"written; {escape(failed)}", highlight=False, soft_wrap=True)  # fmt: skip
     console.print(f"study written to {escape(str(out))} (study.zarr, study.csv, extension.png)")
-    finish(console, findings, allow=allow_untrusted, what="study")
+    finish(findings, allow=allow_untrusted, what="study")
 
 
 def register(app: typer.Typer) -> None:
