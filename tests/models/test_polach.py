@@ -672,3 +672,21 @@ def test_mu0_above_one_warns_in_the_function_the_contact_and_the_set(as_array):
         PolachContact(110e3, 10.0, 8.6e-3, 5.3e-3, mu0=30.0)
     with pytest.warns(PlausibilityWarning, match=r"^polach2005_dry: mu0 = 1.2 is outside"):
         polach_parameters("polach2005_dry").replace(mu0=1.2)
+
+
+def test_the_quiet_form_gives_the_same_forces_and_errors_without_plausibility_warnings():
+    # the fits' optimiser calls polach_forces_quiet: the same law (bit for bit), the same
+    # errors for impossible inputs, no warning for implausible ones (checked once by the fit)
+    from railadhesion.models.polach import polach_forces_quiet
+
+    creep = np.linspace(-0.3, 0.3, 41)
+    args = (creep, 0.001, 0.5, 300e3, 150.0, 0.006, 0.005)  # 300 kN, 150 m/s: implausible
+    with pytest.warns(PlausibilityWarning):
+        loud = polach_forces(*args, mu0=0.4, A=0.4, B=0.6)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        quiet = polach_forces_quiet(*args, mu0=0.4, A=0.4, B=0.6)
+    np.testing.assert_array_equal(np.asarray(quiet), np.asarray(loud))
+    with pytest.raises(ValueError, match=r"mu0 must be in \(0, 1.5\], got 30.0; given in "
+                       r"percent\?"):
+        polach_forces_quiet(*args, mu0=30.0)

@@ -507,3 +507,20 @@ def test_compiled_twod_laws_equal_the_numpy_oracle(creep, load, a, r, mu, k_a, k
     for g, w in zip(got, want, strict=True):
         assert g.shape == (4, 2)
         np.testing.assert_allclose(g, w, rtol=1e-12, atol=1e-13 * max(load, a))
+
+
+def test_fletcher_quiet_is_fletcher_without_plausibility_warnings():
+    import warnings
+
+    from railadhesion.models.twod import fletcher, fletcher_quiet
+    from railadhesion.plausibility import PlausibilityWarning
+
+    creep = np.linspace(0.0, 5.0, 21)  # creep in percent: implausible for the loud form
+    with pytest.warns(PlausibilityWarning):
+        loud = fletcher(creep, 1.0, 2e-4, 0.0235, 0.3, k_a=0.2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        quiet = fletcher_quiet(creep, 1.0, 2e-4, 0.0235, 0.3, k_a=0.2)
+    np.testing.assert_array_equal(np.asarray(quiet.traction), np.asarray(loud.traction))
+    with pytest.raises(ValueError, match="normal_load"):
+        fletcher_quiet(creep, -1.0, 2e-4, 0.0235, 0.3)
