@@ -978,7 +978,7 @@ class BrakingSimulator:
             return
         args = (highest, "pressure_command")
         text = check_plausible(*args, quantity="brake_pressure", emit=False)
-        if text is not None and text not in self.warnings:  # new: warn (UnitWarning if bar?)
+        if text is not None and text not in self.warnings:  # a new message: warn and record it
             self.warnings.append(check_plausible(*args, quantity="brake_pressure"))
 
     # -- whole runs (used by simulate) ------------------------------------------------------
